@@ -1,0 +1,20 @@
+//! Cohesion slot.
+
+use super::{CohesionModel, Contact};
+use crate::math::Real;
+
+/// No cohesion: costs nothing and adds nothing to the neighbour cut-off.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoCohesion;
+
+impl CohesionModel for NoCohesion {
+    #[inline(always)]
+    fn reach(&self) -> Real {
+        0.0
+    }
+
+    #[inline(always)]
+    fn force(&self, _: &Contact) -> Real {
+        0.0
+    }
+}

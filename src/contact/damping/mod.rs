@@ -1,0 +1,5 @@
+//! Normal damping slot.
+
+mod viscous;
+
+pub use viscous::ViscousNormal;

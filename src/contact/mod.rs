@@ -1,0 +1,209 @@
+//! Contact laws composed from slots: normal, damping, tangential, rolling, cohesion.
+//!
+//! Each slot is a generic parameter of [`ContactLaw`]; an absent slot is a zero-sized `No*`
+//! type whose methods are empty and inline away, so a scene pays only for the physics it
+//! uses. The combination is chosen once, when the scene is read (see `simulation`), never
+//! per contact. Parameters are tables indexed by species pair, `si * n_species + sj`.
+
+pub mod cohesion;
+pub mod damping;
+pub mod normal;
+pub mod rolling;
+pub mod tangential;
+
+use crate::math::{Real, Vec3};
+use crate::neighbor::PairHistory;
+
+/// Geometry and kinematics of one interacting pair, seen from particle `i`.
+#[derive(Clone, Copy, Debug)]
+pub struct Contact {
+    /// Species-pair index into the slots' parameter tables.
+    pub species_pair: usize,
+    /// Unit vector from `j` to `i`.
+    pub normal: Vec3,
+    pub distance: Real,
+    /// `r_i + r_j - distance`; negative when apart (cohesion may still act).
+    pub overlap: Real,
+    pub radius_i: Real,
+    pub radius_j: Real,
+    /// Effective radius `r_i r_j / (r_i + r_j)`.
+    pub r_eff: Real,
+    /// Effective mass `m_i m_j / (m_i + m_j)`.
+    pub m_eff: Real,
+    /// Relative velocity `v_i - v_j` at the contact point (spins included when rotating).
+    pub relative_velocity: Vec3,
+    /// Normal component `relative_velocity . normal` (negative while approaching).
+    pub normal_speed: Real,
+    /// Tangential part of the relative velocity.
+    pub tangential_velocity: Vec3,
+}
+
+/// Force and torques one pair exerts; the force on `j` is `-force_on_i`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairResult {
+    pub force_on_i: Vec3,
+    pub torque_on_i: Vec3,
+    pub torque_on_j: Vec3,
+}
+
+/// The elastic normal response: force magnitude (positive pushes apart) and the local
+/// stiffness dF/d(overlap), which restitution-based damping needs.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NormalResponse {
+    pub force: Real,
+    pub stiffness: Real,
+}
+
+pub trait NormalModel: Send + Sync {
+    /// Centre distance below which the pair interacts.
+    fn cutoff(&self, species_pair: usize, radius_i: Real, radius_j: Real) -> Real;
+    /// Elastic force at `contact`; only called when `distance < cutoff`.
+    fn response(&self, contact: &Contact) -> NormalResponse;
+    /// Stiffness of the linearized contact at its stiffest, for the time step.
+    fn linear_stiffness(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> Real;
+}
+
+pub trait DampingModel: Send + Sync {
+    /// Normal damping force (positive pushes apart).
+    fn force(&self, contact: &Contact, elastic: &NormalResponse) -> Real;
+    /// Damping coefficient of the linearized contact (kg/s), for the time-step limit.
+    fn linear_coefficient(&self, species_pair: usize, stiffness: Real, m_eff: Real) -> Real;
+}
+
+pub trait TangentialModel: Send + Sync {
+    type History: PairHistory;
+    /// Whether the model needs particle spin (contact-point velocity, torques).
+    const NEEDS_ROTATION: bool;
+    /// Tangential force on `i`; `normal_force` is the total normal force magnitude.
+    fn force(&self, contact: &Contact, normal_force: Real, history: &mut Self::History, dt: Real) -> Vec3;
+}
+
+pub trait RollingModel: Send + Sync {
+    const NEEDS_ROTATION: bool;
+    /// Rolling-resistance torque on `i` (the torque on `j` is its negative).
+    fn torque(&self, contact: &Contact, normal_force: Real, omega_i: Vec3, omega_j: Vec3) -> Vec3;
+}
+
+pub trait CohesionModel: Send + Sync {
+    /// How far beyond touching (`r_i + r_j`) the attraction reaches; the neighbour search
+    /// adds it to its cut-off.
+    fn reach(&self) -> Real;
+    /// Attractive force magnitude (positive pulls together).
+    fn force(&self, contact: &Contact) -> Real;
+}
+
+/// What the force loop needs from a law.
+pub trait PairLaw: Send + Sync {
+    type History: PairHistory;
+    const NEEDS_ROTATION: bool;
+    /// Largest distance beyond `r_i + r_j` at which any pair still interacts.
+    fn reach(&self) -> Real;
+    fn cutoff(&self, species_pair: usize, radius_i: Real, radius_j: Real) -> Real;
+    fn evaluate(&self, contact: &Contact, history: &mut Self::History, omega: (Vec3, Vec3), dt: Real) -> PairResult;
+    /// (stiffness, damping coefficient) of the linearized contact of two particles.
+    fn linearized(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> (Real, Real);
+}
+
+/// A contact law assembled from five slots.
+#[derive(Clone, Debug)]
+pub struct ContactLaw<N, D, T, R, C> {
+    pub normal: N,
+    pub damping: D,
+    pub tangential: T,
+    pub rolling: R,
+    pub cohesion: C,
+    /// Largest `cutoff - (r_i + r_j)` over the species pairs, from the normal slot.
+    pub normal_reach: Real,
+}
+
+impl<N, D, T, R, C> PairLaw for ContactLaw<N, D, T, R, C>
+where
+    N: NormalModel,
+    D: DampingModel,
+    T: TangentialModel,
+    R: RollingModel,
+    C: CohesionModel,
+{
+    type History = T::History;
+    const NEEDS_ROTATION: bool = T::NEEDS_ROTATION || R::NEEDS_ROTATION;
+
+    fn reach(&self) -> Real {
+        self.normal_reach.max(self.cohesion.reach())
+    }
+
+    fn cutoff(&self, species_pair: usize, radius_i: Real, radius_j: Real) -> Real {
+        self.normal
+            .cutoff(species_pair, radius_i, radius_j)
+            .max(radius_i + radius_j + self.cohesion.reach())
+    }
+
+    #[inline(always)]
+    fn evaluate(&self, contact: &Contact, history: &mut T::History, omega: (Vec3, Vec3), dt: Real) -> PairResult {
+        let touching = contact.distance
+            < self
+                .normal
+                .cutoff(contact.species_pair, contact.radius_i, contact.radius_j);
+        if !touching {
+            // A separated pair loses its history; cohesion may still pull.
+            *history = T::History::default();
+            let pull = self.cohesion.force(contact);
+            return PairResult {
+                force_on_i: -pull * contact.normal,
+                ..Default::default()
+            };
+        }
+        // The normal part first: friction and rolling need |F_n|.
+        let elastic = self.normal.response(contact);
+        let normal_force = elastic.force + self.damping.force(contact, &elastic);
+        let tangential = self.tangential.force(contact, normal_force, history, dt);
+        let pull = self.cohesion.force(contact);
+        let force_on_i = (normal_force - pull) * contact.normal + tangential;
+        if !Self::NEEDS_ROTATION {
+            return PairResult {
+                force_on_i,
+                ..Default::default()
+            };
+        }
+        // Torque of the tangential force about each centre (contact point on the line of
+        // centres), plus rolling resistance.
+        let arm_i = -contact.normal * (contact.radius_i - 0.5 * contact.overlap);
+        let arm_j = contact.normal * (contact.radius_j - 0.5 * contact.overlap);
+        let rolling = self.rolling.torque(contact, normal_force.abs(), omega.0, omega.1);
+        PairResult {
+            force_on_i,
+            torque_on_i: arm_i.cross(tangential) + rolling,
+            torque_on_j: arm_j.cross(-tangential) - rolling,
+        }
+    }
+
+    fn linearized(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> (Real, Real) {
+        let k = self.normal.linear_stiffness(species_pair, radius_i, radius_j, m_eff);
+        let gamma = self.damping.linear_coefficient(species_pair, k, m_eff);
+        (k, gamma)
+    }
+}
+
+/// The seed's model, paper A Eq. (1)-(2): WCA repulsion, normal and tangential dashpots; no
+/// rotation, no history, no cohesion.
+pub type SeedModel = ContactLaw<
+    normal::Wca,
+    damping::ViscousNormal,
+    tangential::ViscousTangential,
+    rolling::NoRolling,
+    cohesion::NoCohesion,
+>;
+
+impl SeedModel {
+    /// Tables are indexed by species pair `si * n + sj`.
+    pub fn seed(wca: Vec<normal::WcaCoefficients>, gamma_n: Vec<Real>, gamma_t: Vec<Real>) -> Self {
+        let normal_reach = 0.0; // r_c = 2^(1/6) sigma is the diameter; cutoff() takes the max
+        ContactLaw {
+            normal: normal::Wca { table: wca },
+            damping: damping::ViscousNormal { gamma_n },
+            tangential: tangential::ViscousTangential { gamma_t },
+            rolling: rolling::NoRolling,
+            cohesion: cohesion::NoCohesion,
+            normal_reach,
+        }
+    }
+}

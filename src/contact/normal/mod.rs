@@ -1,0 +1,5 @@
+//! Normal (elastic repulsion) slot.
+
+mod wca;
+
+pub use wca::{Wca, WcaCoefficients};

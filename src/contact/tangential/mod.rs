@@ -1,0 +1,5 @@
+//! Tangential slot.
+
+mod viscous;
+
+pub use viscous::ViscousTangential;

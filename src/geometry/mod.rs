@@ -1,0 +1,5 @@
+//! Shapes particles collide with: analytic walls (and, later, SDF bodies from STL).
+
+mod finite_plane;
+
+pub use finite_plane::FinitePlane;

@@ -1,0 +1,79 @@
+//! Linked cells: particles binned by a counting sort into cells at least one cut-off wide.
+
+use crate::domain::Domain;
+use crate::math::{Real, Vec3};
+
+/// Particles binned into a regular grid of cells covering the domain.
+///
+/// Cells are at least `cell_size` wide, so every partner within the cut-off lies in the 27
+/// cells around a particle's own. On bounded axes a particle outside the box is clamped into
+/// the edge cell; clamping never separates two nearby particles by more than one cell.
+#[derive(Clone, Debug, Default)]
+pub struct CellGrid {
+    pub counts: [usize; 3],
+    pub cell_of: Vec<u32>,
+    /// Particles of cell `c` are `items[start[c]..start[c + 1]]`, in increasing index order.
+    pub start: Vec<u32>,
+    pub items: Vec<u32>,
+    inv_width: Vec3,
+    lo: Vec3,
+}
+
+impl CellGrid {
+    pub fn build(domain: &Domain, positions: &[Vec3], cell_size: Real) -> CellGrid {
+        let length = domain.length();
+        let mut counts = [1usize; 3];
+        let mut inv_width = Vec3::ZERO;
+        for axis in 0..3 {
+            counts[axis] = ((length[axis] / cell_size).floor() as usize).clamp(1, 1 << 10);
+            inv_width[axis] = counts[axis] as Real / length[axis];
+        }
+        let mut grid = CellGrid {
+            counts,
+            inv_width,
+            lo: domain.lo,
+            ..Default::default()
+        };
+        grid.cell_of = positions.iter().map(|&p| grid.cell_index(p)).collect();
+        let n_cells = counts[0] * counts[1] * counts[2];
+        let mut start = vec![0u32; n_cells + 1];
+        for &c in &grid.cell_of {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..n_cells {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; positions.len()];
+        for (i, &c) in grid.cell_of.iter().enumerate() {
+            items[fill[c as usize] as usize] = i as u32;
+            fill[c as usize] += 1;
+        }
+        grid.start = start;
+        grid.items = items;
+        grid
+    }
+
+    pub fn cell_coords(&self, p: Vec3) -> [usize; 3] {
+        let mut c = [0usize; 3];
+        for axis in 0..3 {
+            let x = ((p[axis] - self.lo[axis]) * self.inv_width[axis]).floor();
+            c[axis] = x.clamp(0.0, (self.counts[axis] - 1) as Real) as usize;
+        }
+        c
+    }
+
+    pub fn cell_index(&self, p: Vec3) -> u32 {
+        let c = self.cell_coords(p);
+        self.linear(c)
+    }
+
+    pub fn linear(&self, c: [usize; 3]) -> u32 {
+        ((c[2] * self.counts[1] + c[1]) * self.counts[0] + c[0]) as u32
+    }
+
+    pub fn particles_in(&self, cell: u32) -> &[u32] {
+        let c = cell as usize;
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+}

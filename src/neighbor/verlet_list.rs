@@ -1,0 +1,273 @@
+//! The Verlet pair list: half list with periodic images, rebuilt from the cell grid when a
+//! particle has moved more than half the skin since the last build.
+
+use rayon::prelude::*;
+
+use super::cell_grid::CellGrid;
+use crate::domain::Domain;
+use crate::math::{Real, Vec3};
+use crate::particles::Particles;
+
+/// One pair within cut-off plus skin: particle `i < j`, with `j` seen through periodic
+/// image `image` (see [`Domain::image_shift`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Pair {
+    pub i: u32,
+    pub j: u32,
+    pub image: u8,
+}
+
+/// Per-pair contact history (e.g. a tangential spring). Stored once per pair, kept across
+/// list rebuilds, mirrored when a re-sort swaps which particle of the pair comes first.
+pub trait PairHistory: Copy + Default + Send + Sync + PartialEq {
+    /// The same history seen from the other particle.
+    fn mirrored(self) -> Self;
+}
+
+/// The seed's model keeps no history: a zero-sized type, so its store costs nothing.
+impl PairHistory for () {
+    fn mirrored(self) -> Self {}
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct VerletList {
+    pub pairs: Vec<Pair>,
+    /// Pairs whose first particle is `i`: `pairs[out_start[i]..out_start[i + 1]]`.
+    pub out_start: Vec<u32>,
+    /// Pairs whose second particle is `j`: `in_pairs[in_start[j]..in_start[j + 1]]`.
+    pub in_start: Vec<u32>,
+    pub in_pairs: Vec<u32>,
+    /// Positions at the last build, for the displacement criterion.
+    reference: Vec<Vec3>,
+    pub skin: Real,
+    pub builds: u64,
+}
+
+impl VerletList {
+    pub fn new(skin: Real) -> Self {
+        VerletList {
+            skin,
+            ..Default::default()
+        }
+    }
+
+    /// True when some particle moved more than half the skin since the last build, or the
+    /// particle count changed.
+    pub fn needs_rebuild(&self, positions: &[Vec3]) -> bool {
+        if positions.len() != self.reference.len() || self.builds == 0 {
+            return true;
+        }
+        let limit = 0.25 * self.skin * self.skin;
+        positions
+            .par_iter()
+            .zip(&self.reference)
+            .any(|(p, r)| (*p - *r).length_squared() > limit)
+    }
+
+    /// Rebuilds the list. Wraps periodic positions into the box first. When `resort` is set
+    /// the particles are reordered by cell so memory order follows space; the permutation
+    /// applied (new index -> old index) is returned so callers can carry per-pair data over.
+    ///
+    /// `reach` is how far beyond touching (`r_i + r_j`) the contact law acts.
+    pub fn build(
+        &mut self,
+        particles: &mut Particles,
+        domain: &Domain,
+        reach: Real,
+        resort: bool,
+    ) -> Option<Vec<u32>> {
+        for p in particles.position.iter_mut() {
+            *p = domain.wrap(*p);
+        }
+        let max_radius = particles.radius.iter().cloned().fold(0.0, Real::max);
+        let cell_size = 2.0 * max_radius + reach + self.skin;
+        let mut grid = CellGrid::build(domain, &particles.position, cell_size);
+        let mut permutation = None;
+        if resort {
+            let order = grid.items.clone();
+            particles.permute(&order);
+            grid = CellGrid::build(domain, &particles.position, cell_size);
+            permutation = Some(order);
+        }
+        self.pairs = find_pairs(&grid, domain, particles, reach + self.skin);
+        self.index_pairs(particles.len());
+        self.reference = particles.position.clone();
+        self.builds += 1;
+        permutation
+    }
+
+    fn index_pairs(&mut self, n: usize) {
+        let mut out_start = vec![0u32; n + 1];
+        let mut in_start = vec![0u32; n + 1];
+        for pair in &self.pairs {
+            out_start[pair.i as usize + 1] += 1;
+            in_start[pair.j as usize + 1] += 1;
+        }
+        for k in 0..n {
+            out_start[k + 1] += out_start[k];
+            in_start[k + 1] += in_start[k];
+        }
+        let mut fill = in_start.clone();
+        let mut in_pairs = vec![0u32; self.pairs.len()];
+        for (k, pair) in self.pairs.iter().enumerate() {
+            let slot = &mut fill[pair.j as usize];
+            in_pairs[*slot as usize] = k as u32;
+            *slot += 1;
+        }
+        self.out_start = out_start;
+        self.in_start = in_start;
+        self.in_pairs = in_pairs;
+    }
+
+    /// Carries per-pair history from the previous list to this one. `old_pairs` and
+    /// `old_history` are the list before the rebuild; `remap` maps old particle indices to
+    /// new ones (`u32::MAX` for a removed particle) when particles were reordered or removed.
+    /// Pairs that are new start from the default history.
+    pub fn carry_history<H: PairHistory>(
+        &self,
+        old_pairs: &[Pair],
+        old_history: &[H],
+        remap: Option<&[u32]>,
+    ) -> Vec<H> {
+        if std::mem::size_of::<H>() == 0 {
+            return vec![H::default(); self.pairs.len()];
+        }
+        let mut old: Vec<(Pair, H)> = match remap {
+            None => old_pairs
+                .iter()
+                .copied()
+                .zip(old_history.iter().copied())
+                .collect(),
+            Some(new_index) => {
+                let mut remapped: Vec<(Pair, H)> = old_pairs
+                    .iter()
+                    .zip(old_history)
+                    .filter_map(|(pair, &h)| {
+                        let (i, j) = (new_index[pair.i as usize], new_index[pair.j as usize]);
+                        if i == u32::MAX || j == u32::MAX {
+                            None
+                        } else if i < j {
+                            Some((Pair { i, j, ..*pair }, h))
+                        } else {
+                            let image = 26 - pair.image; // the opposite image
+                            Some((Pair { i: j, j: i, image }, h.mirrored()))
+                        }
+                    })
+                    .collect();
+                remapped.sort_unstable_by_key(|(pair, _)| *pair);
+                remapped
+            }
+        };
+        old.dedup_by_key(|(pair, _)| *pair);
+        let mut history = Vec::with_capacity(self.pairs.len());
+        let mut cursor = 0;
+        for pair in &self.pairs {
+            while cursor < old.len() && old[cursor].0 < *pair {
+                cursor += 1;
+            }
+            history.push(if cursor < old.len() && old[cursor].0 == *pair {
+                old[cursor].1
+            } else {
+                H::default()
+            });
+        }
+        history
+    }
+}
+
+/// All pairs `i < j` (with image) closer than `r_i + r_j + extra`, sorted by `(i, j, image)`.
+fn find_pairs(grid: &CellGrid, domain: &Domain, particles: &Particles, extra: Real) -> Vec<Pair> {
+    let positions = &particles.position;
+    let radii = &particles.radius;
+    let per_particle: Vec<Vec<Pair>> = (0..particles.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut found = Vec::new();
+            let home = grid.cell_coords(positions[i]);
+            for dz in -1i32..=1 {
+                for dy in -1i32..=1 {
+                    for dx in -1i32..=1 {
+                        let Some((cell, image)) = neighbour_cell(grid, domain, home, [dx, dy, dz])
+                        else {
+                            continue;
+                        };
+                        let shift = domain.image_shift(image);
+                        for &j in grid.particles_in(cell) {
+                            if (j as usize) <= i {
+                                continue;
+                            }
+                            let reach = radii[i] + radii[j as usize] + extra;
+                            let d = positions[j as usize] + shift - positions[i];
+                            if d.length_squared() < reach * reach {
+                                found.push(Pair {
+                                    i: i as u32,
+                                    j,
+                                    image,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+            found.sort_unstable();
+            found
+        })
+        .collect();
+    per_particle.concat()
+}
+
+/// The cell at `home + offset` and the periodic image it is seen through, or None when the
+/// offset leaves a bounded axis. On a periodic axis with fewer than three cells the same cell
+/// is reached through different images, which is what a short box needs.
+fn neighbour_cell(
+    grid: &CellGrid,
+    domain: &Domain,
+    home: [usize; 3],
+    offset: [i32; 3],
+) -> Option<(u32, u8)> {
+    let mut cell = [0usize; 3];
+    let mut image = [0i32; 3];
+    for axis in 0..3 {
+        let n = grid.counts[axis] as i32;
+        let c = home[axis] as i32 + offset[axis];
+        if domain.periodic[axis] {
+            image[axis] = c.div_euclid(n);
+            cell[axis] = c.rem_euclid(n) as usize;
+        } else if c < 0 || c >= n {
+            return None;
+        } else {
+            cell[axis] = c as usize;
+        }
+    }
+    Some((grid.linear(cell), Domain::image_index(image)))
+}
+
+/// Reference answer for tests: every pair `i < j` over all images within `r_i + r_j + extra`.
+pub fn brute_force_pairs(particles: &Particles, domain: &Domain, extra: Real) -> Vec<Pair> {
+    let mut pairs = Vec::new();
+    let range = |axis: usize| if domain.periodic[axis] { -1..=1 } else { 0..=0 };
+    let n = particles.len();
+    let positions: Vec<Vec3> = particles.position.iter().map(|&p| domain.wrap(p)).collect();
+    for i in 0..n {
+        for j in i + 1..n {
+            for a in range(0) {
+                for b in range(1) {
+                    for c in range(2) {
+                        let image = Domain::image_index([a, b, c]);
+                        let d = positions[j] + domain.image_shift(image) - positions[i];
+                        let reach = particles.radius[i] + particles.radius[j] + extra;
+                        if d.length_squared() < reach * reach {
+                            pairs.push(Pair {
+                                i: i as u32,
+                                j: j as u32,
+                                image,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs
+}

@@ -1,0 +1,115 @@
+//! Particle state, one array per field (structure of arrays).
+//!
+//! Angular state exists only when the scene's contact law needs rotation; the seed's
+//! WCA model never allocates it.
+
+use crate::math::{Real, Vec3};
+
+/// Spin, torque and inverse moment of inertia, present only for laws with rotation.
+#[derive(Clone, Debug, Default)]
+pub struct AngularState {
+    pub omega: Vec<Vec3>,
+    pub torque: Vec<Vec3>,
+    pub inv_inertia: Vec<Real>,
+}
+
+/// All particles of a scene. Index order follows space (re-sorted by cell now and then);
+/// `id` is the stable identity used in outputs.
+#[derive(Clone, Debug, Default)]
+pub struct Particles {
+    pub id: Vec<u32>,
+    pub species: Vec<u16>,
+    pub position: Vec<Vec3>,
+    pub velocity: Vec<Vec3>,
+    pub force: Vec<Vec3>,
+    pub radius: Vec<Real>,
+    pub mass: Vec<Real>,
+    pub inv_mass: Vec<Real>,
+    pub angular: Option<AngularState>,
+}
+
+impl Particles {
+    pub fn new(with_rotation: bool) -> Self {
+        Particles {
+            angular: with_rotation.then(AngularState::default),
+            ..Default::default()
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Appends a particle at rest. `mass` in kg; a solid sphere's inertia if rotating.
+    pub fn push(&mut self, species: u16, position: Vec3, radius: Real, mass: Real) {
+        let next_id = self.id.last().map_or(0, |&last| last + 1);
+        self.id.push(next_id);
+        self.species.push(species);
+        self.position.push(position);
+        self.velocity.push(Vec3::ZERO);
+        self.force.push(Vec3::ZERO);
+        self.radius.push(radius);
+        self.mass.push(mass);
+        self.inv_mass.push(1.0 / mass);
+        if let Some(angular) = &mut self.angular {
+            angular.omega.push(Vec3::ZERO);
+            angular.torque.push(Vec3::ZERO);
+            angular.inv_inertia.push(1.0 / (0.4 * mass * radius * radius));
+        }
+    }
+
+    /// Reorders every per-particle array: new index `k` holds old particle `order[k]`.
+    pub fn permute(&mut self, order: &[u32]) {
+        fn apply<T: Copy>(values: &mut Vec<T>, order: &[u32]) {
+            let reordered: Vec<T> = order.iter().map(|&old| values[old as usize]).collect();
+            *values = reordered;
+        }
+        apply(&mut self.id, order);
+        apply(&mut self.species, order);
+        apply(&mut self.position, order);
+        apply(&mut self.velocity, order);
+        apply(&mut self.force, order);
+        apply(&mut self.radius, order);
+        apply(&mut self.mass, order);
+        apply(&mut self.inv_mass, order);
+        if let Some(angular) = &mut self.angular {
+            apply(&mut angular.omega, order);
+            apply(&mut angular.torque, order);
+            apply(&mut angular.inv_inertia, order);
+        }
+    }
+
+    /// Keeps only the particles for which `keep` is true, preserving order.
+    pub fn retain(&mut self, keep: &[bool]) {
+        let order: Vec<u32> = (0..self.len() as u32)
+            .filter(|&k| keep[k as usize])
+            .collect();
+        self.permute(&order);
+    }
+
+    /// Total kinetic energy (translational plus rotational), J.
+    pub fn kinetic_energy(&self) -> Real {
+        let translational: Real = self
+            .velocity
+            .iter()
+            .zip(&self.mass)
+            .map(|(v, m)| 0.5 * m * v.length_squared())
+            .sum();
+        let rotational: Real = self.angular.as_ref().map_or(0.0, |a| {
+            a.omega
+                .iter()
+                .zip(&a.inv_inertia)
+                .map(|(w, inv_i)| 0.5 * w.length_squared() / inv_i)
+                .sum()
+        });
+        translational + rotational
+    }
+
+    pub fn total_mass(&self) -> Real {
+        self.mass.iter().sum()
+    }
+}

@@ -1,0 +1,399 @@
+//! Running a scene: build the world with the scene's laws, run its stages, measure and
+//! write the outputs (summary.json, timeseries.csv, profile.csv, repose.csv, VTK series).
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+use crate::analysis::heap::{self, HeapProfile, ReposeFit};
+use crate::contact::normal::WcaCoefficients;
+use crate::contact::{PairLaw, SeedModel};
+use crate::geometry::FinitePlane;
+use crate::insertion::{insert_random, InsertionFailed};
+use crate::io::{vtk::VtkSeries, write_atomic};
+use crate::math::Real;
+use crate::particles::Particles;
+use crate::scene::{ContactSettings, InsertAmount, Scene, StageEnd};
+use crate::simulation::{NeighborSettings, World};
+use crate::timestep::{self, LinearContact, Timescales, UnstableTimeStep};
+use crate::walls::{Wall, WallLaw, WallSet, WcaWall};
+
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub out_dir: PathBuf,
+    pub quiet: bool,
+    pub force_dt: bool,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("{file}: time step: {source}")]
+    TimeStep {
+        file: String,
+        source: UnstableTimeStep,
+    },
+    #[error("{file}: insert[{index}]: {source}")]
+    Insertion {
+        file: String,
+        index: usize,
+        source: InsertionFailed,
+    },
+    #[error("cannot write {path}: {message}")]
+    Output { path: PathBuf, message: String },
+}
+
+fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
+    RunError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// The angle measured at one time after the repose stage began.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReposeSample {
+    pub time_after_start_s: Real,
+    pub repose_angle_deg: Option<Real>,
+    pub repose_fit_r2: Option<Real>,
+    pub runout_m: Real,
+    pub wall_height_m: Real,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StageRecord {
+    pub name: String,
+    pub start_s: Real,
+    pub end_s: Real,
+    pub steps: u64,
+    pub ended_by: String,
+}
+
+/// Everything `summary.json` holds.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    pub case: String,
+    pub code: String,
+    pub lambda: u32,
+    pub n_particles: usize,
+    pub n_particles_inserted: usize,
+    pub lost_particles: u64,
+    pub steps: u64,
+    pub dt_s: Real,
+    pub contact_period_s: Real,
+    pub stable_dt_s: Real,
+    pub simulated_s: Real,
+    pub wall_s: Real,
+    pub particle_steps: u64,
+    pub particle_steps_per_s: Real,
+    pub threads: usize,
+    pub repose_angle_deg: Option<Real>,
+    pub repose_fit_r2: Option<Real>,
+    pub repose_rule: Option<String>,
+    pub runout_m: Option<Real>,
+    pub repose_samples: Vec<ReposeSample>,
+    pub stages: Vec<StageRecord>,
+    pub warnings: Vec<String>,
+    pub scene_file: String,
+    pub cgdem_version: String,
+}
+
+/// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.
+pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> {
+    match &scene.contact {
+        ContactSettings::Wca { .. } => {
+            let (law, wall_law) = seed_laws(scene);
+            execute(scene, law, wall_law, options)
+        }
+    }
+}
+
+/// The seed's particle law and wall law for a scene with `ContactSettings::Wca`.
+pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
+    let ContactSettings::Wca {
+        epsilon,
+        sigma,
+        gamma_n,
+        gamma_t,
+    } = scene.contact;
+    let n = scene.species.len();
+    let wca = WcaCoefficients { epsilon, sigma };
+    let law = SeedModel::seed(vec![wca; n * n], vec![gamma_n; n * n], vec![gamma_t; n * n]);
+    let per_species: Vec<(WcaCoefficients, Real)> = scene.species.iter().map(|s| (wca, s.mass())).collect();
+    let wall_law = WcaWall::new(&per_species, scene.wall_contact.restitution, scene.wall_contact.friction);
+    (law, wall_law)
+}
+
+/// Linearized contacts of every species pair and every species against a wall.
+pub fn linear_contacts<L: PairLaw, W: WallLaw>(scene: &Scene, law: &L, wall_law: &W) -> Vec<LinearContact> {
+    let n = scene.species.len();
+    let mut contacts = Vec::new();
+    for (a, sa) in scene.species.iter().enumerate() {
+        for (b, sb) in scene.species.iter().enumerate().skip(a) {
+            let m_eff = sa.mass() * sb.mass() / (sa.mass() + sb.mass());
+            let (k, gamma) = law.linearized(a * n + b, sa.radius(), sb.radius(), m_eff);
+            contacts.push(LinearContact {
+                label: format!("{}-{} particle", sa.name, sb.name),
+                stiffness: k,
+                damping: gamma,
+                mass: m_eff,
+            });
+        }
+        if !scene.walls.is_empty() {
+            let (k, gamma) = wall_law.linearized(a, sa.radius(), sa.mass());
+            contacts.push(LinearContact {
+                label: format!("{}-wall", sa.name),
+                stiffness: k,
+                damping: gamma,
+                mass: sa.mass(),
+            });
+        }
+    }
+    contacts
+}
+
+fn build_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError> {
+    let mut particles = Particles::new(rotation);
+    for (index, ins) in scene.insertions.iter().enumerate() {
+        let species = &scene.species[ins.species];
+        let count = match ins.amount {
+            InsertAmount::Count(n) => n,
+            InsertAmount::SolidVolume(v) => (v / (std::f64::consts::PI / 6.0 * species.diameter.powi(3))).round().max(1.0) as u64,
+        };
+        insert_random(&mut particles, ins.species as u16, species.radius(), species.mass(), ins.lo, ins.hi, count, ins.seed).map_err(|source| RunError::Insertion {
+            file: scene.source.display().to_string(),
+            index,
+            source,
+        })?;
+    }
+    Ok(particles)
+}
+
+fn build_walls(scene: &Scene) -> WallSet {
+    // Scene walls are bounded by the box: half-extents of the box diagonal cover it.
+    let half = scene.domain.length().length();
+    WallSet {
+        walls: scene
+            .walls
+            .iter()
+            .map(|w| Wall {
+                name: w.name.clone(),
+                plane: FinitePlane::new(w.point, w.normal, half, half),
+                active: true,
+            })
+            .collect(),
+    }
+}
+
+fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: &RunOptions) -> Result<RunSummary, RunError> {
+    let out = &options.out_dir;
+    std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
+    let file = scene.source.display().to_string();
+    let scales = Timescales::of(&linear_contacts(scene, &law, &wall_law));
+    let (dt, warning) = timestep::choose(scene.time_step, &scales, options.force_dt).map_err(|source| RunError::TimeStep { file: file.clone(), source })?;
+    let mut warnings: Vec<String> = warning.into_iter().collect();
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+
+    let particles = build_particles(scene, L::NEEDS_ROTATION)?;
+    let n_inserted = particles.len();
+    let neighbor = NeighborSettings {
+        skin: scene.skin_fraction * scene.max_diameter(),
+        resort_every: scene.resort_every,
+    };
+    let mut world = World::new(particles, scene.domain.clone(), build_walls(scene), law, wall_law, scene.species.len(), scene.gravity, dt, neighbor);
+
+    let timeseries_path = out.join("timeseries.csv");
+    let mut timeseries = std::io::BufWriter::new(std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?);
+    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m").map_err(|e| output_error(&timeseries_path, e))?;
+    let mut vtk = if scene.output.vtk_interval > 0.0 {
+        Some(VtkSeries::new(&out.join("vtk"), "particles").map_err(|e| output_error(&out.join("vtk"), e))?)
+    } else {
+        None
+    };
+
+    let max_diameter = scene.max_diameter();
+    let floor_z = scene.domain.lo.z;
+    let heap_profile = |world: &World<L, W>| -> Option<HeapProfile> {
+        scene.repose.as_ref().map(|r| {
+            heap::profile(&world.particles.position, &world.particles.radius, r.wall_x, scene.domain.hi.x, floor_z, r.bin_width_diameters * max_diameter)
+        })
+    };
+    let fit = |profile: &HeapProfile| -> Option<ReposeFit> {
+        let r = scene.repose.as_ref()?;
+        heap::repose_angle(profile, 2.0 * max_diameter, r.exclude_wall_fraction, r.exclude_toe_fraction)
+    };
+
+    let total_estimate: Real = scene
+        .stages
+        .iter()
+        .map(|s| match s.end {
+            StageEnd::Duration(d) => d,
+            StageEnd::Settled { max_duration, .. } => max_duration,
+        })
+        .sum();
+    let progress = if options.quiet || !std::io::stderr().is_terminal() {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new((total_estimate / dt).ceil() as u64);
+        bar.set_style(ProgressStyle::with_template("{msg:>10} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+        bar
+    };
+
+    let started = Instant::now();
+    let mut particle_steps: u64 = 0;
+    let mut stages = Vec::new();
+    let mut samples = Vec::new();
+    let mut next_row = 0.0;
+    let mut next_frame = 0.0;
+    let mut final_profile = None;
+    for stage in &scene.stages {
+        for name in &stage.remove_walls {
+            world.walls.remove(name);
+        }
+        progress.set_message(stage.name.clone());
+        let start = world.time;
+        let start_steps = world.steps;
+        let (duration, settle_threshold, min_duration) = match stage.end {
+            StageEnd::Duration(d) => (d, None, d),
+            StageEnd::Settled {
+                kinetic_energy_per_mass,
+                min_duration,
+                max_duration,
+            } => (max_duration, Some(kinetic_energy_per_mass), min_duration),
+        };
+        let stage_steps = (duration / dt).round() as u64;
+        let repose_times: Vec<Real> = match &scene.repose {
+            Some(r) if r.stage == stage.name => r.at_times.clone(),
+            _ => Vec::new(),
+        };
+        let mut next_sample = 0;
+        let mut ended_by = format!("duration {duration} s");
+        for k in 1..=stage_steps {
+            world.step();
+            particle_steps += world.particles.len() as u64;
+            if k % 256 == 0 {
+                progress.inc(256);
+            }
+            let elapsed = world.time - start;
+            if world.time + 0.5 * dt >= next_row {
+                next_row += scene.output.timeseries_interval;
+                let ke = world.kinetic_energy();
+                let mass = world.particles.total_mass();
+                let profile = heap_profile(&world);
+                let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
+                let wall_height = profile.as_ref().map(|p| p.wall_height());
+                let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+                writeln!(timeseries, "{:.9e},{},{:.9e},{:.9e},{},{},{}", world.time, stage.name, ke, ke / mass.max(Real::MIN_POSITIVE), world.particles.len(), opt(front), opt(wall_height)).map_err(|e| output_error(&timeseries_path, e))?;
+                timeseries.flush().map_err(|e| output_error(&timeseries_path, e))?;
+                if let Some(threshold) = settle_threshold {
+                    if elapsed >= min_duration && ke / mass < threshold {
+                        ended_by = format!("kinetic energy per mass {:.3e} J/kg < {threshold:.3e} J/kg", ke / mass);
+                        break;
+                    }
+                }
+            }
+            if let Some(series) = &mut vtk {
+                if world.time + 0.5 * dt >= next_frame {
+                    next_frame += scene.output.vtk_interval;
+                    series.write_frame(&world.particles, world.time).map_err(|e| output_error(&out.join("vtk"), e))?;
+                }
+            }
+            if next_sample < repose_times.len() && elapsed + 0.5 * dt >= repose_times[next_sample] {
+                if let Some(profile) = heap_profile(&world) {
+                    let f = fit(&profile);
+                    samples.push(ReposeSample {
+                        time_after_start_s: repose_times[next_sample],
+                        repose_angle_deg: f.as_ref().map(|f| f.angle_deg),
+                        repose_fit_r2: f.as_ref().map(|f| f.r_squared),
+                        runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
+                        wall_height_m: profile.wall_height(),
+                    });
+                    final_profile = Some(profile);
+                }
+                next_sample += 1;
+            }
+        }
+        if settle_threshold.is_some() && ended_by.starts_with("duration") {
+            let w = format!("stage `{}` did not settle within max_duration {duration} s", stage.name);
+            eprintln!("warning: {w}");
+            warnings.push(w);
+        }
+        stages.push(StageRecord {
+            name: stage.name.clone(),
+            start_s: start,
+            end_s: world.time,
+            steps: world.steps - start_steps,
+            ended_by,
+        });
+    }
+    progress.finish_and_clear();
+    let wall_s = started.elapsed().as_secs_f64();
+    if world.lost > 0 {
+        let w = format!("{} particles left the box through a bounded face and were removed", world.lost);
+        eprintln!("warning: {w}");
+        warnings.push(w);
+    }
+
+    let final_profile = final_profile.or_else(|| heap_profile(&world));
+    if let Some(profile) = &final_profile {
+        let path = out.join("profile.csv");
+        let mut csv = String::from("x_m,height_m\n");
+        for (k, h) in profile.heights.iter().enumerate() {
+            csv += &format!("{:.6e},{:.6e}\n", profile.bin_centre(k), h);
+        }
+        write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
+    }
+    if !samples.is_empty() {
+        let path = out.join("repose.csv");
+        let mut csv = String::from("time_after_start_s,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n");
+        let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
+        for s in &samples {
+            csv += &format!("{},{},{},{:.6e},{:.6e}\n", s.time_after_start_s, opt(s.repose_angle_deg), opt(s.repose_fit_r2), s.runout_m, s.wall_height_m);
+        }
+        write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
+    }
+    let headline = samples.last();
+    let summary = RunSummary {
+        case: scene.name.clone(),
+        code: "cgdem".into(),
+        lambda: scene.lambda,
+        n_particles: world.particles.len(),
+        n_particles_inserted: n_inserted,
+        lost_particles: world.lost,
+        steps: world.steps,
+        dt_s: dt,
+        contact_period_s: scales.shortest_period,
+        stable_dt_s: scales.stable_limit,
+        simulated_s: world.time,
+        wall_s,
+        particle_steps,
+        particle_steps_per_s: particle_steps as Real / wall_s.max(1e-9),
+        threads: rayon::current_num_threads(),
+        repose_angle_deg: headline.and_then(|s| s.repose_angle_deg),
+        repose_fit_r2: headline.and_then(|s| s.repose_fit_r2),
+        repose_rule: scene.repose.as_ref().map(|r| {
+            format!(
+                "least-squares line through the surface profile (bins of {} diameters) between {}% of the run-out from the wall and {}% before the front (deposit >= 2 diameters deep), measured {} s after stage `{}` began",
+                r.bin_width_diameters,
+                r.exclude_wall_fraction * 100.0,
+                r.exclude_toe_fraction * 100.0,
+                r.at_times.last().copied().unwrap_or(0.0),
+                r.stage
+            )
+        }),
+        runout_m: headline.map(|s| s.runout_m),
+        repose_samples: samples,
+        stages,
+        warnings,
+        scene_file: file,
+        cgdem_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let path = out.join("summary.json");
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&path, e))?;
+    write_atomic(&path, json.as_bytes()).map_err(|e| output_error(&path, e))?;
+    Ok(summary)
+}

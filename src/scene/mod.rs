@@ -1,0 +1,162 @@
+//! Scene files: TOML read into raw structs, then validated once into typed settings.
+
+mod error;
+mod raw;
+mod validate;
+
+pub use error::SceneError;
+
+use std::path::{Path, PathBuf};
+
+use crate::domain::Domain;
+use crate::math::{Real, Vec3};
+use crate::timestep::TimeStepRequest;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Species {
+    pub name: String,
+    pub diameter: Real,
+    pub density: Real,
+}
+
+impl Species {
+    pub fn radius(&self) -> Real {
+        0.5 * self.diameter
+    }
+
+    pub fn mass(&self) -> Real {
+        self.density * std::f64::consts::PI / 6.0 * self.diameter.powi(3)
+    }
+}
+
+/// The particle-particle contact law and its parameters (one set for all species pairs).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ContactSettings {
+    /// The seed's model, paper A Eq. (1)-(2): WCA repulsion plus normal and tangential
+    /// viscous damping.
+    Wca {
+        epsilon: Real,
+        sigma: Real,
+        gamma_n: Real,
+        gamma_t: Real,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct WallContactSettings {
+    pub restitution: Real,
+    pub friction: Real,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct WallSettings {
+    pub name: String,
+    pub point: Vec3,
+    pub normal: Vec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum InsertAmount {
+    Count(u64),
+    /// Total solid volume, m^3: the count follows from the particle size, so coarse-graining
+    /// keeps the mass.
+    SolidVolume(Real),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Insertion {
+    pub species: usize,
+    pub lo: Vec3,
+    pub hi: Vec3,
+    pub amount: InsertAmount,
+    pub seed: u64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum StageEnd {
+    /// Run for this long.
+    Duration(Real),
+    /// Run for at least `min_duration`, then until the kinetic energy per unit mass (J/kg,
+    /// invariant under coarse-graining) falls below the threshold, for at most `max_duration`.
+    Settled {
+        kinetic_energy_per_mass: Real,
+        min_duration: Real,
+        max_duration: Real,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    pub name: String,
+    pub remove_walls: Vec<String>,
+    pub end: StageEnd,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSettings {
+    /// Simulated seconds between VTK frames; 0 = none.
+    pub vtk_interval: Real,
+    /// Simulated seconds between time-series rows.
+    pub timeseries_interval: Real,
+}
+
+/// How and when the repose angle of a collapsed heap is measured (see `analysis::heap`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReposeSettings {
+    /// The stage after whose start the `at_times` count.
+    pub stage: String,
+    /// x of the wall that stays; the heap runs out towards +x.
+    pub wall_x: Real,
+    /// Times after the stage start at which the angle is measured; the last is the headline.
+    pub at_times: Vec<Real>,
+    pub bin_width_diameters: Real,
+    pub exclude_wall_fraction: Real,
+    pub exclude_toe_fraction: Real,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub name: String,
+    pub description: String,
+    pub source: PathBuf,
+    pub domain: Domain,
+    pub species: Vec<Species>,
+    pub contact: ContactSettings,
+    pub wall_contact: WallContactSettings,
+    pub walls: Vec<WallSettings>,
+    pub gravity: Vec3,
+    pub time_step: TimeStepRequest,
+    /// Neighbour skin as a fraction of the largest diameter (scales with coarse-graining).
+    pub skin_fraction: Real,
+    pub resort_every: u32,
+    pub insertions: Vec<Insertion>,
+    pub stages: Vec<Stage>,
+    pub output: OutputSettings,
+    pub repose: Option<ReposeSettings>,
+    /// Coarse-graining level already applied (1 = the original system).
+    pub lambda: u32,
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Unreadable {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Scene::parse(&text, path)
+    }
+
+    /// Validates scene text; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let raw: raw::RawScene = toml::from_str(text).map_err(|e| SceneError::Syntax {
+            file: path.to_path_buf(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        })?;
+        validate::scene(raw, path)
+    }
+
+    pub fn max_diameter(&self) -> Real {
+        self.species.iter().map(|s| s.diameter).fold(0.0, Real::max)
+    }
+}

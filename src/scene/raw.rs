@@ -1,0 +1,129 @@
+//! The scene file as written (TOML), before validation. Unknown keys are errors, so a typo
+//! is reported with its name instead of being ignored.
+
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScene {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub domain: RawDomain,
+    pub species: Vec<RawSpecies>,
+    pub contact: RawContact,
+    pub wall_contact: Option<RawWallContact>,
+    #[serde(default, rename = "wall")]
+    pub walls: Vec<RawWall>,
+    #[serde(default)]
+    pub gravity: Option<[f64; 3]>,
+    pub time: RawTime,
+    #[serde(default)]
+    pub neighbor: Option<RawNeighbor>,
+    #[serde(default, rename = "insert")]
+    pub insertions: Vec<RawInsertion>,
+    #[serde(rename = "stage")]
+    pub stages: Vec<RawStage>,
+    #[serde(default)]
+    pub output: Option<RawOutput>,
+    #[serde(default)]
+    pub repose: Option<RawRepose>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDomain {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    #[serde(default)]
+    pub periodic: [bool; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSpecies {
+    pub name: String,
+    pub diameter: f64,
+    pub density: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawContact {
+    pub model: String,
+    pub epsilon: Option<f64>,
+    pub sigma: Option<f64>,
+    pub gamma_n: Option<f64>,
+    pub gamma_t: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWallContact {
+    pub restitution: f64,
+    pub friction: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWall {
+    pub name: String,
+    pub point: [f64; 3],
+    pub normal: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTime {
+    pub dt_fraction: Option<f64>,
+    pub dt: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawNeighbor {
+    pub skin_fraction: Option<f64>,
+    pub resort_every: Option<u32>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawInsertion {
+    pub species: String,
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    pub count: Option<u64>,
+    pub solid_volume: Option<f64>,
+    #[serde(default)]
+    pub seed: u64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStage {
+    pub name: String,
+    #[serde(default)]
+    pub remove_walls: Vec<String>,
+    pub duration: Option<f64>,
+    pub until_kinetic_energy_per_mass_below: Option<f64>,
+    pub max_duration: Option<f64>,
+    pub min_duration: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawOutput {
+    pub vtk_interval: Option<f64>,
+    pub timeseries_interval: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRepose {
+    pub stage: String,
+    pub wall_x: f64,
+    pub at_times: Vec<f64>,
+    pub bin_width_diameters: Option<f64>,
+    pub exclude_wall_fraction: Option<f64>,
+    pub exclude_toe_fraction: Option<f64>,
+}

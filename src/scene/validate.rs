@@ -1,0 +1,298 @@
+//! Raw scene -> typed settings, with one precise error per bad value.
+
+use std::path::Path;
+
+use super::raw::*;
+use super::*;
+use crate::math::TWO_POW_ONE_SIXTH;
+
+struct Checker<'a> {
+    file: &'a Path,
+}
+
+impl Checker<'_> {
+    fn invalid(&self, field: impl Into<String>, value: impl std::fmt::Display, allowed: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_path_buf(),
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+
+    fn positive(&self, field: &str, value: f64) -> Result<f64, SceneError> {
+        if value.is_finite() && value > 0.0 {
+            Ok(value)
+        } else {
+            Err(self.invalid(field, value, "a finite number > 0"))
+        }
+    }
+
+    fn non_negative(&self, field: &str, value: f64) -> Result<f64, SceneError> {
+        if value.is_finite() && value >= 0.0 {
+            Ok(value)
+        } else {
+            Err(self.invalid(field, value, "a finite number >= 0"))
+        }
+    }
+
+    fn vector(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(Vec3::from_array(v))
+        } else {
+            Err(self.invalid(field, format!("{v:?}"), "three finite numbers"))
+        }
+    }
+
+    fn required<T>(&self, field: &str, value: Option<T>, what: &str) -> Result<T, SceneError> {
+        value.ok_or_else(|| self.invalid(field, "missing", what))
+    }
+}
+
+pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
+    let c = Checker { file };
+    if raw.name.trim().is_empty() {
+        return Err(c.invalid("name", "\"\"", "a non-empty case name"));
+    }
+
+    let lo = c.vector("domain.lo", raw.domain.lo)?;
+    let hi = c.vector("domain.hi", raw.domain.hi)?;
+    for axis in 0..3 {
+        if hi[axis] <= lo[axis] {
+            return Err(c.invalid(format!("domain.hi[{axis}]"), hi[axis], format!("greater than domain.lo[{axis}] = {}", lo[axis])));
+        }
+    }
+    let domain = Domain {
+        lo,
+        hi,
+        periodic: raw.domain.periodic,
+    };
+    let shortest_side = (0..3).map(|a| hi[a] - lo[a]).fold(f64::INFINITY, f64::min);
+
+    if raw.species.is_empty() {
+        return Err(c.invalid("species", "none", "at least one [[species]] table"));
+    }
+    let mut species = Vec::new();
+    for (k, s) in raw.species.iter().enumerate() {
+        let diameter = c.positive(&format!("species[{k}].diameter"), s.diameter)?;
+        if diameter >= shortest_side {
+            return Err(c.invalid(format!("species[{k}].diameter"), diameter, format!("smaller than the shortest box side, {shortest_side} m")));
+        }
+        let density = c.positive(&format!("species[{k}].density"), s.density)?;
+        if species.iter().any(|t: &Species| t.name == s.name) {
+            return Err(c.invalid(format!("species[{k}].name"), &s.name, "a name not used by another species"));
+        }
+        species.push(Species {
+            name: s.name.clone(),
+            diameter,
+            density,
+        });
+    }
+
+    let contact = match raw.contact.model.as_str() {
+        "wca" => {
+            let epsilon = c.positive("contact.epsilon", c.required("contact.epsilon", raw.contact.epsilon, "the WCA energy, J")?)?;
+            let sigma = c.positive("contact.sigma", c.required("contact.sigma", raw.contact.sigma, "the WCA length, m")?)?;
+            let gamma_n = c.non_negative("contact.gamma_n", c.required("contact.gamma_n", raw.contact.gamma_n, "the normal dashpot, kg/s")?)?;
+            let gamma_t = c.non_negative("contact.gamma_t", c.required("contact.gamma_t", raw.contact.gamma_t, "the tangential dashpot, kg/s")?)?;
+            // The WCA cut-off 2^(1/6) sigma is the particle diameter (paper A); a mismatch
+            // would make particles touch before or after they repel.
+            for s in &species {
+                let rc = TWO_POW_ONE_SIXTH * sigma;
+                if (rc / s.diameter - 1.0).abs() > 0.01 {
+                    return Err(c.invalid("contact.sigma", sigma, format!("2^(1/6) sigma within 1% of the diameter of species `{}` ({} m), i.e. sigma near {:.6e}", s.name, s.diameter, s.diameter / TWO_POW_ONE_SIXTH)));
+                }
+            }
+            ContactSettings::Wca {
+                epsilon,
+                sigma,
+                gamma_n,
+                gamma_t,
+            }
+        }
+        other => return Err(c.invalid("contact.model", format!("\"{other}\""), "\"wca\" (the seed's model)")),
+    };
+
+    let wall_contact = match &raw.wall_contact {
+        Some(w) => {
+            if !(w.restitution > 0.0 && w.restitution <= 1.0) {
+                return Err(c.invalid("wall_contact.restitution", w.restitution, "0 < e <= 1"));
+            }
+            WallContactSettings {
+                restitution: w.restitution,
+                friction: c.non_negative("wall_contact.friction", w.friction)?,
+            }
+        }
+        None if raw.walls.is_empty() => WallContactSettings {
+            restitution: 1.0,
+            friction: 0.0,
+        },
+        None => return Err(c.invalid("wall_contact", "missing", "a [wall_contact] table with restitution and friction when the scene has walls")),
+    };
+
+    let mut walls = Vec::new();
+    for (k, w) in raw.walls.iter().enumerate() {
+        let point = c.vector(&format!("wall[{k}].point"), w.point)?;
+        let normal = c.vector(&format!("wall[{k}].normal"), w.normal)?;
+        if normal.length() == 0.0 {
+            return Err(c.invalid(format!("wall[{k}].normal"), format!("{:?}", w.normal), "a non-zero vector"));
+        }
+        if walls.iter().any(|x: &WallSettings| x.name == w.name) {
+            return Err(c.invalid(format!("wall[{k}].name"), &w.name, "a name not used by another wall"));
+        }
+        walls.push(WallSettings {
+            name: w.name.clone(),
+            point,
+            normal: normal.normalize(),
+        });
+    }
+
+    let gravity = c.vector("gravity", raw.gravity.unwrap_or([0.0, 0.0, -9.81]))?;
+
+    let time_step = match (raw.time.dt_fraction, raw.time.dt) {
+        (Some(f), None) if f > 0.0 && f <= 0.5 => TimeStepRequest::FractionOfPeriod(f),
+        (Some(f), None) => return Err(c.invalid("time.dt_fraction", f, "0 < dt_fraction <= 0.5 of the shortest contact period")),
+        (None, Some(dt)) => TimeStepRequest::Explicit(c.positive("time.dt", dt)?),
+        _ => return Err(c.invalid("time", "both or neither of dt_fraction and dt", "exactly one of dt_fraction (of the contact period) or dt (seconds)")),
+    };
+
+    let neighbor = raw.neighbor.as_ref();
+    let skin_fraction = neighbor.and_then(|n| n.skin_fraction).unwrap_or(0.3);
+    if !(skin_fraction > 0.0 && skin_fraction <= 2.0) {
+        return Err(c.invalid("neighbor.skin_fraction", skin_fraction, "0 < skin_fraction <= 2 (of the largest diameter)"));
+    }
+    let resort_every = neighbor.and_then(|n| n.resort_every).unwrap_or(20);
+    let max_diameter = species.iter().map(|s| s.diameter).fold(0.0, f64::max);
+    for axis in 0..3 {
+        let needed = (2.0 + skin_fraction) * max_diameter;
+        if domain.periodic[axis] && hi[axis] - lo[axis] < needed {
+            return Err(c.invalid(format!("domain.periodic[{axis}]"), true, format!("a periodic side of at least (2 + skin) diameters = {needed:.4e} m; this side is {:.4e} m", hi[axis] - lo[axis])));
+        }
+    }
+
+    let mut insertions = Vec::new();
+    for (k, ins) in raw.insertions.iter().enumerate() {
+        let species_index = species
+            .iter()
+            .position(|s| s.name == ins.species)
+            .ok_or_else(|| c.invalid(format!("insert[{k}].species"), &ins.species, format!("one of the species: {}", names(species.iter().map(|s| &s.name)))))?;
+        let ilo = c.vector(&format!("insert[{k}].lo"), ins.lo)?;
+        let ihi = c.vector(&format!("insert[{k}].hi"), ins.hi)?;
+        for axis in 0..3 {
+            if ihi[axis] <= ilo[axis] || ilo[axis] < lo[axis] || ihi[axis] > hi[axis] {
+                return Err(c.invalid(format!("insert[{k}].lo/hi[{axis}]"), format!("{} .. {}", ilo[axis], ihi[axis]), format!("a non-empty range inside the domain, {} .. {}", lo[axis], hi[axis])));
+            }
+        }
+        let amount = match (ins.count, ins.solid_volume) {
+            (Some(n), None) if n > 0 => InsertAmount::Count(n),
+            (None, Some(v)) => InsertAmount::SolidVolume(c.positive(&format!("insert[{k}].solid_volume"), v)?),
+            _ => return Err(c.invalid(format!("insert[{k}]"), "count and solid_volume", "exactly one of count (> 0) or solid_volume (m^3)")),
+        };
+        insertions.push(Insertion {
+            species: species_index,
+            lo: ilo,
+            hi: ihi,
+            amount,
+            seed: ins.seed,
+        });
+    }
+
+    if raw.stages.is_empty() {
+        return Err(c.invalid("stage", "none", "at least one [[stage]]"));
+    }
+    let mut stages = Vec::new();
+    for (k, s) in raw.stages.iter().enumerate() {
+        for name in &s.remove_walls {
+            if !walls.iter().any(|w| &w.name == name) {
+                return Err(c.invalid(format!("stage[{k}].remove_walls"), name, format!("one of the walls: {}", names(walls.iter().map(|w| &w.name)))));
+            }
+        }
+        let end = match (s.duration, s.until_kinetic_energy_per_mass_below, s.max_duration) {
+            (Some(d), None, None) if s.min_duration.is_none() => StageEnd::Duration(c.positive(&format!("stage[{k}].duration"), d)?),
+            (None, Some(threshold), Some(max)) => {
+                let min = c.non_negative(&format!("stage[{k}].min_duration"), s.min_duration.unwrap_or(0.0))?;
+                let max = c.positive(&format!("stage[{k}].max_duration"), max)?;
+                if min > max {
+                    return Err(c.invalid(format!("stage[{k}].min_duration"), min, format!("at most max_duration = {max} s")));
+                }
+                StageEnd::Settled {
+                    kinetic_energy_per_mass: c.positive(&format!("stage[{k}].until_kinetic_energy_per_mass_below"), threshold)?,
+                    min_duration: min,
+                    max_duration: max,
+                }
+            }
+            _ => return Err(c.invalid(format!("stage[{k}]"), &s.name, "either duration alone, or until_kinetic_energy_per_mass_below (J/kg) with max_duration (and optionally min_duration)")),
+        };
+        stages.push(Stage {
+            name: s.name.clone(),
+            remove_walls: s.remove_walls.clone(),
+            end,
+        });
+    }
+
+    let output = raw.output.as_ref();
+    let vtk_interval = c.non_negative("output.vtk_interval", output.and_then(|o| o.vtk_interval).unwrap_or(0.0))?;
+    let timeseries_interval = c.positive("output.timeseries_interval", output.and_then(|o| o.timeseries_interval).unwrap_or(0.01))?;
+
+    let repose = match &raw.repose {
+        None => None,
+        Some(r) => {
+            let stage = stages
+                .iter()
+                .find(|s| s.name == r.stage)
+                .ok_or_else(|| c.invalid("repose.stage", &r.stage, format!("one of the stages: {}", names(stages.iter().map(|s| &s.name)))))?;
+            if r.at_times.is_empty() || r.at_times.windows(2).any(|w| w[1] <= w[0]) || r.at_times[0] <= 0.0 {
+                return Err(c.invalid("repose.at_times", format!("{:?}", r.at_times), "one or more increasing times > 0 s after the stage starts"));
+            }
+            if let StageEnd::Duration(d) = stage.end {
+                let last = *r.at_times.last().unwrap_or(&0.0);
+                if last > d {
+                    return Err(c.invalid("repose.at_times", last, format!("times within the stage `{}`, which lasts {d} s", stage.name)));
+                }
+            }
+            let fraction = |field: &str, v: Option<f64>, default: f64| -> Result<f64, SceneError> {
+                let v = v.unwrap_or(default);
+                if (0.0..0.5).contains(&v) {
+                    Ok(v)
+                } else {
+                    Err(c.invalid(field, v, "0 <= fraction < 0.5 of the run-out"))
+                }
+            };
+            Some(ReposeSettings {
+                stage: r.stage.clone(),
+                wall_x: r.wall_x,
+                at_times: r.at_times.clone(),
+                bin_width_diameters: c.positive("repose.bin_width_diameters", r.bin_width_diameters.unwrap_or(1.0))?,
+                exclude_wall_fraction: fraction("repose.exclude_wall_fraction", r.exclude_wall_fraction, 0.15)?,
+                exclude_toe_fraction: fraction("repose.exclude_toe_fraction", r.exclude_toe_fraction, 0.15)?,
+            })
+        }
+    };
+
+    Ok(Scene {
+        name: raw.name,
+        description: raw.description,
+        source: file.to_path_buf(),
+        domain,
+        species,
+        contact,
+        wall_contact,
+        walls,
+        gravity,
+        time_step,
+        skin_fraction,
+        resort_every,
+        insertions,
+        stages,
+        output: OutputSettings {
+            vtk_interval,
+            timeseries_interval,
+        },
+        repose,
+        lambda: 1,
+    })
+}
+
+fn names<'a>(list: impl Iterator<Item = &'a String>) -> String {
+    list.map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+}

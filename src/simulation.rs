@@ -1,0 +1,267 @@
+//! The world and its step loop, generic over the pair law and the wall law.
+//!
+//! The combination of laws is fixed when the scene is built, so the compiler sees one
+//! concrete force loop per scene: the seed's WCA scene has no rotation, no history and no
+//! cohesion in it.
+
+use rayon::prelude::*;
+
+use crate::contact::{Contact, PairLaw, PairResult};
+use crate::domain::Domain;
+use crate::integrate::{drift_kick, kick};
+use crate::math::{Real, Vec3};
+use crate::neighbor::{Pair, VerletList};
+use crate::particles::Particles;
+use crate::walls::{WallLaw, WallSet};
+
+const CHUNK: usize = 512;
+
+/// Neighbour-list settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeighborSettings {
+    /// Verlet skin, m.
+    pub skin: Real,
+    /// Re-sort particles by cell every this many list builds (0 = never).
+    pub resort_every: u32,
+}
+
+pub struct World<L: PairLaw, W: WallLaw> {
+    pub particles: Particles,
+    pub domain: Domain,
+    pub walls: WallSet,
+    pub law: L,
+    pub wall_law: W,
+    pub n_species: usize,
+    pub gravity: Vec3,
+    pub dt: Real,
+    pub time: Real,
+    pub steps: u64,
+    /// Particles removed because they left the box through a bounded face.
+    pub lost: u64,
+    neighbor: NeighborSettings,
+    list: VerletList,
+    history: Vec<L::History>,
+    pair_result: Vec<PairResult>,
+}
+
+impl<L: PairLaw, W: WallLaw> World<L, W> {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(particles: Particles, domain: Domain, walls: WallSet, law: L, wall_law: W, n_species: usize, gravity: Vec3, dt: Real, neighbor: NeighborSettings) -> Self {
+        let mut particles = particles;
+        if L::NEEDS_ROTATION && particles.angular.is_none() {
+            let mut rotating = Particles::new(true);
+            for k in 0..particles.len() {
+                rotating.push(particles.species[k], particles.position[k], particles.radius[k], particles.mass[k]);
+                rotating.velocity[k] = particles.velocity[k];
+            }
+            particles = rotating;
+        }
+        let mut world = World {
+            particles,
+            domain,
+            walls,
+            law,
+            wall_law,
+            n_species,
+            gravity,
+            dt,
+            time: 0.0,
+            steps: 0,
+            lost: 0,
+            neighbor,
+            list: VerletList::new(neighbor.skin),
+            history: Vec::new(),
+            pair_result: Vec::new(),
+        };
+        world.rebuild();
+        world.compute_forces();
+        world
+    }
+
+    /// The current pair list (for tests and diagnostics).
+    pub fn pairs(&self) -> &[Pair] {
+        &self.list.pairs
+    }
+
+    pub fn list_builds(&self) -> u64 {
+        self.list.builds
+    }
+
+    /// One velocity-Verlet step.
+    pub fn step(&mut self) {
+        let dt = self.dt;
+        let p = &mut self.particles;
+        drift_kick(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
+        if L::NEEDS_ROTATION {
+            if let Some(a) = &mut p.angular {
+                kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
+            }
+        }
+        if self.list.needs_rebuild(&self.particles.position) {
+            self.rebuild();
+        }
+        self.compute_forces();
+        let p = &mut self.particles;
+        kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
+        if L::NEEDS_ROTATION {
+            if let Some(a) = &mut p.angular {
+                kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
+            }
+        }
+        self.time += dt;
+        self.steps += 1;
+    }
+
+    /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list
+    /// and carries the contact history over.
+    pub fn rebuild(&mut self) {
+        let old_count = self.particles.len();
+        let mut remap: Option<Vec<u32>> = None;
+        let keep: Vec<bool> = self
+            .particles
+            .position
+            .iter()
+            .map(|&x| x.is_finite() && self.domain.contains_bounded(x))
+            .collect();
+        if keep.iter().any(|&k| !k) {
+            let mut next = 0u32;
+            remap = Some(
+                keep.iter()
+                    .map(|&k| {
+                        if k {
+                            next += 1;
+                            next - 1
+                        } else {
+                            u32::MAX
+                        }
+                    })
+                    .collect(),
+            );
+            self.particles.retain(&keep);
+            self.lost += (old_count - self.particles.len()) as u64;
+        }
+        let resort = self.neighbor.resort_every > 0 && self.list.builds % self.neighbor.resort_every as u64 == 0;
+        let old_pairs = std::mem::take(&mut self.list.pairs);
+        let old_history = std::mem::take(&mut self.history);
+        if let Some(order) = self.list.build(&mut self.particles, &self.domain, self.law.reach(), resort) {
+            // Compose: old index -> (after removal) -> after re-sort.
+            let mut sorted_index = vec![0u32; order.len()];
+            for (new, &old) in order.iter().enumerate() {
+                sorted_index[old as usize] = new as u32;
+            }
+            remap = Some(match remap {
+                None => sorted_index,
+                Some(first) => first
+                    .iter()
+                    .map(|&k| if k == u32::MAX { k } else { sorted_index[k as usize] })
+                    .collect(),
+            });
+        }
+        self.history = self.list.carry_history(&old_pairs, &old_history, remap.as_deref());
+        self.pair_result.resize(self.list.pairs.len(), PairResult::default());
+    }
+
+    /// Pair forces (each pair once, in parallel), then a per-particle gather in a fixed
+    /// order with walls and gravity. No atomics, no thread-count dependence.
+    pub fn compute_forces(&mut self) {
+        let p = &self.particles;
+        let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
+        let omega = p.angular.as_ref().map(|a| a.omega.as_slice());
+        let law = &self.law;
+        let n_species = self.n_species;
+        let dt = self.dt;
+        self.list
+            .pairs
+            .par_iter()
+            .zip(self.history.par_iter_mut())
+            .zip(self.pair_result.par_iter_mut())
+            .with_min_len(CHUNK)
+            .for_each(|((pair, history), result)| {
+                *result = pair_force(law, p, omega, &images, n_species, *pair, history, dt);
+            });
+
+        let p = &mut self.particles;
+        let (list, results) = (&self.list, &self.pair_result);
+        let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
+        let (position, velocity, radius, mass, species) = (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
+        p.force
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(i, force)| {
+                let mut f = mass[i] * gravity;
+                f += walls.force_on(wall_law, species[i] as usize, position[i], velocity[i], radius[i], mass[i], dt);
+                for k in list.out_start[i]..list.out_start[i + 1] {
+                    f += results[k as usize].force_on_i;
+                }
+                for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
+                    f -= results[k as usize].force_on_i;
+                }
+                *force = f;
+            });
+        if L::NEEDS_ROTATION {
+            if let Some(a) = &mut p.angular {
+                a.torque.par_iter_mut().enumerate().with_min_len(CHUNK).for_each(|(i, torque)| {
+                    let mut t = Vec3::ZERO;
+                    for k in list.out_start[i]..list.out_start[i + 1] {
+                        t += results[k as usize].torque_on_i;
+                    }
+                    for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
+                        t += results[k as usize].torque_on_j;
+                    }
+                    *torque = t;
+                });
+            }
+        }
+    }
+
+    pub fn kinetic_energy(&self) -> Real {
+        self.particles.kinetic_energy()
+    }
+}
+
+/// The force of one listed pair; zero (and history reset) when out of range.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn pair_force<L: PairLaw>(law: &L, p: &Particles, omega: Option<&[Vec3]>, images: &[Vec3; 27], n_species: usize, pair: Pair, history: &mut L::History, dt: Real) -> PairResult {
+    let (i, j) = (pair.i as usize, pair.j as usize);
+    let d = p.position[i] - (p.position[j] + images[pair.image as usize]);
+    let distance_sq = d.length_squared();
+    let (radius_i, radius_j) = (p.radius[i], p.radius[j]);
+    let species_pair = p.species[i] as usize * n_species + p.species[j] as usize;
+    let cutoff = law.cutoff(species_pair, radius_i, radius_j);
+    if distance_sq >= cutoff * cutoff {
+        *history = L::History::default();
+        return PairResult::default();
+    }
+    let distance = distance_sq.sqrt();
+    let normal = d / distance;
+    let overlap = radius_i + radius_j - distance;
+    let mut relative_velocity = p.velocity[i] - p.velocity[j];
+    let mut spins = (Vec3::ZERO, Vec3::ZERO);
+    if L::NEEDS_ROTATION {
+        if let Some(omega) = omega {
+            spins = (omega[i], omega[j]);
+            // Contact point on the line of centres, inside each sphere by half the overlap.
+            let arm_i = -normal * (radius_i - 0.5 * overlap);
+            let arm_j = normal * (radius_j - 0.5 * overlap);
+            relative_velocity += spins.0.cross(arm_i) - spins.1.cross(arm_j);
+        }
+    }
+    let normal_speed = relative_velocity.dot(normal);
+    let (mass_i, mass_j) = (p.mass[i], p.mass[j]);
+    let contact = Contact {
+        species_pair,
+        normal,
+        distance,
+        overlap,
+        radius_i,
+        radius_j,
+        r_eff: radius_i * radius_j / (radius_i + radius_j),
+        m_eff: mass_i * mass_j / (mass_i + mass_j),
+        relative_velocity,
+        normal_speed,
+        tangential_velocity: relative_velocity - normal_speed * normal,
+    };
+    law.evaluate(&contact, history, spins, dt)
+}
