@@ -18,7 +18,9 @@ use crate::timestep::TimeStepRequest;
 pub enum CoarseGrainError {
     #[error("lambda = {0} is not allowed: lambda must be a power of two (1, 2, 4, 8, ...)")]
     NotPowerOfTwo(u32),
-    #[error("{file}: at lambda = {lambda} the particles ({diameter:.4e} m) no longer fit: {reason}")]
+    #[error(
+        "{file}: at lambda = {lambda} the particles ({diameter:.4e} m) no longer fit: {reason}"
+    )]
     TooCoarse {
         file: String,
         lambda: u32,
@@ -69,7 +71,10 @@ pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainErro
     };
     for axis in 0..3 {
         if diameter >= length[axis] {
-            return Err(too_coarse(format!("the box is only {:.4e} m along axis {axis}", length[axis])));
+            return Err(too_coarse(format!(
+                "the box is only {:.4e} m along axis {axis}",
+                length[axis]
+            )));
         }
         let needed = (2.0 + out.skin_fraction) * diameter;
         if out.domain.periodic[axis] && length[axis] < needed {
@@ -77,4 +82,88 @@ pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainErro
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::normal::WcaCoefficients;
+    use std::path::Path;
+
+    fn collapse_scene() -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/cases/aor_collapse.toml");
+        Scene::load(&path).unwrap()
+    }
+
+    /// (stiffness, effective mass, damping) of the particle-particle contact.
+    fn linear_pair(scene: &Scene) -> (f64, f64, f64) {
+        let ContactSettings::Wca {
+            epsilon,
+            sigma,
+            gamma_n,
+            ..
+        } = scene.contact;
+        let k = WcaCoefficients { epsilon, sigma }.contact_stiffness();
+        (k, 0.5 * scene.species[0].mass(), gamma_n)
+    }
+
+    #[test]
+    fn damping_ratio_is_invariant_and_the_period_grows_by_lambda() {
+        let original = collapse_scene();
+        let (k1, m1, g1) = linear_pair(&original);
+        let zeta1 = g1 / (2.0 * (k1 * m1).sqrt());
+        let period1 = (m1 / k1).sqrt();
+        for lambda in [2u32, 4, 8] {
+            let coarse = coarse_grain(&original, lambda).unwrap();
+            let (k, m, g) = linear_pair(&coarse);
+            let l = lambda as f64;
+            assert!((k / (l * k1) - 1.0).abs() < 1e-12, "k' = lambda k");
+            assert!(
+                (m / (l.powi(3) * m1) - 1.0).abs() < 1e-12,
+                "m' = lambda^3 m"
+            );
+            assert!(
+                ((g / (2.0 * (k * m).sqrt())) / zeta1 - 1.0).abs() < 1e-12,
+                "damping ratio"
+            );
+            assert!(
+                ((m / k).sqrt() / (l * period1) - 1.0).abs() < 1e-12,
+                "period x lambda"
+            );
+            assert_eq!(
+                coarse.wall_contact, original.wall_contact,
+                "restitution and friction kept"
+            );
+            assert_eq!(coarse.domain, original.domain, "same box");
+        }
+    }
+
+    #[test]
+    fn particle_count_falls_by_lambda_cubed() {
+        let mut scene = collapse_scene();
+        scene.insertions[0].amount = InsertAmount::Count(80_000);
+        for lambda in [2u32, 4, 8] {
+            let coarse = coarse_grain(&scene, lambda).unwrap();
+            assert_eq!(
+                coarse.insertions[0].amount,
+                InsertAmount::Count(80_000 / (lambda as u64).pow(3))
+            );
+        }
+    }
+
+    #[test]
+    fn explicit_time_step_grows_by_lambda_and_lambda_must_be_a_power_of_two() {
+        let mut scene = collapse_scene();
+        scene.time_step = TimeStepRequest::Explicit(1e-8);
+        let coarse = coarse_grain(&scene, 4).unwrap();
+        assert_eq!(coarse.time_step, TimeStepRequest::Explicit(4e-8));
+        assert_eq!(
+            coarse_grain(&scene, 3).unwrap_err(),
+            CoarseGrainError::NotPowerOfTwo(3)
+        );
+        assert!(matches!(
+            coarse_grain(&scene, 64),
+            Err(CoarseGrainError::TooCoarse { .. })
+        ));
+    }
 }

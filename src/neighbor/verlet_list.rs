@@ -271,3 +271,170 @@ pub fn brute_force_pairs(particles: &Particles, domain: &Domain, extra: Real) ->
     pairs.sort_unstable();
     pairs
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    fn random_particles(
+        n: usize,
+        domain: &Domain,
+        radius_range: (Real, Real),
+        seed: u64,
+    ) -> Particles {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let mut particles = Particles::new(false);
+        for _ in 0..n {
+            let u = Vec3::new(rng.gen(), rng.gen(), rng.gen());
+            // Some particles slightly outside bounded faces: clamping must still find them.
+            let p = domain.lo + (u * 1.02 - Vec3::splat(0.01)) * domain.length();
+            let r = rng.gen_range(radius_range.0..=radius_range.1);
+            particles.push(0, p, r, 1.0);
+        }
+        particles
+    }
+
+    fn check(domain: Domain, n: usize, radii: (Real, Real), skin: Real) {
+        for seed in 0..3 {
+            let mut particles = random_particles(n, &domain, radii, seed);
+            let mut list = VerletList::new(skin);
+            list.build(&mut particles, &domain, 0.0, false);
+            assert_eq!(
+                list.pairs,
+                brute_force_pairs(&particles, &domain, skin),
+                "seed {seed}"
+            );
+            // Re-sorted by cell: the same set of pairs in the new numbering.
+            list.build(&mut particles, &domain, 0.0, true);
+            assert_eq!(
+                list.pairs,
+                brute_force_pairs(&particles, &domain, skin),
+                "seed {seed}, re-sorted"
+            );
+            // Incidence: every pair appears once as outgoing of i and once as incoming of j.
+            for (k, pair) in list.pairs.iter().enumerate() {
+                let out = list.out_start[pair.i as usize]..list.out_start[pair.i as usize + 1];
+                assert!(out.contains(&(k as u32)));
+                let incoming = &list.in_pairs[list.in_start[pair.j as usize] as usize
+                    ..list.in_start[pair.j as usize + 1] as usize];
+                assert!(incoming.contains(&(k as u32)));
+            }
+        }
+    }
+
+    fn unit_box(periodic: [bool; 3], size: Vec3) -> Domain {
+        Domain {
+            lo: Vec3::new(-0.3, 0.1, 2.0),
+            hi: Vec3::new(-0.3, 0.1, 2.0) + size,
+            periodic,
+        }
+    }
+
+    #[test]
+    fn cell_list_equals_brute_force_monodisperse() {
+        check(
+            unit_box([false; 3], Vec3::splat(1.0)),
+            600,
+            (0.03, 0.03),
+            0.01,
+        );
+    }
+
+    #[test]
+    fn cell_list_equals_brute_force_polydisperse_one_to_five() {
+        check(
+            unit_box([false; 3], Vec3::new(1.0, 0.7, 1.3)),
+            500,
+            (0.01, 0.05),
+            0.01,
+        );
+    }
+
+    #[test]
+    fn cell_list_equals_brute_force_with_periodic_boundaries() {
+        check(
+            unit_box([true, false, true], Vec3::splat(1.0)),
+            600,
+            (0.02, 0.05),
+            0.02,
+        );
+        check(
+            unit_box([true; 3], Vec3::splat(1.0)),
+            600,
+            (0.02, 0.05),
+            0.02,
+        );
+    }
+
+    #[test]
+    fn short_periodic_box_finds_every_image_pair() {
+        // One or two cells across a periodic axis: a pair can interact through two images.
+        check(
+            unit_box([false, true, false], Vec3::new(1.0, 0.25, 1.0)),
+            200,
+            (0.04, 0.05),
+            0.02,
+        );
+        check(
+            unit_box([false, true, true], Vec3::new(1.0, 0.13, 0.2)),
+            100,
+            (0.03, 0.05),
+            0.02,
+        );
+    }
+
+    #[test]
+    fn rebuild_is_needed_only_after_half_the_skin() {
+        let domain = unit_box([false; 3], Vec3::splat(1.0));
+        let mut particles = random_particles(50, &domain, (0.02, 0.02), 1);
+        let mut list = VerletList::new(0.01);
+        list.build(&mut particles, &domain, 0.0, false);
+        particles.position[7].x += 0.0049;
+        assert!(!list.needs_rebuild(&particles.position));
+        particles.position[7].x += 0.0002;
+        assert!(list.needs_rebuild(&particles.position));
+    }
+
+    #[derive(Clone, Copy, Debug, Default, PartialEq)]
+    struct Spring(Vec3);
+    impl PairHistory for Spring {
+        fn mirrored(self) -> Self {
+            Spring(-self.0)
+        }
+    }
+
+    #[test]
+    fn history_follows_its_pair_through_a_resort_and_is_mirrored_when_the_order_flips() {
+        let domain = unit_box([true; 3], Vec3::splat(1.0));
+        let mut particles = random_particles(300, &domain, (0.03, 0.05), 4);
+        let mut list = VerletList::new(0.02);
+        list.build(&mut particles, &domain, 0.0, false);
+        // Tag each pair's history with the ids of its particles, from i's side.
+        let ids = particles.id.clone();
+        let tag = |a: u32, b: u32| Vec3::new(a as Real, b as Real, 1.0);
+        let history: Vec<Spring> = list
+            .pairs
+            .iter()
+            .map(|p| Spring(tag(ids[p.i as usize], ids[p.j as usize])))
+            .collect();
+        let old_pairs = list.pairs.clone();
+        let order = list.build(&mut particles, &domain, 0.0, true).unwrap();
+        let mut remap = vec![0u32; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            remap[old as usize] = new as u32;
+        }
+        let carried = list.carry_history(&old_pairs, &history, Some(&remap));
+        for (pair, h) in list.pairs.iter().zip(&carried) {
+            let (a, b) = (particles.id[pair.i as usize], particles.id[pair.j as usize]);
+            if h.0 == tag(a, b) {
+                continue;
+            }
+            assert_eq!(h.0, -tag(b, a), "pair {pair:?} carried {h:?}");
+        }
+        assert!(
+            carried.iter().all(|h| h.0.z.abs() == 1.0),
+            "a pair lost its history"
+        );
+    }
+}

@@ -31,6 +31,16 @@ pub trait WallLaw: Send + Sync {
     fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real);
 }
 
+/// The state of one particle that walls act on.
+#[derive(Clone, Copy, Debug)]
+pub struct WallParticle {
+    pub species: usize,
+    pub position: Vec3,
+    pub velocity: Vec3,
+    pub radius: Real,
+    pub mass: Real,
+}
+
 #[derive(Clone, Debug)]
 pub struct Wall {
     pub name: String,
@@ -58,7 +68,14 @@ impl WallSet {
 
     /// Total force of the active walls on one particle.
     #[inline(always)]
-    pub fn force_on<W: WallLaw>(&self, law: &W, species: usize, position: Vec3, velocity: Vec3, radius: Real, mass: Real, dt: Real) -> Vec3 {
+    pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> Vec3 {
+        let WallParticle {
+            species,
+            position,
+            velocity,
+            radius,
+            mass,
+        } = *particle;
         let reach = law.reach(species, radius);
         let mut total = Vec3::ZERO;
         for wall in self.walls.iter().filter(|w| w.active) {

@@ -1,0 +1,114 @@
+//! The command line: errors are messages with a non-zero exit, never panics; outputs land
+//! where asked.
+
+use std::process::Command;
+
+fn cgdem() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_cgdem"))
+}
+
+#[test]
+fn a_missing_scene_file_is_an_error_naming_it() {
+    let out = cgdem()
+        .args(["run", "no/such/case.toml", "--quiet"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("no/such/case.toml") && stderr.contains("cannot read"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"));
+}
+
+#[test]
+fn lambda_must_be_a_power_of_two() {
+    let out = cgdem()
+        .args([
+            "run",
+            "validation/cases/aor_collapse.toml",
+            "--lambda",
+            "3",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("power of two"), "{stderr}");
+}
+
+#[test]
+fn a_time_step_above_the_limit_is_refused_with_the_limit_unless_forced() {
+    let dir = std::env::temp_dir().join(format!("cgdem-cli-dt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = std::fs::read_to_string("tests/data/tiny_drop.toml")
+        .unwrap()
+        .replace("dt_fraction = 0.05", "dt = 1e-3");
+    let case = dir.join("too_big_dt.toml");
+    std::fs::write(&case, scene).unwrap();
+    let out = cgdem()
+        .args(["run", case.to_str().unwrap(), "--quiet", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("exceeds the stable limit") && stderr.contains("--force-dt"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_small_run_writes_summary_timeseries_profile_and_a_vtk_series() {
+    let dir = std::env::temp_dir().join(format!("cgdem-cli-run-{}", std::process::id()));
+    let out = cgdem()
+        .args([
+            "run",
+            "tests/data/tiny_drop.toml",
+            "--quiet",
+            "--threads",
+            "2",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "case",
+        "lambda",
+        "n_particles",
+        "steps",
+        "dt_s",
+        "wall_s",
+        "particle_steps_per_s",
+        "repose_angle_deg",
+        "repose_fit_r2",
+    ] {
+        assert!(summary.get(key).is_some(), "summary.json lacks `{key}`");
+    }
+    assert_eq!(summary["n_particles"], summary["n_particles_inserted"]);
+    let series = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
+    assert!(series.starts_with("time_s,stage,kinetic_energy_j"));
+    assert!(series.lines().count() > 5);
+    assert!(std::fs::read_to_string(dir.join("profile.csv"))
+        .unwrap()
+        .starts_with("x_m,height_m"));
+    let pvd = std::fs::read_to_string(dir.join("vtk/particles.pvd")).unwrap();
+    let frames = pvd.matches("<DataSet").count();
+    assert!(frames >= 2, "{pvd}");
+    let first = std::fs::read_to_string(dir.join("vtk/particles_000000.vtu")).unwrap();
+    assert!(
+        first.contains("UnstructuredGrid")
+            && first.contains("radius")
+            && first.contains("velocity")
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,147 @@
+//! Small worlds for the tests.
+
+use cgdem::contact::normal::WcaCoefficients;
+use cgdem::contact::SeedModel;
+use cgdem::domain::Domain;
+use cgdem::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
+use cgdem::particles::Particles;
+use cgdem::simulation::{NeighborSettings, World};
+use cgdem::walls::{WallSet, WcaWall};
+
+/// The seed's coke parameters (paper A sec. 3), coarse-grained by `lambda`.
+pub struct Coke {
+    pub wca: WcaCoefficients,
+    pub gamma_n: Real,
+    pub gamma_t: Real,
+    pub density: Real,
+}
+
+impl Coke {
+    pub fn at(lambda: Real) -> Coke {
+        Coke {
+            wca: WcaCoefficients {
+                epsilon: 9.434e-2 * lambda.powi(3),
+                sigma: 1.203e-3 * lambda,
+            },
+            gamma_n: 0.1257 * lambda * lambda,
+            gamma_t: 0.1257 * lambda * lambda,
+            density: 1370.0,
+        }
+    }
+
+    pub fn diameter(&self) -> Real {
+        TWO_POW_ONE_SIXTH * self.wca.sigma
+    }
+
+    pub fn mass(&self) -> Real {
+        self.density * std::f64::consts::PI / 6.0 * self.diameter().powi(3)
+    }
+
+    /// Linearized pair period `2 pi sqrt(m_eff / k)`.
+    pub fn pair_period(&self) -> Real {
+        2.0 * std::f64::consts::PI * (0.5 * self.mass() / self.wca.contact_stiffness()).sqrt()
+    }
+
+    pub fn law(&self) -> SeedModel {
+        SeedModel::seed(vec![self.wca], vec![self.gamma_n], vec![self.gamma_t])
+    }
+
+    pub fn wall_law(&self, restitution: Real, friction: Real) -> WcaWall {
+        WcaWall::new(&[(self.wca, self.mass())], restitution, friction)
+    }
+}
+
+pub fn open_box(half: Real) -> Domain {
+    Domain {
+        lo: Vec3::splat(-half),
+        hi: Vec3::splat(half),
+        periodic: [false; 3],
+    }
+}
+
+pub fn world(
+    coke: &Coke,
+    particles: Particles,
+    domain: Domain,
+    walls: WallSet,
+    wall_law: WcaWall,
+    gravity: Vec3,
+    dt: Real,
+) -> World<SeedModel, WcaWall> {
+    let neighbor = NeighborSettings {
+        skin: 0.3 * coke.diameter(),
+        resort_every: 5,
+    };
+    World::new(
+        particles,
+        domain,
+        walls,
+        coke.law(),
+        wall_law,
+        1,
+        gravity,
+        dt,
+        neighbor,
+    )
+}
+
+/// Two coke particles approaching head-on (or offset by `impact_parameter` diameters) with
+/// relative speed `speed`, just out of contact.
+pub fn binary_collision(
+    coke: &Coke,
+    speed: Real,
+    impact_parameter: Real,
+    dt: Real,
+) -> World<SeedModel, WcaWall> {
+    let d = coke.diameter();
+    let mut particles = Particles::new(false);
+    let b = impact_parameter * d;
+    let gap = (d * d - b * b).sqrt() * 1.001;
+    particles.push(
+        0,
+        Vec3::new(-0.5 * gap, -0.5 * b, 0.0),
+        0.5 * d,
+        coke.mass(),
+    );
+    particles.push(0, Vec3::new(0.5 * gap, 0.5 * b, 0.0), 0.5 * d, coke.mass());
+    particles.velocity[0] = Vec3::new(0.5 * speed, 0.0, 0.0);
+    particles.velocity[1] = Vec3::new(-0.5 * speed, 0.0, 0.0);
+    world(
+        coke,
+        particles,
+        open_box(20.0 * d),
+        WallSet::default(),
+        coke.wall_law(0.5, 0.0),
+        Vec3::ZERO,
+        dt,
+    )
+}
+
+/// Runs until the pair separates again; returns (steps in contact, relative velocity after).
+pub fn collide(world: &mut World<SeedModel, WcaWall>, contact_distance: Real) -> (u64, Vec3) {
+    let distance = |w: &World<SeedModel, WcaWall>| {
+        (w.particles.position[0] - w.particles.position[1]).length()
+    };
+    let mut in_contact = 0;
+    let mut touched = false;
+    for _ in 0..10_000_000 {
+        world.step();
+        if distance(world) < contact_distance {
+            touched = true;
+            in_contact += 1;
+        } else if touched {
+            break;
+        }
+    }
+    assert!(touched, "the particles never met");
+    // Index order may have been re-sorted; the relative velocity's sign follows the ids.
+    let (a, b) = if world.particles.id[0] == 0 {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
+    (
+        in_contact,
+        world.particles.velocity[a] - world.particles.velocity[b],
+    )
+}

@@ -1,0 +1,83 @@
+//! Scene files: the shipped cases validate; every file in validation/bad fails with the
+//! error its first line names.
+
+use std::path::Path;
+
+use cgdem::coarse_graining::coarse_grain;
+use cgdem::scene::{InsertAmount, Scene};
+
+#[test]
+fn shipped_cases_validate_and_coarse_grain_to_lambda_8() {
+    for entry in std::fs::read_dir("validation/cases").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            let coarse = coarse_grain(&scene, 8).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(coarse.lambda, 8);
+        }
+    }
+}
+
+#[test]
+fn collapse_case_meets_the_size_requirements_at_lambda_8() {
+    let scene = Scene::load(Path::new("validation/cases/aor_collapse.toml")).unwrap();
+    let coarse = coarse_grain(&scene, 8).unwrap();
+    let d = coarse.max_diameter();
+    // Column: the inserted solid volume at solid fraction 0.6 over the column footprint.
+    let ins = &coarse.insertions[0];
+    let InsertAmount::SolidVolume(v) = ins.amount else {
+        panic!("expected solid_volume")
+    };
+    let footprint = (ins.hi.x - ins.lo.x) * (ins.hi.y - ins.lo.y);
+    let column_height = v / 0.6 / footprint;
+    assert!(
+        column_height / d >= 15.0,
+        "column {:.1} diameters high",
+        column_height / d
+    );
+    let depth = coarse.domain.length().y;
+    assert!(
+        coarse.domain.periodic[1] && depth / d >= 4.0,
+        "periodic depth {:.1} diameters",
+        depth / d
+    );
+}
+
+#[test]
+fn every_bad_scene_gives_its_named_error() {
+    let mut checked = 0;
+    for entry in std::fs::read_dir("validation/bad").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let expected = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("# expect: "))
+            .unwrap_or_else(|| panic!("{}: first line must be `# expect: <text>`", path.display()))
+            .to_string();
+        let result = Scene::load(&path).map(|scene| coarse_grain(&scene, 1).map(|_| scene));
+        let message = match result {
+            Err(e) => e.to_string(),
+            Ok(Err(e)) => e.to_string(),
+            Ok(Ok(_)) => panic!(
+                "{}: accepted, expected an error containing `{expected}`",
+                path.display()
+            ),
+        };
+        assert!(
+            message.contains(&expected),
+            "{}: error `{message}` does not contain `{expected}`",
+            path.display()
+        );
+        assert!(
+            message.contains(&path.display().to_string()),
+            "{}: error `{message}` does not name the file",
+            path.display()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} bad scenes");
+}
