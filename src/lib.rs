@@ -14,6 +14,7 @@ pub mod io;
 pub mod math;
 pub mod neighbor;
 pub mod particles;
+pub mod report;
 pub mod run;
 pub mod scene;
 pub mod simulation;

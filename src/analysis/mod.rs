@@ -1,4 +1,18 @@
 //! Post-processing shared by every code: cgdem's own state and the reference codes' dumps
-//! go through the same functions.
+//! go through the same functions (heap profiles and repose angles; porosity, distance
+//! transforms and pore-size distributions of packings).
 
+pub mod distance_transform;
 pub mod heap;
+pub mod pore_size;
+pub mod porosity;
+
+pub use distance_transform::squared_distance_transform;
+pub use pore_size::{
+    pore_size_field, pore_size_field_of_spheres, rasterize_spheres, Boundary, PoreSizeDistribution,
+    PoreSizeError, PoreSizeField, VoxelGrid,
+};
+pub use porosity::{
+    bed_measurement_region, porosity_voxel, porosity_z_slab, sphere_slab_volume, BedRegionRule,
+    MeasurementRegion, Porosity, PorosityError,
+};

@@ -1,5 +1,28 @@
-//! Shapes particles collide with: analytic walls (and, later, SDF bodies from STL).
+//! Shapes particles collide with: analytic walls, STL meshes and their signed distance
+//! grids, analytic SDFs, and the seed's screw-feeder geometry.
 
+pub mod aabb;
+pub mod accuracy;
+pub mod analytic;
+pub mod bvh;
 mod finite_plane;
+pub mod mesh;
+mod mesh_builder;
+pub mod screw_feeder;
+pub mod sdf_grid;
+pub mod stl;
+pub mod triangle_distance;
+pub mod winding_number;
 
+pub use aabb::Aabb;
+pub use accuracy::{cylinder_mesh, sdf_accuracy, sphere_mesh, AccuracyRow, ScrewFlight, TestShape};
+pub use analytic::{
+    AxisAlignedBox, Cone, Cylinder, Difference, HalfSpace, Intersection, Sdf, Sphere, Union,
+};
+pub use bvh::{Bvh, Nearest};
 pub use finite_plane::FinitePlane;
+pub use mesh::{EdgeDefect, TopologyReport, TriMesh};
+pub use sdf_grid::{SdfGrid, SdfGridError};
+pub use stl::{read_stl, read_stl_unchecked, write_stl_ascii, write_stl_binary, StlError};
+pub use triangle_distance::{closest_point_on_triangle, TriangleFeature};
+pub use winding_number::{winding_number, FastWindingNumber};
