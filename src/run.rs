@@ -56,6 +56,8 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
 #[derive(Clone, Debug, Serialize)]
 pub struct ReposeSample {
     pub time_after_start_s: Real,
+    /// "fixed time" or "stage end" (the stage's own end condition).
+    pub trigger: String,
     pub repose_angle_deg: Option<Real>,
     pub repose_fit_r2: Option<Real>,
     pub runout_m: Real,
@@ -286,6 +288,22 @@ fn execute<L: PairLaw, W: WallLaw>(
             r.exclude_toe_fraction,
         )
     };
+    let sample = |world: &World<L, W>,
+                  time_after_start_s: Real,
+                  trigger: &str|
+     -> Option<(ReposeSample, HeapProfile)> {
+        let profile = heap_profile(world)?;
+        let f = fit(&profile);
+        let sample = ReposeSample {
+            time_after_start_s,
+            trigger: trigger.to_string(),
+            repose_angle_deg: f.as_ref().map(|f| f.angle_deg),
+            repose_fit_r2: f.as_ref().map(|f| f.r_squared),
+            runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
+            wall_height_m: profile.wall_height(),
+        };
+        Some((sample, profile))
+    };
 
     let total_estimate: Real = scene
         .stages
@@ -386,18 +404,22 @@ fn execute<L: PairLaw, W: WallLaw>(
                 }
             }
             if next_sample < repose_times.len() && elapsed + 0.5 * dt >= repose_times[next_sample] {
-                if let Some(profile) = heap_profile(&world) {
-                    let f = fit(&profile);
-                    samples.push(ReposeSample {
-                        time_after_start_s: repose_times[next_sample],
-                        repose_angle_deg: f.as_ref().map(|f| f.angle_deg),
-                        repose_fit_r2: f.as_ref().map(|f| f.r_squared),
-                        runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
-                        wall_height_m: profile.wall_height(),
-                    });
+                if let Some((s, profile)) = sample(&world, repose_times[next_sample], "fixed time")
+                {
+                    samples.push(s);
                     final_profile = Some(profile);
                 }
                 next_sample += 1;
+            }
+        }
+        let measures_at_end = scene
+            .repose
+            .as_ref()
+            .is_some_and(|r| r.stage == stage.name && r.at_stage_end);
+        if measures_at_end {
+            if let Some((s, profile)) = sample(&world, world.time - start, "stage end") {
+                samples.push(s);
+                final_profile = Some(profile);
             }
         }
         if settle_threshold.is_some() && ended_by.starts_with("duration") {
@@ -439,13 +461,14 @@ fn execute<L: PairLaw, W: WallLaw>(
     if !samples.is_empty() {
         let path = out.join("repose.csv");
         let mut csv = String::from(
-            "time_after_start_s,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
+            "time_after_start_s,trigger,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
         );
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
         for s in &samples {
             csv += &format!(
-                "{},{},{},{:.6e},{:.6e}\n",
+                "{},{},{},{},{:.6e},{:.6e}\n",
                 s.time_after_start_s,
+                s.trigger,
                 opt(s.repose_angle_deg),
                 opt(s.repose_fit_r2),
                 s.runout_m,
@@ -454,7 +477,12 @@ fn execute<L: PairLaw, W: WallLaw>(
         }
         write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
     }
-    let headline = samples.last();
+    // The headline: the stage-end sample when the scene asks for one, else the last fixed time.
+    let headline = samples
+        .iter()
+        .rev()
+        .find(|s| s.trigger == "stage end")
+        .or(samples.last());
     let summary = RunSummary {
         case: scene.name.clone(),
         code: "cgdem".into(),
@@ -474,13 +502,17 @@ fn execute<L: PairLaw, W: WallLaw>(
         repose_angle_deg: headline.and_then(|s| s.repose_angle_deg),
         repose_fit_r2: headline.and_then(|s| s.repose_fit_r2),
         repose_rule: scene.repose.as_ref().map(|r| {
+            let when = if r.at_stage_end {
+                let end = scene.stages.iter().find(|s| s.name == r.stage).map(|s| describe_end(&s.end)).unwrap_or_default();
+                format!("at the end of stage `{}` ({end})", r.stage)
+            } else {
+                format!("{} s after stage `{}` began", r.at_times.last().copied().unwrap_or(0.0), r.stage)
+            };
             format!(
-                "least-squares line through the surface profile (bins of {} diameters) between {}% of the run-out from the wall and {}% before the front (deposit >= 2 diameters deep), measured {} s after stage `{}` began",
+                "least-squares line through the surface profile (bins of {} diameters) between {}% of the run-out from the wall and {}% before the front (deposit >= 2 diameters deep), measured {when}",
                 r.bin_width_diameters,
                 r.exclude_wall_fraction * 100.0,
                 r.exclude_toe_fraction * 100.0,
-                r.at_times.last().copied().unwrap_or(0.0),
-                r.stage
             )
         }),
         runout_m: headline.map(|s| s.runout_m),
@@ -494,4 +526,16 @@ fn execute<L: PairLaw, W: WallLaw>(
     let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&path, e))?;
     write_atomic(&path, json.as_bytes()).map_err(|e| output_error(&path, e))?;
     Ok(summary)
+}
+
+/// How a stage ends, in words for the summary.
+fn describe_end(end: &StageEnd) -> String {
+    match end {
+        StageEnd::Duration(d) => format!("after {d} s"),
+        StageEnd::Settled {
+            kinetic_energy_per_mass,
+            min_duration,
+            max_duration,
+        } => format!("kinetic energy per mass below {kinetic_energy_per_mass:e} J/kg, after at least {min_duration} s and at most {max_duration} s"),
+    }
 }

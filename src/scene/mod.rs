@@ -107,8 +107,11 @@ pub struct ReposeSettings {
     pub stage: String,
     /// x of the wall that stays; the heap runs out towards +x.
     pub wall_x: Real,
-    /// Times after the stage start at which the angle is measured; the last is the headline.
+    /// Times after the stage start at which the angle is also measured.
     pub at_times: Vec<Real>,
+    /// Measure when the stage ends by its own condition (e.g. the heap has come to rest);
+    /// this is then the headline angle. Otherwise the last of `at_times` is.
+    pub at_stage_end: bool,
     pub bin_width_diameters: Real,
     pub exclude_wall_fraction: Real,
     pub exclude_toe_fraction: Real,

@@ -122,7 +122,10 @@ pub struct RawOutput {
 pub struct RawRepose {
     pub stage: String,
     pub wall_x: f64,
+    #[serde(default)]
     pub at_times: Vec<f64>,
+    #[serde(default)]
+    pub at_stage_end: bool,
     pub bin_width_diameters: Option<f64>,
     pub exclude_wall_fraction: Option<f64>,
     pub exclude_toe_fraction: Option<f64>,

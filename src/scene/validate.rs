@@ -354,14 +354,20 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                     ),
                 )
             })?;
-            if r.at_times.is_empty()
-                || r.at_times.windows(2).any(|w| w[1] <= w[0])
-                || r.at_times[0] <= 0.0
+            if r.at_times.windows(2).any(|w| w[1] <= w[0])
+                || r.at_times.first().is_some_and(|&t| t <= 0.0)
             {
                 return Err(c.invalid(
                     "repose.at_times",
                     format!("{:?}", r.at_times),
-                    "one or more increasing times > 0 s after the stage starts",
+                    "increasing times > 0 s after the stage starts",
+                ));
+            }
+            if r.at_times.is_empty() && !r.at_stage_end {
+                return Err(c.invalid(
+                    "repose",
+                    "no measurement time",
+                    "at_times, or at_stage_end = true, or both",
                 ));
             }
             if let StageEnd::Duration(d) = stage.end {
@@ -386,6 +392,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 stage: r.stage.clone(),
                 wall_x: r.wall_x,
                 at_times: r.at_times.clone(),
+                at_stage_end: r.at_stage_end,
                 bin_width_diameters: c.positive(
                     "repose.bin_width_diameters",
                     r.bin_width_diameters.unwrap_or(1.0),
