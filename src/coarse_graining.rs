@@ -13,6 +13,7 @@
 
 use crate::scene::{ContactSettings, InsertAmount, Scene};
 use crate::timestep::TimeStepRequest;
+use clap::ValueEnum;
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum CoarseGrainError {
@@ -29,14 +30,54 @@ pub enum CoarseGrainError {
     },
 }
 
-/// Returns the scene coarse-grained by `lambda` relative to its current level.
+/// Which quantities a coarse-graining keeps. Both scale diameters by `lambda` and masses by
+/// `lambda^3` and keep the damping ratio (hence each contact's restitution); they differ in
+/// how the contact energy and the dashpots scale (derivation: reference/COARSE_GRAINING.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CoarseGrainRule {
+    /// Paper A: `phi'(r) = lambda^3 phi(r/lambda)`, `gamma' = lambda^2 gamma`,
+    /// `dt' = lambda dt`. Keeps each contact's restitution and the overlap per diameter under
+    /// the same velocity; the bulk viscosity `~ gamma/d` grows by `lambda`, so viscous flows
+    /// run `lambda` times slower.
+    #[default]
+    Seed,
+    /// `phi'(r) = lambda phi(r/lambda)`, `gamma' = lambda gamma`, `dt' = lambda^2 dt`. Keeps
+    /// each contact's restitution and the bulk viscosity `~ gamma/d`, so viscous flows run at
+    /// the same speed; contacts are softer (period `lambda^2` longer).
+    BulkViscosity,
+}
+
+impl CoarseGrainRule {
+    /// Exponents of lambda for (WCA energy, dashpots, explicit time step).
+    fn exponents(self) -> (i32, i32, i32) {
+        match self {
+            CoarseGrainRule::Seed => (3, 2, 1),
+            CoarseGrainRule::BulkViscosity => (1, 1, 2),
+        }
+    }
+}
+
+/// Returns the scene coarse-grained by `lambda` relative to its current level, by the
+/// seed's rule.
 pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainError> {
+    coarse_grain_by(scene, lambda, CoarseGrainRule::Seed)
+}
+
+/// Returns the scene coarse-grained by `lambda` relative to its current level.
+pub fn coarse_grain_by(
+    scene: &Scene,
+    lambda: u32,
+    rule: CoarseGrainRule,
+) -> Result<Scene, CoarseGrainError> {
     if lambda == 0 || !lambda.is_power_of_two() {
         return Err(CoarseGrainError::NotPowerOfTwo(lambda));
     }
     let l = lambda as f64;
+    let (energy, damping, time) = rule.exponents();
     let mut out = scene.clone();
     out.lambda = scene.lambda * lambda;
+    out.cg_rule = rule;
     for s in &mut out.species {
         s.diameter *= l;
     }
@@ -47,14 +88,14 @@ pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainErro
             gamma_n,
             gamma_t,
         } => ContactSettings::Wca {
-            epsilon: epsilon * l.powi(3),
+            epsilon: epsilon * l.powi(energy),
             sigma: sigma * l,
-            gamma_n: gamma_n * l * l,
-            gamma_t: gamma_t * l * l,
+            gamma_n: gamma_n * l.powi(damping),
+            gamma_t: gamma_t * l.powi(damping),
         },
     };
     if let TimeStepRequest::Explicit(dt) = scene.time_step {
-        out.time_step = TimeStepRequest::Explicit(dt * l);
+        out.time_step = TimeStepRequest::Explicit(dt * l.powi(time));
     }
     for ins in &mut out.insertions {
         if let InsertAmount::Count(n) = ins.amount {
@@ -135,6 +176,31 @@ mod tests {
                 "restitution and friction kept"
             );
             assert_eq!(coarse.domain, original.domain, "same box");
+        }
+    }
+
+    #[test]
+    fn bulk_viscosity_rule_keeps_damping_ratio_and_gamma_over_d_and_stretches_the_period_by_lambda_squared(
+    ) {
+        let original = collapse_scene();
+        let (k1, m1, g1) = linear_pair(&original);
+        let d1 = original.species[0].diameter;
+        for lambda in [2u32, 4, 8] {
+            let coarse =
+                coarse_grain_by(&original, lambda, CoarseGrainRule::BulkViscosity).unwrap();
+            let (k, m, g) = linear_pair(&coarse);
+            let l = lambda as f64;
+            let d = coarse.species[0].diameter;
+            assert!(
+                ((g / (2.0 * (k * m).sqrt())) / (g1 / (2.0 * (k1 * m1).sqrt())) - 1.0).abs()
+                    < 1e-12
+            );
+            assert!(
+                ((g / d) / (g1 / d1) - 1.0).abs() < 1e-12,
+                "bulk viscosity gamma/d kept"
+            );
+            assert!(((m / k).sqrt() / (l * l * (m1 / k1).sqrt()) - 1.0).abs() < 1e-12);
+            assert_eq!(coarse.cg_rule, CoarseGrainRule::BulkViscosity);
         }
     }
 

@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
 
-use cgdem::coarse_graining::coarse_grain;
+use cgdem::coarse_graining::{coarse_grain_by, CoarseGrainRule};
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
@@ -31,6 +31,11 @@ enum Command {
         /// Diameters grow by lambda, the particle count falls by lambda^3 (paper A Eq. 3-6).
         #[arg(long, default_value_t = 1)]
         lambda: u32,
+        /// Coarse-graining rule: `seed` (paper A: eps' = lambda^3 eps, gamma' = lambda^2 gamma)
+        /// or `bulk-viscosity` (eps' = lambda eps, gamma' = lambda gamma: keeps gamma/d, so
+        /// viscous flows keep their speed; see reference/COARSE_GRAINING.md).
+        #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
+        cg_rule: CoarseGrainRule,
         /// Output directory (default: runs/<case>-lambda<N>).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -53,6 +58,7 @@ fn main() -> ExitCode {
         Command::Run {
             case,
             lambda,
+            cg_rule,
             out,
             threads,
             quiet,
@@ -77,12 +83,11 @@ fn main() -> ExitCode {
             let result = pool.install(|| {
                 Scene::load(&case)
                     .map_err(|e| e.to_string())
-                    .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
                     .and_then(|scene| {
-                        let out_dir = out.unwrap_or_else(|| {
-                            PathBuf::from("runs")
-                                .join(format!("{}-lambda{}", scene.name, scene.lambda))
-                        });
+                        coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())
+                    })
+                    .and_then(|scene| {
+                        let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
                         let options = RunOptions {
                             out_dir: out_dir.clone(),
                             quiet,
@@ -116,4 +121,15 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// `runs/<case>-lambda<N>`, with the rule appended when it is not the seed's.
+fn default_out_dir(scene: &Scene) -> PathBuf {
+    let mut name = format!("{}-lambda{}", scene.name, scene.lambda);
+    if scene.cg_rule != CoarseGrainRule::Seed {
+        if let Some(rule) = scene.cg_rule.to_possible_value() {
+            name += &format!("-{}", rule.get_name());
+        }
+    }
+    PathBuf::from("runs").join(name)
 }

@@ -138,6 +138,8 @@ pub struct Scene {
     pub repose: Option<ReposeSettings>,
     /// Coarse-graining level already applied (1 = the original system).
     pub lambda: u32,
+    /// The rule by which it was coarse-grained.
+    pub cg_rule: crate::coarse_graining::CoarseGrainRule,
 }
 
 impl Scene {

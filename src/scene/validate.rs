@@ -432,6 +432,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         },
         repose,
         lambda: 1,
+        cg_rule: Default::default(),
     })
 }
 
