@@ -1,0 +1,182 @@
+//! Suite files (`validation/suites/*.toml`): which cases, codes, lambda levels, rules and
+//! seeds a validation run covers, and the tolerances it is judged by.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::coarse_graining::CoarseGrainRule;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Code {
+    Cgdem,
+    Lammps,
+    Liggghts,
+}
+
+impl Code {
+    pub fn name(self) -> &'static str {
+        match self {
+            Code::Cgdem => "cgdem",
+            Code::Lammps => "lammps",
+            Code::Liggghts => "liggghts",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SuiteCase {
+    /// The scene file, relative to the repository root (the working directory).
+    pub file: PathBuf,
+    pub codes: Vec<Code>,
+    pub lambdas: Vec<u32>,
+    pub cg_rules: Vec<CoarseGrainRule>,
+    pub seeds: Vec<u64>,
+    /// Largest acceptable repose-angle difference between codes or levels, degrees, when
+    /// it is not already within the combined seed spread.
+    pub angle_tolerance_deg: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Suite {
+    pub name: String,
+    pub description: String,
+    pub source: PathBuf,
+    pub cases: Vec<SuiteCase>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SuiteError {
+    #[error("{file}: cannot read the suite file: {source}")]
+    Unreadable {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{file}: not a valid suite file: {message}")]
+    Syntax { file: PathBuf, message: String },
+    #[error("{file}: field `{field}` = {value} is not allowed: {allowed}")]
+    Invalid {
+        file: PathBuf,
+        field: String,
+        value: String,
+        allowed: String,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSuite {
+    name: String,
+    #[serde(default)]
+    description: String,
+    #[serde(rename = "case")]
+    cases: Vec<RawCase>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCase {
+    file: PathBuf,
+    codes: Vec<String>,
+    lambdas: Vec<u32>,
+    #[serde(default)]
+    cg_rules: Vec<String>,
+    seeds: Vec<u64>,
+    angle_tolerance_deg: Option<f64>,
+}
+
+impl Suite {
+    pub fn load(path: &Path) -> Result<Suite, SuiteError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SuiteError::Unreadable {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        let raw: RawSuite = toml::from_str(&text).map_err(|e| SuiteError::Syntax {
+            file: path.to_path_buf(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        })?;
+        let invalid = |field: String, value: String, allowed: &str| SuiteError::Invalid {
+            file: path.to_path_buf(),
+            field,
+            value,
+            allowed: allowed.into(),
+        };
+        let mut cases = Vec::new();
+        for (k, c) in raw.cases.into_iter().enumerate() {
+            let codes = c
+                .codes
+                .iter()
+                .map(|name| match name.as_str() {
+                    "cgdem" => Ok(Code::Cgdem),
+                    "lammps" => Ok(Code::Lammps),
+                    "liggghts" => Ok(Code::Liggghts),
+                    other => Err(invalid(
+                        format!("case[{k}].codes"),
+                        format!("\"{other}\""),
+                        "\"cgdem\", \"lammps\" or \"liggghts\"",
+                    )),
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            if codes.is_empty() {
+                return Err(invalid(
+                    format!("case[{k}].codes"),
+                    "[]".into(),
+                    "at least one code",
+                ));
+            }
+            if c.lambdas.is_empty() || c.lambdas.iter().any(|l| !l.is_power_of_two()) {
+                return Err(invalid(
+                    format!("case[{k}].lambdas"),
+                    format!("{:?}", c.lambdas),
+                    "one or more powers of two",
+                ));
+            }
+            if c.seeds.is_empty() {
+                return Err(invalid(
+                    format!("case[{k}].seeds"),
+                    "[]".into(),
+                    "at least one insertion seed",
+                ));
+            }
+            let cg_rules = if c.cg_rules.is_empty() {
+                vec![CoarseGrainRule::Seed]
+            } else {
+                c.cg_rules
+                    .iter()
+                    .map(|name| match name.as_str() {
+                        "seed" => Ok(CoarseGrainRule::Seed),
+                        "bulk-viscosity" => Ok(CoarseGrainRule::BulkViscosity),
+                        other => Err(invalid(
+                            format!("case[{k}].cg_rules"),
+                            format!("\"{other}\""),
+                            "\"seed\" or \"bulk-viscosity\"",
+                        )),
+                    })
+                    .collect::<Result<Vec<_>, _>>()?
+            };
+            let angle_tolerance_deg = c.angle_tolerance_deg.unwrap_or(2.0);
+            if !(angle_tolerance_deg > 0.0) {
+                return Err(invalid(
+                    format!("case[{k}].angle_tolerance_deg"),
+                    angle_tolerance_deg.to_string(),
+                    "a number of degrees > 0",
+                ));
+            }
+            cases.push(SuiteCase {
+                file: c.file,
+                codes,
+                lambdas: c.lambdas,
+                cg_rules,
+                seeds: c.seeds,
+                angle_tolerance_deg,
+            });
+        }
+        Ok(Suite {
+            name: raw.name,
+            description: raw.description,
+            source: path.to_path_buf(),
+            cases,
+        })
+    }
+}
