@@ -11,7 +11,11 @@ use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
 #[derive(Parser)]
-#[command(name = "cgdem", version, about = "Discrete-element solver for powders and granular flow, with coarse-graining")]
+#[command(
+    name = "cgdem",
+    version,
+    about = "Discrete-element solver for powders and granular flow, with coarse-graining"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -60,26 +64,44 @@ fn main() -> ExitCode {
             }
             // The whole run executes inside the pool: parallel loops started from a worker
             // thread run small jobs inline instead of handing them across threads each step.
-            let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build() {
+            let pool = match rayon::ThreadPoolBuilder::new()
+                .num_threads(threads.unwrap_or(0))
+                .build()
+            {
                 Ok(pool) => pool,
                 Err(e) => {
                     eprintln!("error: cannot start the worker threads: {e}");
                     return ExitCode::FAILURE;
                 }
             };
-            let result = pool.install(|| Scene::load(&case)
-                .map_err(|e| e.to_string())
-                .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
-                .and_then(|scene| {
-                    let out_dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-lambda{}", scene.name, scene.lambda)));
-                    let options = RunOptions { out_dir: out_dir.clone(), quiet, force_dt };
-                    run(&scene, &options).map(|summary| (summary, out_dir)).map_err(|e| e.to_string())
-                }));
+            let result = pool.install(|| {
+                Scene::load(&case)
+                    .map_err(|e| e.to_string())
+                    .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
+                    .and_then(|scene| {
+                        let out_dir = out.unwrap_or_else(|| {
+                            PathBuf::from("runs")
+                                .join(format!("{}-lambda{}", scene.name, scene.lambda))
+                        });
+                        let options = RunOptions {
+                            out_dir: out_dir.clone(),
+                            quiet,
+                            force_dt,
+                        };
+                        run(&scene, &options)
+                            .map(|summary| (summary, out_dir))
+                            .map_err(|e| e.to_string())
+                    })
+            });
             match result {
                 Ok((summary, out_dir)) => {
                     println!("case {} at lambda = {}: {} particles, {} steps of {:.3e} s, {:.1} s wall time, {:.3e} particle-steps/s", summary.case, summary.lambda, summary.n_particles, summary.steps, summary.dt_s, summary.wall_s, summary.particle_steps_per_s);
                     if let Some(angle) = summary.repose_angle_deg {
-                        println!("repose angle {angle:.2} deg (R^2 = {:.3}), run-out {:.4} m", summary.repose_fit_r2.unwrap_or(f64::NAN), summary.runout_m.unwrap_or(f64::NAN));
+                        println!(
+                            "repose angle {angle:.2} deg (R^2 = {:.3}), run-out {:.4} m",
+                            summary.repose_fit_r2.unwrap_or(f64::NAN),
+                            summary.runout_m.unwrap_or(f64::NAN)
+                        );
                         if let Some(rule) = &summary.repose_rule {
                             println!("  rule: {rule}");
                         }

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::domain::Domain;
-use crate::integrate::{drift_kick, kick};
+use crate::integrate::{drift_kick, kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{Pair, VerletList};
 use crate::particles::Particles;
@@ -42,16 +42,38 @@ pub struct World<L: PairLaw, W: WallLaw> {
     list: VerletList,
     history: Vec<L::History>,
     pair_result: Vec<PairResult>,
+    integrator: Integrator,
+    /// PCVV's `F0`, `T0` (empty for velocity Verlet).
+    old_force: Vec<Vec3>,
+    old_torque: Vec<Vec3>,
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
+    /// Whether particles carry spin: the pair law or the wall law needs it.
+    pub const ROTATES: bool = L::NEEDS_ROTATION || W::NEEDS_ROTATION;
+
     #[allow(clippy::too_many_arguments)]
-    pub fn new(particles: Particles, domain: Domain, walls: WallSet, law: L, wall_law: W, n_species: usize, gravity: Vec3, dt: Real, neighbor: NeighborSettings) -> Self {
+    pub fn new(
+        particles: Particles,
+        domain: Domain,
+        walls: WallSet,
+        law: L,
+        wall_law: W,
+        n_species: usize,
+        gravity: Vec3,
+        dt: Real,
+        neighbor: NeighborSettings,
+    ) -> Self {
         let mut particles = particles;
-        if L::NEEDS_ROTATION && particles.angular.is_none() {
+        if Self::ROTATES && particles.angular.is_none() {
             let mut rotating = Particles::new(true);
             for k in 0..particles.len() {
-                rotating.push(particles.species[k], particles.position[k], particles.radius[k], particles.mass[k]);
+                rotating.push(
+                    particles.species[k],
+                    particles.position[k],
+                    particles.radius[k],
+                    particles.mass[k],
+                );
                 rotating.velocity[k] = particles.velocity[k];
             }
             particles = rotating;
@@ -72,6 +94,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             list: VerletList::new(neighbor.skin),
             history: Vec::new(),
             pair_result: Vec::new(),
+            integrator: Integrator::VelocityVerlet,
+            old_force: Vec::new(),
+            old_torque: Vec::new(),
         };
         world.rebuild();
         world.compute_forces();
@@ -87,12 +112,68 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.list.builds
     }
 
-    /// One velocity-Verlet step.
+    /// Steps with `integrator` from now on.
+    pub fn with_integrator(mut self, integrator: Integrator) -> Self {
+        self.integrator = integrator;
+        self
+    }
+
+    pub fn integrator(&self) -> Integrator {
+        self.integrator
+    }
+
+    /// One step of the chosen scheme (chosen per step, never per particle).
     pub fn step(&mut self) {
+        match self.integrator {
+            Integrator::VelocityVerlet => self.step_verlet(),
+            Integrator::Pcvv => self.step_pcvv(),
+        }
+        self.time += self.dt;
+        self.steps += 1;
+    }
+
+    /// One predictor-corrector velocity-Verlet step, paper B Eq. (11)-(15).
+    fn step_pcvv(&mut self) {
+        let dt = self.dt;
+        let p = &mut self.particles;
+        pcvv::predict(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
+        if Self::ROTATES {
+            if let Some(a) = &mut p.angular {
+                pcvv::predict_rate(&mut a.omega, &a.torque, &a.inv_inertia, dt);
+            }
+        }
+        if self.list.needs_rebuild(&self.particles.position) {
+            self.rebuild();
+        }
+        // F0, T0 after the rebuild, which may reorder particles.
+        self.old_force.clone_from(&self.particles.force);
+        if Self::ROTATES {
+            if let Some(a) = &self.particles.angular {
+                self.old_torque.clone_from(&a.torque);
+            }
+        }
+        self.compute_forces();
+        let p = &mut self.particles;
+        pcvv::correct(&mut p.velocity, &p.force, &self.old_force, &p.inv_mass, dt);
+        if Self::ROTATES {
+            if let Some(a) = &mut p.angular {
+                pcvv::correct(
+                    &mut a.omega,
+                    &a.torque,
+                    &self.old_torque,
+                    &a.inv_inertia,
+                    dt,
+                );
+            }
+        }
+    }
+
+    /// One velocity-Verlet step.
+    fn step_verlet(&mut self) {
         let dt = self.dt;
         let p = &mut self.particles;
         drift_kick(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
-        if L::NEEDS_ROTATION {
+        if Self::ROTATES {
             if let Some(a) = &mut p.angular {
                 kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
@@ -103,13 +184,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.compute_forces();
         let p = &mut self.particles;
         kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
-        if L::NEEDS_ROTATION {
+        if Self::ROTATES {
             if let Some(a) = &mut p.angular {
                 kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
-        self.time += dt;
-        self.steps += 1;
     }
 
     /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list
@@ -140,10 +219,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.particles.retain(&keep);
             self.lost += (old_count - self.particles.len()) as u64;
         }
-        let resort = self.neighbor.resort_every > 0 && self.list.builds % self.neighbor.resort_every as u64 == 0;
+        let resort = self.neighbor.resort_every > 0
+            && self.list.builds % self.neighbor.resort_every as u64 == 0;
         let old_pairs = std::mem::take(&mut self.list.pairs);
         let old_history = std::mem::take(&mut self.history);
-        if let Some(order) = self.list.build(&mut self.particles, &self.domain, self.law.reach(), resort) {
+        if let Some(order) =
+            self.list
+                .build(&mut self.particles, &self.domain, self.law.reach(), resort)
+        {
             // Compose: old index -> (after removal) -> after re-sort.
             let mut sorted_index = vec![0u32; order.len()];
             for (new, &old) in order.iter().enumerate() {
@@ -153,12 +236,21 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 None => sorted_index,
                 Some(first) => first
                     .iter()
-                    .map(|&k| if k == u32::MAX { k } else { sorted_index[k as usize] })
+                    .map(|&k| {
+                        if k == u32::MAX {
+                            k
+                        } else {
+                            sorted_index[k as usize]
+                        }
+                    })
                     .collect(),
             });
         }
-        self.history = self.list.carry_history(&old_pairs, &old_history, remap.as_deref());
-        self.pair_result.resize(self.list.pairs.len(), PairResult::default());
+        self.history = self
+            .list
+            .carry_history(&old_pairs, &old_history, remap.as_deref());
+        self.pair_result
+            .resize(self.list.pairs.len(), PairResult::default());
     }
 
     /// Pair forces (each pair once, in parallel), then a per-particle gather in a fixed
@@ -180,17 +272,30 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 *result = pair_force(law, p, omega, &images, n_species, *pair, history, dt);
             });
 
+        if Self::ROTATES {
+            self.gather_with_torques();
+            return;
+        }
         let p = &mut self.particles;
         let (list, results) = (&self.list, &self.pair_result);
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
-        let (position, velocity, radius, mass, species) = (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
+        let (position, velocity, radius, mass, species) =
+            (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
         p.force
             .par_iter_mut()
             .enumerate()
             .with_min_len(CHUNK)
             .for_each(|(i, force)| {
                 let mut f = mass[i] * gravity;
-                f += walls.force_on(wall_law, species[i] as usize, position[i], velocity[i], radius[i], mass[i], dt);
+                f += walls.force_on(
+                    wall_law,
+                    species[i] as usize,
+                    position[i],
+                    velocity[i],
+                    radius[i],
+                    mass[i],
+                    dt,
+                );
                 for k in list.out_start[i]..list.out_start[i + 1] {
                     f += results[k as usize].force_on_i;
                 }
@@ -199,20 +304,69 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 }
                 *force = f;
             });
-        if L::NEEDS_ROTATION {
-            if let Some(a) = &mut p.angular {
-                a.torque.par_iter_mut().enumerate().with_min_len(CHUNK).for_each(|(i, torque)| {
-                    let mut t = Vec3::ZERO;
-                    for k in list.out_start[i]..list.out_start[i + 1] {
-                        t += results[k as usize].torque_on_i;
-                    }
-                    for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                        t += results[k as usize].torque_on_j;
-                    }
-                    *torque = t;
-                });
-            }
-        }
+    }
+
+    /// The gather for spinning particles: forces and torques of pairs, walls and gravity.
+    fn gather_with_torques(&mut self) {
+        let (list, results, dt) = (&self.list, &self.pair_result, self.dt);
+        let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
+        let Particles {
+            position,
+            velocity,
+            radius,
+            mass,
+            species,
+            force,
+            angular,
+            ..
+        } = &mut self.particles;
+        let Some(a) = angular.as_mut() else {
+            return;
+        };
+        let omega = &a.omega;
+        force
+            .par_iter_mut()
+            .zip(a.torque.par_iter_mut())
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(i, (force, torque))| {
+                let mut f = mass[i] * gravity;
+                let mut t = Vec3::ZERO;
+                if W::NEEDS_ROTATION {
+                    let (wf, wt) = walls.force_and_torque_on(
+                        wall_law,
+                        species[i] as usize,
+                        position[i],
+                        velocity[i],
+                        omega[i],
+                        radius[i],
+                        mass[i],
+                        dt,
+                    );
+                    f += wf;
+                    t += wt;
+                } else {
+                    f += walls.force_on(
+                        wall_law,
+                        species[i] as usize,
+                        position[i],
+                        velocity[i],
+                        radius[i],
+                        mass[i],
+                        dt,
+                    );
+                }
+                for k in list.out_start[i]..list.out_start[i + 1] {
+                    f += results[k as usize].force_on_i;
+                    t += results[k as usize].torque_on_i;
+                }
+                for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
+                    f -= results[k as usize].force_on_i;
+                    t += results[k as usize].torque_on_j;
+                }
+                *force = f;
+                *torque = t;
+            });
     }
 
     pub fn kinetic_energy(&self) -> Real {
@@ -223,7 +377,16 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 /// The force of one listed pair; zero (and history reset) when out of range.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn pair_force<L: PairLaw>(law: &L, p: &Particles, omega: Option<&[Vec3]>, images: &[Vec3; 27], n_species: usize, pair: Pair, history: &mut L::History, dt: Real) -> PairResult {
+fn pair_force<L: PairLaw>(
+    law: &L,
+    p: &Particles,
+    omega: Option<&[Vec3]>,
+    images: &[Vec3; 27],
+    n_species: usize,
+    pair: Pair,
+    history: &mut L::History,
+    dt: Real,
+) -> PairResult {
     let (i, j) = (pair.i as usize, pair.j as usize);
     let d = p.position[i] - (p.position[j] + images[pair.image as usize]);
     let distance_sq = d.length_squared();
@@ -258,6 +421,8 @@ fn pair_force<L: PairLaw>(law: &L, p: &Particles, omega: Option<&[Vec3]>, images
         radius_i,
         radius_j,
         r_eff: radius_i * radius_j / (radius_i + radius_j),
+        mass_i,
+        mass_j,
         m_eff: mass_i * mass_j / (mass_i + mass_j),
         relative_velocity,
         normal_speed,

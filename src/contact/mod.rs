@@ -28,6 +28,8 @@ pub struct Contact {
     pub radius_j: Real,
     /// Effective radius `r_i r_j / (r_i + r_j)`.
     pub r_eff: Real,
+    pub mass_i: Real,
+    pub mass_j: Real,
     /// Effective mass `m_i m_j / (m_i + m_j)`.
     pub m_eff: Real,
     /// Relative velocity `v_i - v_j` at the contact point (spins included when rotating).
@@ -60,7 +62,13 @@ pub trait NormalModel: Send + Sync {
     /// Elastic force at `contact`; only called when `distance < cutoff`.
     fn response(&self, contact: &Contact) -> NormalResponse;
     /// Stiffness of the linearized contact at its stiffest, for the time step.
-    fn linear_stiffness(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> Real;
+    fn linear_stiffness(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        m_eff: Real,
+    ) -> Real;
 }
 
 pub trait DampingModel: Send + Sync {
@@ -75,13 +83,26 @@ pub trait TangentialModel: Send + Sync {
     /// Whether the model needs particle spin (contact-point velocity, torques).
     const NEEDS_ROTATION: bool;
     /// Tangential force on `i`; `normal_force` is the total normal force magnitude.
-    fn force(&self, contact: &Contact, normal_force: Real, history: &mut Self::History, dt: Real) -> Vec3;
+    fn force(
+        &self,
+        contact: &Contact,
+        normal_force: Real,
+        history: &mut Self::History,
+        dt: Real,
+    ) -> Vec3;
 }
 
 pub trait RollingModel: Send + Sync {
     const NEEDS_ROTATION: bool;
     /// Rolling-resistance torque on `i` (the torque on `j` is its negative).
-    fn torque(&self, contact: &Contact, normal_force: Real, omega_i: Vec3, omega_j: Vec3) -> Vec3;
+    fn torque(
+        &self,
+        contact: &Contact,
+        normal_force: Real,
+        omega_i: Vec3,
+        omega_j: Vec3,
+        dt: Real,
+    ) -> Vec3;
 }
 
 pub trait CohesionModel: Send + Sync {
@@ -99,9 +120,21 @@ pub trait PairLaw: Send + Sync {
     /// Largest distance beyond `r_i + r_j` at which any pair still interacts.
     fn reach(&self) -> Real;
     fn cutoff(&self, species_pair: usize, radius_i: Real, radius_j: Real) -> Real;
-    fn evaluate(&self, contact: &Contact, history: &mut Self::History, omega: (Vec3, Vec3), dt: Real) -> PairResult;
+    fn evaluate(
+        &self,
+        contact: &Contact,
+        history: &mut Self::History,
+        omega: (Vec3, Vec3),
+        dt: Real,
+    ) -> PairResult;
     /// (stiffness, damping coefficient) of the linearized contact of two particles.
-    fn linearized(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> (Real, Real);
+    fn linearized(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        m_eff: Real,
+    ) -> (Real, Real);
 }
 
 /// A contact law assembled from five slots.
@@ -138,7 +171,13 @@ where
     }
 
     #[inline(always)]
-    fn evaluate(&self, contact: &Contact, history: &mut T::History, omega: (Vec3, Vec3), dt: Real) -> PairResult {
+    fn evaluate(
+        &self,
+        contact: &Contact,
+        history: &mut T::History,
+        omega: (Vec3, Vec3),
+        dt: Real,
+    ) -> PairResult {
         let touching = contact.distance
             < self
                 .normal
@@ -168,7 +207,9 @@ where
         // centres), plus rolling resistance.
         let arm_i = -contact.normal * (contact.radius_i - 0.5 * contact.overlap);
         let arm_j = contact.normal * (contact.radius_j - 0.5 * contact.overlap);
-        let rolling = self.rolling.torque(contact, normal_force.abs(), omega.0, omega.1);
+        let rolling = self
+            .rolling
+            .torque(contact, normal_force.abs(), omega.0, omega.1, dt);
         PairResult {
             force_on_i,
             torque_on_i: arm_i.cross(tangential) + rolling,
@@ -176,8 +217,16 @@ where
         }
     }
 
-    fn linearized(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> (Real, Real) {
-        let k = self.normal.linear_stiffness(species_pair, radius_i, radius_j, m_eff);
+    fn linearized(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        m_eff: Real,
+    ) -> (Real, Real) {
+        let k = self
+            .normal
+            .linear_stiffness(species_pair, radius_i, radius_j, m_eff);
         let gamma = self.damping.linear_coefficient(species_pair, k, m_eff);
         (k, gamma)
     }
@@ -204,6 +253,88 @@ impl SeedModel {
             rolling: rolling::NoRolling,
             cohesion: cohesion::NoCohesion,
             normal_reach,
+        }
+    }
+}
+
+/// The Hertz family (LIGGGHTS `model hertz`, paper B). Each scene picks one of these
+/// concrete combinations (see `run`), so it pays only for its slots.
+pub type HertzHistory = ContactLaw<
+    normal::Hertz,
+    damping::HertzDamping,
+    tangential::Mindlin,
+    rolling::NoRolling,
+    cohesion::NoCohesion,
+>;
+/// `HertzHistory` plus constant-torque rolling resistance.
+pub type HertzHistoryRolling = ContactLaw<
+    normal::Hertz,
+    damping::HertzDamping,
+    tangential::Mindlin,
+    rolling::ConstantTorque,
+    cohesion::NoCohesion,
+>;
+/// `HertzHistoryRolling` plus van der Waals attraction.
+pub type HertzHistoryRollingVdw = ContactLaw<
+    normal::Hertz,
+    damping::HertzDamping,
+    tangential::Mindlin,
+    rolling::ConstantTorque,
+    cohesion::VanDerWaals,
+>;
+/// Paper B as written: Hertz, Yang dashpot and tangential law, rolling, van der Waals.
+pub type PaperB = ContactLaw<
+    normal::Hertz,
+    damping::YangDamping,
+    tangential::YangTangential,
+    rolling::ConstantTorque,
+    cohesion::VanDerWaals,
+>;
+/// Paper B without rolling resistance and cohesion.
+pub type YangHertz = ContactLaw<
+    normal::Hertz,
+    damping::YangDamping,
+    tangential::YangTangential,
+    rolling::NoRolling,
+    cohesion::NoCohesion,
+>;
+
+impl<N: NormalModel, D, T, R, C> ContactLaw<N, D, T, R, C> {
+    /// Assembles a law; the normal slot touches exactly at `r_i + r_j`.
+    pub fn new(normal: N, damping: D, tangential: T, rolling: R, cohesion: C) -> Self {
+        ContactLaw {
+            normal,
+            damping,
+            tangential,
+            rolling,
+            cohesion,
+            normal_reach: 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// Two 1 g spheres of effective radius `r_eff` (radii `2 r_eff`) overlapping by `delta`
+    /// along x, at rest.
+    pub fn contact_at(delta: Real, r_eff: Real) -> Contact {
+        let r = 2.0 * r_eff;
+        Contact {
+            species_pair: 0,
+            normal: Vec3::X,
+            distance: 2.0 * r - delta,
+            overlap: delta,
+            radius_i: r,
+            radius_j: r,
+            r_eff,
+            mass_i: 2e-3,
+            mass_j: 2e-3,
+            m_eff: 1e-3,
+            relative_velocity: Vec3::ZERO,
+            normal_speed: 0.0,
+            tangential_velocity: Vec3::ZERO,
         }
     }
 }

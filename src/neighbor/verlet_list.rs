@@ -29,6 +29,20 @@ impl PairHistory for () {
     fn mirrored(self) -> Self {}
 }
 
+/// A displacement of `i` relative to `j` (e.g. a tangential spring): `j` sees it negated.
+impl PairHistory for Vec3 {
+    fn mirrored(self) -> Self {
+        -self
+    }
+}
+
+/// A magnitude (e.g. accumulated slip length): the same from either side.
+impl PairHistory for Real {
+    fn mirrored(self) -> Self {
+        self
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct VerletList {
     pub pairs: Vec<Pair>,

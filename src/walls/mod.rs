@@ -1,7 +1,9 @@
 //! Walls: finite planes that can be removed during a run, and the particle-wall laws.
 
+mod hertz_wall;
 mod wca_wall;
 
+pub use hertz_wall::{HertzWall, HertzWallSpecies};
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
 use crate::geometry::FinitePlane;
@@ -23,10 +25,17 @@ pub struct WallContact {
 
 /// A particle-wall contact law.
 pub trait WallLaw: Send + Sync {
+    /// Whether the law uses the particle spin and exerts torques (then the world calls
+    /// `force_and_torque` instead of `force`).
+    const NEEDS_ROTATION: bool = false;
     /// Largest centre-to-plane distance at which the wall acts on `species`.
     fn reach(&self, species: usize, radius: Real) -> Real;
     /// Force on the particle; only called when `distance < reach`.
     fn force(&self, contact: &WallContact, dt: Real) -> Vec3;
+    /// Force and torque on a spinning particle; `contact.relative_velocity` is the centre's.
+    fn force_and_torque(&self, contact: &WallContact, _omega: Vec3, dt: Real) -> (Vec3, Vec3) {
+        (self.force(contact, dt), Vec3::ZERO)
+    }
     /// (stiffness, damping coefficient) of the linearized contact, for the time step.
     fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real);
 }
@@ -58,7 +67,16 @@ impl WallSet {
 
     /// Total force of the active walls on one particle.
     #[inline(always)]
-    pub fn force_on<W: WallLaw>(&self, law: &W, species: usize, position: Vec3, velocity: Vec3, radius: Real, mass: Real, dt: Real) -> Vec3 {
+    pub fn force_on<W: WallLaw>(
+        &self,
+        law: &W,
+        species: usize,
+        position: Vec3,
+        velocity: Vec3,
+        radius: Real,
+        mass: Real,
+        dt: Real,
+    ) -> Vec3 {
         let reach = law.reach(species, radius);
         let mut total = Vec3::ZERO;
         for wall in self.walls.iter().filter(|w| w.active) {
@@ -80,5 +98,43 @@ impl WallSet {
             total += law.force(&contact, dt);
         }
         total
+    }
+
+    /// Total force and torque of the active walls on one spinning particle.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub fn force_and_torque_on<W: WallLaw>(
+        &self,
+        law: &W,
+        species: usize,
+        position: Vec3,
+        velocity: Vec3,
+        omega: Vec3,
+        radius: Real,
+        mass: Real,
+        dt: Real,
+    ) -> (Vec3, Vec3) {
+        let reach = law.reach(species, radius);
+        let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
+        for wall in self.walls.iter().filter(|w| w.active) {
+            let Some(distance) = wall.plane.distance(position) else {
+                continue;
+            };
+            if distance <= 0.0 || distance >= reach {
+                continue;
+            }
+            let contact = WallContact {
+                species,
+                normal: wall.plane.normal,
+                distance,
+                relative_velocity: velocity,
+                radius,
+                mass,
+            };
+            let (f, t) = law.force_and_torque(&contact, omega, dt);
+            force += f;
+            torque += t;
+        }
+        (force, torque)
     }
 }
