@@ -93,6 +93,8 @@ pub trait TangentialModel: Send + Sync {
 }
 
 pub trait RollingModel: Send + Sync {
+    /// Per-pair state (e.g. a rolling spring); `()` when the model has none.
+    type History: PairHistory;
     const NEEDS_ROTATION: bool;
     /// Rolling-resistance torque on `i` (the torque on `j` is its negative).
     fn torque(
@@ -101,6 +103,7 @@ pub trait RollingModel: Send + Sync {
         normal_force: Real,
         omega_i: Vec3,
         omega_j: Vec3,
+        history: &mut Self::History,
         dt: Real,
     ) -> Vec3;
 }
@@ -157,7 +160,8 @@ where
     R: RollingModel,
     C: CohesionModel,
 {
-    type History = T::History;
+    /// Tangential and rolling history side by side; `((), ())` (no storage) for the seed.
+    type History = (T::History, R::History);
     const NEEDS_ROTATION: bool = T::NEEDS_ROTATION || R::NEEDS_ROTATION;
 
     fn reach(&self) -> Real {
@@ -174,7 +178,7 @@ where
     fn evaluate(
         &self,
         contact: &Contact,
-        history: &mut T::History,
+        history: &mut Self::History,
         omega: (Vec3, Vec3),
         dt: Real,
     ) -> PairResult {
@@ -184,7 +188,7 @@ where
                 .cutoff(contact.species_pair, contact.radius_i, contact.radius_j);
         if !touching {
             // A separated pair loses its history; cohesion may still pull.
-            *history = T::History::default();
+            *history = Default::default();
             let pull = self.cohesion.force(contact);
             return PairResult {
                 force_on_i: -pull * contact.normal,
@@ -194,7 +198,9 @@ where
         // The normal part first: friction and rolling need |F_n|.
         let elastic = self.normal.response(contact);
         let normal_force = elastic.force + self.damping.force(contact, &elastic);
-        let tangential = self.tangential.force(contact, normal_force, history, dt);
+        let tangential = self
+            .tangential
+            .force(contact, normal_force, &mut history.0, dt);
         let pull = self.cohesion.force(contact);
         let force_on_i = (normal_force - pull) * contact.normal + tangential;
         if !Self::NEEDS_ROTATION {
@@ -207,9 +213,14 @@ where
         // centres), plus rolling resistance.
         let arm_i = -contact.normal * (contact.radius_i - 0.5 * contact.overlap);
         let arm_j = contact.normal * (contact.radius_j - 0.5 * contact.overlap);
-        let rolling = self
-            .rolling
-            .torque(contact, normal_force.abs(), omega.0, omega.1, dt);
+        let rolling = self.rolling.torque(
+            contact,
+            normal_force.abs(),
+            omega.0,
+            omega.1,
+            &mut history.1,
+            dt,
+        );
         PairResult {
             force_on_i,
             torque_on_i: arm_i.cross(tangential) + rolling,

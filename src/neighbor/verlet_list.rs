@@ -36,6 +36,13 @@ impl PairHistory for Vec3 {
     }
 }
 
+/// Two histories side by side (e.g. tangential and rolling).
+impl<A: PairHistory, B: PairHistory> PairHistory for (A, B) {
+    fn mirrored(self) -> Self {
+        (self.0.mirrored(), self.1.mirrored())
+    }
+}
+
 /// A magnitude (e.g. accumulated slip length): the same from either side.
 impl PairHistory for Real {
     fn mirrored(self) -> Self {

@@ -3,9 +3,8 @@
 //! component along the normal (torsion is excluded, as in LIGGGHTS's default).
 //!
 //! Paper B writes `R_i`; for two equal spheres `R_i = 2 R_eff`, so its `mu_r` is half of ours.
-//! This is not LIGGGHTS `epsd2`, which is an incremental rolling spring `k_r = k_t R_eff^2`
-//! capped at the same `mu_r R_eff F_n` (it needs a per-pair torque history); it agrees with
-//! epsd2 once the cap binds (steady rolling), not in elastic rolling oscillations.
+//! LIGGGHTS `epsd2` (see `Epsd2`) is a rolling spring capped at the same `mu_r R_eff |F_n|`;
+//! the two agree once the cap binds (steady rolling), not in elastic rolling oscillations.
 //!
 //! `w/|w|` flips with `w`; as for the seed's wall friction the torque is capped so it can at
 //! most halve `|w|` in one step: `|T| <= |w| / (2 dt (1/I_i + 1/I_j))`, solid spheres
@@ -21,6 +20,7 @@ pub struct ConstantTorque {
 }
 
 impl RollingModel for ConstantTorque {
+    type History = ();
     const NEEDS_ROTATION: bool = true;
 
     #[inline(always)]
@@ -30,6 +30,7 @@ impl RollingModel for ConstantTorque {
         normal_force: Real,
         omega_i: Vec3,
         omega_j: Vec3,
+        _: &mut (),
         dt: Real,
     ) -> Vec3 {
         let n = contact.normal;
@@ -60,10 +61,17 @@ mod tests {
             rolling_friction: vec![0.1],
         };
         // Spin about y (rolling) plus about the normal x (torsion, ignored).
-        let t = model.torque(&c, 2.0, Vec3::new(5.0, 3.0, 0.0), Vec3::ZERO, 1e-6);
+        let t = model.torque(&c, 2.0, Vec3::new(5.0, 3.0, 0.0), Vec3::ZERO, &mut (), 1e-6);
         assert!((t - Vec3::new(0.0, -0.1 * 5e-4 * 2.0, 0.0)).length() < 1e-15);
         // A tiny spin is only braked, never reversed.
-        let t = model.torque(&c, 2.0, Vec3::new(0.0, 1e-9, 0.0), Vec3::ZERO, 1e-6);
+        let t = model.torque(
+            &c,
+            2.0,
+            Vec3::new(0.0, 1e-9, 0.0),
+            Vec3::ZERO,
+            &mut (),
+            1e-6,
+        );
         assert!(t.y < 0.0 && t.y.abs() < 0.1 * 5e-4 * 2.0);
     }
 }
