@@ -11,7 +11,10 @@
 //! `gamma / (2 sqrt(k m_eff))` and hence the restitution are unchanged. Wall damping is set
 //! from the restitution, so it follows the same rule by construction.
 
-use crate::scene::{ContactSettings, InsertAmount, Scene};
+use crate::scene::{
+    CohesionKind, ContactSettings, HertzDampingKind, HertzSettings, InsertAmount, RollingKind,
+    Scene,
+};
 use crate::timestep::TimeStepRequest;
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -29,6 +32,59 @@ pub enum CoarseGrainError {
     },
 }
 
+/// Hertz parameters under `phi'(r) = lambda^3 phi(r / lambda)`, i.e. every contact force
+/// `F'(x') = lambda^2 F(x' / lambda)` at the same velocities (reference/COARSE_GRAINING_HERTZ.md):
+/// Young's modulus, Poisson's ratio, restitution, friction and rolling friction unchanged;
+/// Yang's `gamma_n` (s) times lambda; Hamaker constant times lambda^3, `h_min` and the
+/// cohesion cut-off times lambda.
+pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
+    let mut out = h.clone();
+    if let HertzDampingKind::Yang { gamma_n } = h.damping {
+        out.damping = HertzDampingKind::Yang {
+            gamma_n: gamma_n * l,
+        };
+    }
+    if let CohesionKind::VanDerWaals {
+        hamaker_constant,
+        h_min,
+        cutoff,
+    } = h.cohesion
+    {
+        out.cohesion = CohesionKind::VanDerWaals {
+            hamaker_constant: hamaker_constant * l.powi(3),
+            h_min: h_min * l,
+            cutoff: cutoff.map(|c| c * l),
+        };
+    }
+    out
+}
+
+/// Where coarse-graining the scene by `lambda` is not consistent, with the reason (like
+/// LIGGGHTS-PFM's model check). Empty for lambda = 1 and for the seed's WCA scenes, whose
+/// rule is paper A's.
+pub fn coarse_grain_warnings(scene: &Scene, lambda: u32) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let ContactSettings::Hertz(h) = &scene.contact else {
+        return warnings;
+    };
+    if lambda <= 1 {
+        return warnings;
+    }
+    let l = lambda as f64;
+    if scene.gravity.length() > 0.0 {
+        warnings.push(format!("gravity: weights scale as lambda^3 but contact forces as lambda^2, so weight/contact-force ratios (overlap under load, Bond number) grow {l}x at lambda = {lambda}"));
+    }
+    if let CohesionKind::VanDerWaals { .. } = h.cohesion {
+        if scene.gravity.length() > 0.0 {
+            warnings.push(format!("cohesion: the granular Bond number F_vdw(h_min) / (m g) falls {l}x at lambda = {lambda}; cohesion-controlled structure (porosity of fine powders) is not preserved"));
+        }
+    }
+    if h.rolling != RollingKind::None {
+        warnings.push(format!("rolling: the torque mu_r R_eff |F_n| scales like r x F (lambda^3) and is formally consistent, but one parcel stands for lambda^3 = {} real particles whose rolling contacts (and the shape effects mu_r stands for) are not resolved; mu_r calibrated on real particles is unverified for parcels at lambda = {lambda} (LIGGGHTS flags rolling models under coarse-graining)", l.powi(3)));
+    }
+    warnings
+}
+
 /// Returns the scene coarse-grained by `lambda` relative to its current level.
 pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainError> {
     if lambda == 0 || !lambda.is_power_of_two() {
@@ -40,18 +96,19 @@ pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainErro
     for s in &mut out.species {
         s.diameter *= l;
     }
-    out.contact = match scene.contact {
+    out.contact = match &scene.contact {
         ContactSettings::Wca {
             epsilon,
             sigma,
             gamma_n,
             gamma_t,
         } => ContactSettings::Wca {
-            epsilon: epsilon * l.powi(3),
-            sigma: sigma * l,
-            gamma_n: gamma_n * l * l,
-            gamma_t: gamma_t * l * l,
+            epsilon: *epsilon * l.powi(3),
+            sigma: *sigma * l,
+            gamma_n: *gamma_n * l * l,
+            gamma_t: *gamma_t * l * l,
         },
+        ContactSettings::Hertz(h) => ContactSettings::Hertz(coarse_grain_hertz(h, l)),
     };
     if let TimeStepRequest::Explicit(dt) = scene.time_step {
         out.time_step = TimeStepRequest::Explicit(dt * l);

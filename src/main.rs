@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use cgdem::coarse_graining::coarse_grain;
+use cgdem::coarse_graining::{coarse_grain, coarse_grain_warnings};
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
@@ -44,6 +44,10 @@ enum Command {
         /// Run even if the time step exceeds the stable limit (prints a warning).
         #[arg(long)]
         force_dt: bool,
+        /// Refuse to coarse-grain where the scaling rule is inconsistent for the scene's
+        /// model (gravity, cohesion, rolling with Hertz), instead of warning.
+        #[arg(long)]
+        strict: bool,
     },
 }
 
@@ -57,6 +61,7 @@ fn main() -> ExitCode {
             threads,
             quiet,
             force_dt,
+            strict,
         } => {
             if threads == Some(0) {
                 eprintln!("error: --threads must be at least 1");
@@ -77,7 +82,20 @@ fn main() -> ExitCode {
             let result = pool.install(|| {
                 Scene::load(&case)
                     .map_err(|e| e.to_string())
-                    .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
+                    .and_then(|scene| {
+                        let warnings = coarse_grain_warnings(&scene, lambda);
+                        if strict && !warnings.is_empty() {
+                            return Err(format!(
+                                "{}: --strict: coarse-graining by lambda = {lambda} is inconsistent:\n  {}",
+                                case.display(),
+                                warnings.join("\n  ")
+                            ));
+                        }
+                        for w in &warnings {
+                            eprintln!("warning: coarse-graining: {w}");
+                        }
+                        coarse_grain(&scene, lambda).map_err(|e| e.to_string())
+                    })
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| {
                             PathBuf::from("runs")
