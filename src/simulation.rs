@@ -108,6 +108,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         &self.list.pairs
     }
 
+    /// Per-pair contact history, parallel to `pairs()`.
+    pub fn history(&self) -> &[L::History] {
+        &self.history
+    }
+
     pub fn list_builds(&self) -> u64 {
         self.list.builds
     }
@@ -195,6 +200,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// and carries the contact history over.
     pub fn rebuild(&mut self) {
         let old_count = self.particles.len();
+        // How far the build's wrap will move each particle, for the pairs' images.
+        let wraps: Option<Vec<[i32; 3]>> = self.domain.any_periodic().then(|| {
+            self.particles
+                .position
+                .iter()
+                .map(|&x| self.domain.wrap_count(x))
+                .collect()
+        });
         let mut remap: Option<Vec<u32>> = None;
         let keep: Vec<bool> = self
             .particles
@@ -246,9 +259,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     .collect(),
             });
         }
-        self.history = self
-            .list
-            .carry_history(&old_pairs, &old_history, remap.as_deref());
+        self.history =
+            self.list
+                .carry_history(&old_pairs, &old_history, wraps.as_deref(), remap.as_deref());
         self.pair_result
             .resize(self.list.pairs.len(), PairResult::default());
     }

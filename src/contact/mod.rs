@@ -325,6 +325,9 @@ impl<N: NormalModel, D, T, R, C> ContactLaw<N, D, T, R, C> {
 }
 
 #[cfg(test)]
+mod physics_tests;
+
+#[cfg(test)]
 pub(crate) mod tests {
     use super::*;
 
