@@ -140,3 +140,109 @@ pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainErro
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{HertzSettings, TangentialKind};
+
+    fn paper_b() -> HertzSettings {
+        HertzSettings {
+            youngs_modulus: 1e7,
+            poisson_ratio: 0.29,
+            restitution: 1.0,
+            friction: 0.3,
+            rolling_friction: 0.002,
+            damping: HertzDampingKind::Yang { gamma_n: 1e-5 },
+            tangential: TangentialKind::Yang,
+            rolling: RollingKind::ConstantTorque,
+            cohesion: CohesionKind::VanDerWaals {
+                hamaker_constant: 6.5e-20,
+                h_min: 4e-10,
+                cutoff: None,
+            },
+            characteristic_velocity: 1.0,
+        }
+    }
+
+    #[test]
+    fn hertz_parameters_scale_so_every_contact_force_is_lambda_squared_at_the_scaled_state() {
+        use crate::contact::cohesion::vdw_force;
+        let l = 4.0;
+        let h = paper_b();
+        let g = coarse_grain_hertz(&h, l);
+        assert_eq!(
+            (
+                g.youngs_modulus,
+                g.poisson_ratio,
+                g.friction,
+                g.rolling_friction
+            ),
+            (
+                h.youngs_modulus,
+                h.poisson_ratio,
+                h.friction,
+                h.rolling_friction
+            )
+        );
+        assert_eq!(g.damping, HertzDampingKind::Yang { gamma_n: 4e-5 });
+        let (
+            CohesionKind::VanDerWaals {
+                hamaker_constant: a0,
+                h_min: h0,
+                ..
+            },
+            CohesionKind::VanDerWaals {
+                hamaker_constant: a1,
+                h_min: h1,
+                ..
+            },
+        ) = (h.cohesion, g.cohesion)
+        else {
+            panic!("vdw lost")
+        };
+        // F'(lambda x) = lambda^2 F(x): Hertz (Y unchanged), Yang dashpot, van der Waals.
+        let (r, delta, v) = (2.5e-5, 1e-8, 0.01);
+        let hertz = |y: f64, r: f64, d: f64| 4.0 / 3.0 * y * (r * d).sqrt() * d;
+        let yang = |gamma: f64, y: f64, r: f64, d: f64| gamma * 2.0 * y * (r * d).sqrt() * v;
+        let ratio = |a: f64, b: f64| a / b / (l * l) - 1.0;
+        assert!(
+            ratio(
+                hertz(g.youngs_modulus, l * r, l * delta),
+                hertz(h.youngs_modulus, r, delta)
+            )
+            .abs()
+                < 1e-12
+        );
+        assert!(ratio(yang(4e-5, 1e7, l * r, l * delta), yang(1e-5, 1e7, r, delta)).abs() < 1e-12);
+        for gap in [h0, 3.0 * h0, 30.0 * h0] {
+            assert!(
+                ratio(
+                    vdw_force(a1, l * r, l * r, l * gap),
+                    vdw_force(a0, r, r, gap)
+                )
+                .abs()
+                    < 1e-12
+            );
+        }
+        assert!((h1 / h0 - l).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hertz_scenes_warn_where_coarse_graining_is_inconsistent_and_the_seed_does_not() {
+        let case = |name: &str| {
+            Scene::load(
+                &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("validation/cases")
+                    .join(name),
+            )
+            .unwrap()
+        };
+        let hertz = case("hertz_settle.toml");
+        assert!(coarse_grain_warnings(&hertz, 1).is_empty());
+        let warnings = coarse_grain_warnings(&hertz, 2);
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert!(warnings[0].starts_with("gravity") && warnings[1].starts_with("rolling"));
+        assert!(coarse_grain_warnings(&case("aor_collapse.toml"), 8).is_empty());
+    }
+}

@@ -240,3 +240,30 @@ pub fn run_hertz(
         }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_uncompiled_combination_is_refused_with_the_supported_list() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("validation/cases/hertz_settle.toml");
+        let mut scene = Scene::load(&path).unwrap();
+        let crate::scene::ContactSettings::Hertz(h) = &mut scene.contact else {
+            panic!("not hertz")
+        };
+        h.tangential = TangentialKind::Yang; // with the LIGGGHTS dashpot: not on the list
+        let h = h.clone();
+        let options = RunOptions {
+            out_dir: std::env::temp_dir().join("cgdem-unsupported"),
+            quiet: true,
+            force_dt: false,
+        };
+        let message = run_hertz(&scene, &h, &options).unwrap_err().to_string();
+        assert!(
+            message.contains("not compiled") && message.contains("yang/yang/constant_torque/vdw"),
+            "{message}"
+        );
+    }
+}

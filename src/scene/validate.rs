@@ -687,3 +687,125 @@ fn names<'a>(list: impl Iterator<Item = &'a String>) -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::*;
+    use std::path::Path;
+
+    /// Paper B's combination in a minimal scene; `contact` replaces the [contact] table body.
+    fn scene_with(contact: &str, time: &str) -> Result<Scene, SceneError> {
+        let text = format!(
+            r#"
+name = "t"
+[domain]
+lo = [0.0, 0.0, 0.0]
+hi = [0.01, 0.01, 0.01]
+[[species]]
+name = "fine"
+diameter = 5e-5
+density = 2500.0
+[contact]
+{contact}
+[time]
+{time}
+[[stage]]
+name = "s"
+duration = 0.1
+"#
+        );
+        Scene::parse(&text, Path::new("case.toml"))
+    }
+
+    const PAPER_B: &str = r#"model = "hertz"
+youngs_modulus = 1e7
+poisson_ratio = 0.29
+friction = 0.3
+rolling_friction = 0.002
+damping = "yang"
+gamma_n_yang = 1e-5
+tangential = "yang"
+rolling = "constant_torque"
+cohesion = "vdw"
+hamaker_constant = 6.5e-20
+h_min = 4e-10"#;
+
+    #[test]
+    fn a_paper_b_hertz_scene_is_read_with_liggghts_keywords_and_pcvv() {
+        let scene = scene_with(PAPER_B, "dt = 1e-8\nintegrator = \"pcvv\"").unwrap();
+        assert_eq!(scene.integrator, Integrator::Pcvv);
+        let ContactSettings::Hertz(h) = scene.contact else {
+            panic!("not hertz")
+        };
+        assert_eq!(h.damping, HertzDampingKind::Yang { gamma_n: 1e-5 });
+        assert_eq!(h.tangential, TangentialKind::Yang);
+        assert_eq!(h.rolling, RollingKind::ConstantTorque);
+        assert_eq!(
+            h.cohesion,
+            CohesionKind::VanDerWaals {
+                hamaker_constant: 6.5e-20,
+                h_min: 4e-10,
+                cutoff: None
+            }
+        );
+    }
+
+    #[test]
+    fn bad_hertz_values_name_the_file_field_value_and_what_is_allowed() {
+        let cases = [
+            (
+                PAPER_B.replace("poisson_ratio = 0.29", "poisson_ratio = 0.7"),
+                "contact.poisson_ratio",
+                "-1 <= poisson_ratio < 0.5",
+            ),
+            (
+                PAPER_B.replace("damping = \"yang\"", "damping = \"tsuji\""),
+                "contact.damping",
+                "\"yang\"",
+            ),
+            (
+                PAPER_B.replace("rolling = \"constant_torque\"", "rolling = \"cdt\""),
+                "contact.rolling",
+                "epsd2",
+            ),
+            (
+                PAPER_B.replace("h_min = 4e-10", ""),
+                "contact.h_min",
+                "van der Waals",
+            ),
+            (
+                PAPER_B.replace("gamma_n_yang = 1e-5", "gamma_n = 1e-5"),
+                "contact.gamma_n",
+                "gamma_n_yang",
+            ),
+            (
+                PAPER_B.replace("damping = \"yang\"", "damping = \"hertz\""),
+                "contact.gamma_n_yang",
+                "only with damping",
+            ),
+        ];
+        for (contact, field, allowed) in cases {
+            let message = scene_with(&contact, "dt = 1e-8").unwrap_err().to_string();
+            assert!(
+                message.starts_with("case.toml: field `")
+                    && message.contains(field)
+                    && message.contains(allowed),
+                "{message}"
+            );
+        }
+        let message = scene_with(PAPER_B, "dt = 1e-8\nintegrator = \"rk4\"")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("time.integrator")
+                && message.contains("\"rk4\"")
+                && message.contains("pcvv"),
+            "{message}"
+        );
+        let message = scene_with("model = \"wca\"\nepsilon = 1.0\nsigma = 4.4545e-5\ngamma_n = 0.0\ngamma_t = 0.0\nfriction = 0.3", "dt = 1e-8").unwrap_err().to_string();
+        assert!(
+            message.contains("contact.friction") && message.contains("hertz"),
+            "{message}"
+        );
+    }
+}

@@ -66,6 +66,7 @@ impl WallSet {
     }
 
     /// Total force of the active walls on one particle.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn force_on<W: WallLaw>(
         &self,
