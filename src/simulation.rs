@@ -233,7 +233,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.lost += (old_count - self.particles.len()) as u64;
         }
         let resort = self.neighbor.resort_every > 0
-            && self.list.builds.is_multiple_of(self.neighbor.resort_every as u64);
+            && self
+                .list
+                .builds
+                .is_multiple_of(self.neighbor.resort_every as u64);
         let old_pairs = std::mem::take(&mut self.list.pairs);
         let old_history = std::mem::take(&mut self.history);
         if let Some(order) =

@@ -105,6 +105,12 @@ fn world<L: PairLaw, W: WallLaw>(
 
 /// Head-on impact at relative speed `v` of two spheres of radius `r`: (contact time, e).
 fn head_on<L: PairLaw>(law: L, r: Real, v: Real, dt: Real) -> (Real, Real) {
+    let (t, e, _) = head_on_with_overlap(law, r, v, dt);
+    (t, e)
+}
+
+/// As `head_on`, also the largest overlap.
+fn head_on_with_overlap<L: PairLaw>(law: L, r: Real, v: Real, dt: Real) -> (Real, Real, Real) {
     let gap = 2.0 * v * dt;
     let bodies = [
         (
@@ -128,10 +134,12 @@ fn head_on<L: PairLaw>(law: L, r: Real, v: Real, dt: Real) -> (Real, Real) {
         dt,
         0,
     );
-    let (mut started, mut steps) = (false, 0u64);
+    let (mut started, mut steps, mut largest) = (false, 0u64, 0.0 as Real);
     for _ in 0..10_000_000 {
         w.step();
-        let touching = (w.particles.position[1] - w.particles.position[0]).length() < 2.0 * r;
+        let distance = (w.particles.position[1] - w.particles.position[0]).length();
+        largest = largest.max(2.0 * r - distance);
+        let touching = distance < 2.0 * r;
         if touching {
             started = true;
             steps += 1;
@@ -140,7 +148,19 @@ fn head_on<L: PairLaw>(law: L, r: Real, v: Real, dt: Real) -> (Real, Real) {
         }
     }
     let rebound = (w.particles.velocity[1] - w.particles.velocity[0]).x / v;
-    (steps as Real * dt, rebound)
+    (steps as Real * dt, rebound, largest)
+}
+
+#[test]
+fn head_on_impact_matches_the_liggghts_model_hertz_run_of_reference_mapping() {
+    // reference/MAPPING.md: d = 2 mm, rho = 2500, E = 5e6 Pa, nu = 0.3, e = 0.5, approach
+    // 1 m/s, dt = 1e-7 s; LIGGGHTS 3.8.0 gave e = 0.499981886129, contact 2.9410e-4 s,
+    // largest overlap 7.198264e-5 m (LAMMPS tsuji with the mapped coefficient agrees).
+    let (t, e, overlap) = head_on_with_overlap(hertz_law(0.5, 0.5, NoCohesion), RADIUS, 1.0, 1e-7);
+    eprintln!("cgdem: e = {e:.12}, contact {t:.5e} s, largest overlap {overlap:.7e} m");
+    assert!((e - 0.499981886129).abs() < 1e-11);
+    assert!((t - 2.9410e-4).abs() <= 1.5e-7);
+    assert!((overlap / 7.198264e-5 - 1.0).abs() < 1e-5);
 }
 
 #[test]
