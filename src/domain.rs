@@ -33,6 +33,25 @@ impl Domain {
         offset * self.length()
     }
 
+    /// The offsets (a, b, c) of image `k` (the inverse of `image_index`).
+    pub fn image_offset(image: u8) -> [i32; 3] {
+        let k = image as i32;
+        [k / 9 - 1, (k / 3) % 3 - 1, k % 3 - 1]
+    }
+
+    /// How many box lengths `wrap` subtracts from `p` along each periodic axis (0 elsewhere).
+    pub fn wrap_count(&self, p: Vec3) -> [i32; 3] {
+        let length = self.length();
+        let wrapped = self.wrap(p);
+        std::array::from_fn(|axis| {
+            if self.periodic[axis] {
+                ((p[axis] - wrapped[axis]) / length[axis]).round() as i32
+            } else {
+                0
+            }
+        })
+    }
+
     pub fn image_index(offset: [i32; 3]) -> u8 {
         ((offset[0] + 1) * 9 + (offset[1] + 1) * 3 + (offset[2] + 1)) as u8
     }

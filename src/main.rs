@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use cgdem::coarse_graining::{coarse_grain_by, CoarseGrainRule};
+use cgdem::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
@@ -49,6 +49,10 @@ enum Command {
         /// Run even if the time step exceeds the stable limit (prints a warning).
         #[arg(long)]
         force_dt: bool,
+        /// Refuse to coarse-grain where the scaling rule is inconsistent for the scene's
+        /// model (gravity, cohesion, rolling with Hertz), instead of warning.
+        #[arg(long)]
+        strict: bool,
     },
 }
 
@@ -63,6 +67,7 @@ fn main() -> ExitCode {
             threads,
             quiet,
             force_dt,
+            strict,
         } => {
             if threads == Some(0) {
                 eprintln!("error: --threads must be at least 1");
@@ -84,6 +89,17 @@ fn main() -> ExitCode {
                 Scene::load(&case)
                     .map_err(|e| e.to_string())
                     .and_then(|scene| {
+                        let warnings = coarse_grain_warnings(&scene, lambda);
+                        if strict && !warnings.is_empty() {
+                            return Err(format!(
+                                "{}: --strict: coarse-graining by lambda = {lambda} is inconsistent:\n  {}",
+                                case.display(),
+                                warnings.join("\n  ")
+                            ));
+                        }
+                        for w in &warnings {
+                            eprintln!("warning: coarse-graining: {w}");
+                        }
                         coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())
                     })
                     .and_then(|scene| {

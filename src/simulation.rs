@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::domain::Domain;
-use crate::integrate::{drift_kick, kick};
+use crate::integrate::{drift_kick, kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{Pair, VerletList};
 use crate::particles::Particles;
@@ -41,13 +41,17 @@ pub struct World<L: PairLaw, W: WallLaw> {
     neighbor: NeighborSettings,
     list: VerletList,
     history: Vec<L::History>,
-    /// Force on `i` of each listed pair; torques on `i` and `j` only for laws with rotation,
-    /// so the seed's scenes move a third of the bytes.
-    pair_force: Vec<Vec3>,
-    pair_torque: Vec<(Vec3, Vec3)>,
+    pair_result: Vec<PairResult>,
+    integrator: Integrator,
+    /// PCVV's `F0`, `T0` (empty for velocity Verlet).
+    old_force: Vec<Vec3>,
+    old_torque: Vec<Vec3>,
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
+    /// Whether particles carry spin: the pair law or the wall law needs it.
+    pub const ROTATES: bool = L::NEEDS_ROTATION || W::NEEDS_ROTATION;
+
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         particles: Particles,
@@ -61,7 +65,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         neighbor: NeighborSettings,
     ) -> Self {
         let mut particles = particles;
-        if L::NEEDS_ROTATION && particles.angular.is_none() {
+        if Self::ROTATES && particles.angular.is_none() {
             let mut rotating = Particles::new(true);
             for k in 0..particles.len() {
                 rotating.push(
@@ -89,8 +93,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             neighbor,
             list: VerletList::new(neighbor.skin),
             history: Vec::new(),
-            pair_force: Vec::new(),
-            pair_torque: Vec::new(),
+            pair_result: Vec::new(),
+            integrator: Integrator::VelocityVerlet,
+            old_force: Vec::new(),
+            old_torque: Vec::new(),
         };
         world.rebuild();
         world.compute_forces();
@@ -102,16 +108,77 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         &self.list.pairs
     }
 
+    /// Per-pair contact history, parallel to `pairs()`.
+    pub fn history(&self) -> &[L::History] {
+        &self.history
+    }
+
     pub fn list_builds(&self) -> u64 {
         self.list.builds
     }
 
-    /// One velocity-Verlet step.
+    /// Steps with `integrator` from now on.
+    pub fn with_integrator(mut self, integrator: Integrator) -> Self {
+        self.integrator = integrator;
+        self
+    }
+
+    pub fn integrator(&self) -> Integrator {
+        self.integrator
+    }
+
+    /// One step of the chosen scheme (chosen per step, never per particle).
     pub fn step(&mut self) {
+        match self.integrator {
+            Integrator::VelocityVerlet => self.step_verlet(),
+            Integrator::Pcvv => self.step_pcvv(),
+        }
+        self.time += self.dt;
+        self.steps += 1;
+    }
+
+    /// One predictor-corrector velocity-Verlet step, paper B Eq. (11)-(15).
+    fn step_pcvv(&mut self) {
+        let dt = self.dt;
+        let p = &mut self.particles;
+        pcvv::predict(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
+        if Self::ROTATES {
+            if let Some(a) = &mut p.angular {
+                pcvv::predict_rate(&mut a.omega, &a.torque, &a.inv_inertia, dt);
+            }
+        }
+        if self.list.needs_rebuild(&self.particles.position) {
+            self.rebuild();
+        }
+        // F0, T0 after the rebuild, which may reorder particles.
+        self.old_force.clone_from(&self.particles.force);
+        if Self::ROTATES {
+            if let Some(a) = &self.particles.angular {
+                self.old_torque.clone_from(&a.torque);
+            }
+        }
+        self.compute_forces();
+        let p = &mut self.particles;
+        pcvv::correct(&mut p.velocity, &p.force, &self.old_force, &p.inv_mass, dt);
+        if Self::ROTATES {
+            if let Some(a) = &mut p.angular {
+                pcvv::correct(
+                    &mut a.omega,
+                    &a.torque,
+                    &self.old_torque,
+                    &a.inv_inertia,
+                    dt,
+                );
+            }
+        }
+    }
+
+    /// One velocity-Verlet step.
+    fn step_verlet(&mut self) {
         let dt = self.dt;
         let p = &mut self.particles;
         drift_kick(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
-        if L::NEEDS_ROTATION {
+        if Self::ROTATES {
             if let Some(a) = &mut p.angular {
                 kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
@@ -122,19 +189,25 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.compute_forces();
         let p = &mut self.particles;
         kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
-        if L::NEEDS_ROTATION {
+        if Self::ROTATES {
             if let Some(a) = &mut p.angular {
                 kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
-        self.time += dt;
-        self.steps += 1;
     }
 
     /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list
     /// and carries the contact history over.
     pub fn rebuild(&mut self) {
         let old_count = self.particles.len();
+        // How far the build's wrap will move each particle, for the pairs' images.
+        let wraps: Option<Vec<[i32; 3]>> = self.domain.any_periodic().then(|| {
+            self.particles
+                .position
+                .iter()
+                .map(|&x| self.domain.wrap_count(x))
+                .collect()
+        });
         let mut remap: Option<Vec<u32>> = None;
         let keep: Vec<bool> = self
             .particles
@@ -189,14 +262,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     .collect(),
             });
         }
-        self.history = self
-            .list
-            .carry_history(&old_pairs, &old_history, remap.as_deref());
-        self.pair_force.resize(self.list.pairs.len(), Vec3::ZERO);
-        if L::NEEDS_ROTATION {
-            self.pair_torque
-                .resize(self.list.pairs.len(), (Vec3::ZERO, Vec3::ZERO));
-        }
+        self.history =
+            self.list
+                .carry_history(&old_pairs, &old_history, wraps.as_deref(), remap.as_deref());
+        self.pair_result
+            .resize(self.list.pairs.len(), PairResult::default());
     }
 
     /// Pair forces (each pair once, in parallel), then a per-particle gather in a fixed
@@ -208,32 +278,22 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let law = &self.law;
         let n_species = self.n_species;
         let dt = self.dt;
-        let pairs = self.list.pairs.par_iter().zip(self.history.par_iter_mut());
-        if L::NEEDS_ROTATION {
-            pairs
-                .zip(
-                    self.pair_force
-                        .par_iter_mut()
-                        .zip(self.pair_torque.par_iter_mut()),
-                )
-                .with_min_len(CHUNK)
-                .for_each(|((pair, history), (force, torque))| {
-                    let result = pair_force(law, p, omega, &images, n_species, *pair, history, dt);
-                    *force = result.force_on_i;
-                    *torque = (result.torque_on_i, result.torque_on_j);
-                });
-        } else {
-            pairs
-                .zip(self.pair_force.par_iter_mut())
-                .with_min_len(CHUNK)
-                .for_each(|((pair, history), force)| {
-                    *force = pair_force(law, p, omega, &images, n_species, *pair, history, dt)
-                        .force_on_i;
-                });
-        }
+        self.list
+            .pairs
+            .par_iter()
+            .zip(self.history.par_iter_mut())
+            .zip(self.pair_result.par_iter_mut())
+            .with_min_len(CHUNK)
+            .for_each(|((pair, history), result)| {
+                *result = pair_force(law, p, omega, &images, n_species, *pair, history, dt);
+            });
 
+        if Self::ROTATES {
+            self.gather_with_torques();
+            return;
+        }
         let p = &mut self.particles;
-        let (list, forces, torques) = (&self.list, &self.pair_force, &self.pair_torque);
+        let (list, results) = (&self.list, &self.pair_result);
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let (position, velocity, radius, mass, species) =
             (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
@@ -252,33 +312,66 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 };
                 f += walls.force_on(wall_law, &particle, dt);
                 for k in list.out_start[i]..list.out_start[i + 1] {
-                    f += forces[k as usize];
+                    f += results[k as usize].force_on_i;
                 }
                 for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                    f -= forces[k as usize];
+                    f -= results[k as usize].force_on_i;
                 }
                 *force = f;
             });
-        if L::NEEDS_ROTATION {
-            if let Some(a) = &mut p.angular {
-                a.torque
-                    .par_iter_mut()
-                    .enumerate()
-                    .with_min_len(CHUNK)
-                    .for_each(|(i, torque)| {
-                        let mut t = Vec3::ZERO;
-                        for k in list.out_start[i]..list.out_start[i + 1] {
-                            t += torques[k as usize].0;
-                        }
-                        for &k in
-                            &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize]
-                        {
-                            t += torques[k as usize].1;
-                        }
-                        *torque = t;
-                    });
-            }
-        }
+    }
+
+    /// The gather for spinning particles: forces and torques of pairs, walls and gravity.
+    fn gather_with_torques(&mut self) {
+        let (list, results, dt) = (&self.list, &self.pair_result, self.dt);
+        let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
+        let Particles {
+            position,
+            velocity,
+            radius,
+            mass,
+            species,
+            force,
+            angular,
+            ..
+        } = &mut self.particles;
+        let Some(a) = angular.as_mut() else {
+            return;
+        };
+        let omega = &a.omega;
+        force
+            .par_iter_mut()
+            .zip(a.torque.par_iter_mut())
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(i, (force, torque))| {
+                let mut f = mass[i] * gravity;
+                let particle = WallParticle {
+                    species: species[i] as usize,
+                    position: position[i],
+                    velocity: velocity[i],
+                    radius: radius[i],
+                    mass: mass[i],
+                };
+                let mut t = Vec3::ZERO;
+                if W::NEEDS_ROTATION {
+                    let (wf, wt) = walls.force_and_torque_on(wall_law, &particle, omega[i], dt);
+                    f += wf;
+                    t += wt;
+                } else {
+                    f += walls.force_on(wall_law, &particle, dt);
+                }
+                for k in list.out_start[i]..list.out_start[i + 1] {
+                    f += results[k as usize].force_on_i;
+                    t += results[k as usize].torque_on_i;
+                }
+                for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
+                    f -= results[k as usize].force_on_i;
+                    t += results[k as usize].torque_on_j;
+                }
+                *force = f;
+                *torque = t;
+            });
     }
 
     pub fn kinetic_energy(&self) -> Real {
@@ -333,6 +426,8 @@ fn pair_force<L: PairLaw>(
         radius_i,
         radius_j,
         r_eff: radius_i * radius_j / (radius_i + radius_j),
+        mass_i,
+        mass_j,
         m_eff: mass_i * mass_j / (mass_i + mass_j),
         relative_velocity,
         normal_speed,

@@ -28,6 +28,8 @@ pub struct Contact {
     pub radius_j: Real,
     /// Effective radius `r_i r_j / (r_i + r_j)`.
     pub r_eff: Real,
+    pub mass_i: Real,
+    pub mass_j: Real,
     /// Effective mass `m_i m_j / (m_i + m_j)`.
     pub m_eff: Real,
     /// Relative velocity `v_i - v_j` at the contact point (spins included when rotating).
@@ -91,9 +93,19 @@ pub trait TangentialModel: Send + Sync {
 }
 
 pub trait RollingModel: Send + Sync {
+    /// Per-pair state (e.g. a rolling spring); `()` when the model has none.
+    type History: PairHistory;
     const NEEDS_ROTATION: bool;
     /// Rolling-resistance torque on `i` (the torque on `j` is its negative).
-    fn torque(&self, contact: &Contact, normal_force: Real, omega_i: Vec3, omega_j: Vec3) -> Vec3;
+    fn torque(
+        &self,
+        contact: &Contact,
+        normal_force: Real,
+        omega_i: Vec3,
+        omega_j: Vec3,
+        history: &mut Self::History,
+        dt: Real,
+    ) -> Vec3;
 }
 
 pub trait CohesionModel: Send + Sync {
@@ -148,7 +160,8 @@ where
     R: RollingModel,
     C: CohesionModel,
 {
-    type History = T::History;
+    /// Tangential and rolling history side by side; `((), ())` (no storage) for the seed.
+    type History = (T::History, R::History);
     const NEEDS_ROTATION: bool = T::NEEDS_ROTATION || R::NEEDS_ROTATION;
 
     fn reach(&self) -> Real {
@@ -165,7 +178,7 @@ where
     fn evaluate(
         &self,
         contact: &Contact,
-        history: &mut T::History,
+        history: &mut Self::History,
         omega: (Vec3, Vec3),
         dt: Real,
     ) -> PairResult {
@@ -175,7 +188,7 @@ where
                 .cutoff(contact.species_pair, contact.radius_i, contact.radius_j);
         if !touching {
             // A separated pair loses its history; cohesion may still pull.
-            *history = T::History::default();
+            *history = Default::default();
             let pull = self.cohesion.force(contact);
             return PairResult {
                 force_on_i: -pull * contact.normal,
@@ -185,7 +198,9 @@ where
         // The normal part first: friction and rolling need |F_n|.
         let elastic = self.normal.response(contact);
         let normal_force = elastic.force + self.damping.force(contact, &elastic);
-        let tangential = self.tangential.force(contact, normal_force, history, dt);
+        let tangential = self
+            .tangential
+            .force(contact, normal_force, &mut history.0, dt);
         let pull = self.cohesion.force(contact);
         let force_on_i = (normal_force - pull) * contact.normal + tangential;
         if !Self::NEEDS_ROTATION {
@@ -198,9 +213,14 @@ where
         // centres), plus rolling resistance.
         let arm_i = -contact.normal * (contact.radius_i - 0.5 * contact.overlap);
         let arm_j = contact.normal * (contact.radius_j - 0.5 * contact.overlap);
-        let rolling = self
-            .rolling
-            .torque(contact, normal_force.abs(), omega.0, omega.1);
+        let rolling = self.rolling.torque(
+            contact,
+            normal_force.abs(),
+            omega.0,
+            omega.1,
+            &mut history.1,
+            dt,
+        );
         PairResult {
             force_on_i,
             torque_on_i: arm_i.cross(tangential) + rolling,
@@ -244,6 +264,91 @@ impl SeedModel {
             rolling: rolling::NoRolling,
             cohesion: cohesion::NoCohesion,
             normal_reach,
+        }
+    }
+}
+
+/// The Hertz family (LIGGGHTS `model hertz`, paper B). Each scene picks one of these
+/// concrete combinations (see `run`), so it pays only for its slots.
+pub type HertzHistory = ContactLaw<
+    normal::Hertz,
+    damping::HertzDamping,
+    tangential::Mindlin,
+    rolling::NoRolling,
+    cohesion::NoCohesion,
+>;
+/// `HertzHistory` plus constant-torque rolling resistance.
+pub type HertzHistoryRolling = ContactLaw<
+    normal::Hertz,
+    damping::HertzDamping,
+    tangential::Mindlin,
+    rolling::ConstantTorque,
+    cohesion::NoCohesion,
+>;
+/// `HertzHistoryRolling` plus van der Waals attraction.
+pub type HertzHistoryRollingVdw = ContactLaw<
+    normal::Hertz,
+    damping::HertzDamping,
+    tangential::Mindlin,
+    rolling::ConstantTorque,
+    cohesion::VanDerWaals,
+>;
+/// Paper B as written: Hertz, Yang dashpot and tangential law, rolling, van der Waals.
+pub type PaperB = ContactLaw<
+    normal::Hertz,
+    damping::YangDamping,
+    tangential::YangTangential,
+    rolling::ConstantTorque,
+    cohesion::VanDerWaals,
+>;
+/// Paper B without rolling resistance and cohesion.
+pub type YangHertz = ContactLaw<
+    normal::Hertz,
+    damping::YangDamping,
+    tangential::YangTangential,
+    rolling::NoRolling,
+    cohesion::NoCohesion,
+>;
+
+impl<N: NormalModel, D, T, R, C> ContactLaw<N, D, T, R, C> {
+    /// Assembles a law; the normal slot touches exactly at `r_i + r_j`.
+    pub fn new(normal: N, damping: D, tangential: T, rolling: R, cohesion: C) -> Self {
+        ContactLaw {
+            normal,
+            damping,
+            tangential,
+            rolling,
+            cohesion,
+            normal_reach: 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod physics_tests;
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// Two 1 g spheres of effective radius `r_eff` (radii `2 r_eff`) overlapping by `delta`
+    /// along x, at rest.
+    pub fn contact_at(delta: Real, r_eff: Real) -> Contact {
+        let r = 2.0 * r_eff;
+        Contact {
+            species_pair: 0,
+            normal: Vec3::X,
+            distance: 2.0 * r - delta,
+            overlap: delta,
+            radius_i: r,
+            radius_j: r,
+            r_eff,
+            mass_i: 2e-3,
+            mass_j: 2e-3,
+            m_eff: 1e-3,
+            relative_velocity: Vec3::ZERO,
+            normal_speed: 0.0,
+            tangential_velocity: Vec3::ZERO,
         }
     }
 }

@@ -29,6 +29,27 @@ impl PairHistory for () {
     fn mirrored(self) -> Self {}
 }
 
+/// A displacement of `i` relative to `j` (e.g. a tangential spring): `j` sees it negated.
+impl PairHistory for Vec3 {
+    fn mirrored(self) -> Self {
+        -self
+    }
+}
+
+/// Two histories side by side (e.g. tangential and rolling).
+impl<A: PairHistory, B: PairHistory> PairHistory for (A, B) {
+    fn mirrored(self) -> Self {
+        (self.0.mirrored(), self.1.mirrored())
+    }
+}
+
+/// A magnitude (e.g. accumulated slip length): the same from either side.
+impl PairHistory for Real {
+    fn mirrored(self) -> Self {
+        self
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct VerletList {
     pub pairs: Vec<Pair>,
@@ -120,43 +141,61 @@ impl VerletList {
     }
 
     /// Carries per-pair history from the previous list to this one. `old_pairs` and
-    /// `old_history` are the list before the rebuild; `remap` maps old particle indices to
-    /// new ones (`u32::MAX` for a removed particle) when particles were reordered or removed.
+    /// `old_history` are the list before the rebuild; `wraps[k]` is how many box lengths the
+    /// build's wrap moved old particle `k` on each periodic axis (a pair's image changes when
+    /// one of its particles crosses a periodic face); `remap` maps old particle indices to new
+    /// ones (`u32::MAX` for a removed particle) when particles were reordered or removed.
     /// Pairs that are new start from the default history.
     pub fn carry_history<H: PairHistory>(
         &self,
         old_pairs: &[Pair],
         old_history: &[H],
+        wraps: Option<&[[i32; 3]]>,
         remap: Option<&[u32]>,
     ) -> Vec<H> {
         if std::mem::size_of::<H>() == 0 {
             return vec![H::default(); self.pairs.len()];
         }
-        let mut old: Vec<(Pair, H)> = match remap {
-            None => old_pairs
+        let wraps = wraps.filter(|w| w.iter().any(|&k| k != [0; 3]));
+        let mut old: Vec<(Pair, H)> = if remap.is_none() && wraps.is_none() {
+            old_pairs
                 .iter()
                 .copied()
                 .zip(old_history.iter().copied())
-                .collect(),
-            Some(new_index) => {
-                let mut remapped: Vec<(Pair, H)> = old_pairs
-                    .iter()
-                    .zip(old_history)
-                    .filter_map(|(pair, &h)| {
-                        let (i, j) = (new_index[pair.i as usize], new_index[pair.j as usize]);
-                        if i == u32::MAX || j == u32::MAX {
-                            None
-                        } else if i < j {
-                            Some((Pair { i, j, ..*pair }, h))
-                        } else {
-                            let image = 26 - pair.image; // the opposite image
-                            Some((Pair { i: j, j: i, image }, h.mirrored()))
+                .collect()
+        } else {
+            let mut remapped: Vec<(Pair, H)> = old_pairs
+                .iter()
+                .zip(old_history)
+                .filter_map(|(pair, &h)| {
+                    let mut image = pair.image;
+                    if let Some(w) = wraps {
+                        // d = x_i - (x_j + o L); after wrapping x -> x - W L:
+                        // o' = o + W_j - W_i.
+                        let o = Domain::image_offset(image);
+                        let (wi, wj) = (w[pair.i as usize], w[pair.j as usize]);
+                        let moved: [i32; 3] = std::array::from_fn(|a| o[a] + wj[a] - wi[a]);
+                        if moved.iter().any(|x| x.abs() > 1) {
+                            return None;
                         }
-                    })
-                    .collect();
-                remapped.sort_unstable_by_key(|(pair, _)| *pair);
-                remapped
-            }
+                        image = Domain::image_index(moved);
+                    }
+                    let (i, j) = match remap {
+                        Some(new_index) => (new_index[pair.i as usize], new_index[pair.j as usize]),
+                        None => (pair.i, pair.j),
+                    };
+                    if i == u32::MAX || j == u32::MAX {
+                        None
+                    } else if i < j {
+                        Some((Pair { i, j, image }, h))
+                    } else {
+                        let image = 26 - image; // the opposite image
+                        Some((Pair { i: j, j: i, image }, h.mirrored()))
+                    }
+                })
+                .collect();
+            remapped.sort_unstable_by_key(|(pair, _)| *pair);
+            remapped
         };
         old.dedup_by_key(|(pair, _)| *pair);
         let mut history = Vec::with_capacity(self.pairs.len());
@@ -424,7 +463,7 @@ mod tests {
         for (new, &old) in order.iter().enumerate() {
             remap[old as usize] = new as u32;
         }
-        let carried = list.carry_history(&old_pairs, &history, Some(&remap));
+        let carried = list.carry_history(&old_pairs, &history, None, Some(&remap));
         for (pair, h) in list.pairs.iter().zip(&carried) {
             let (a, b) = (particles.id[pair.i as usize], particles.id[pair.j as usize]);
             if h.0 == tag(a, b) {

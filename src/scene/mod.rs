@@ -9,6 +9,7 @@ pub use error::SceneError;
 use std::path::{Path, PathBuf};
 
 use crate::domain::Domain;
+use crate::integrate::Integrator;
 use crate::math::{Real, Vec3};
 use crate::timestep::TimeStepRequest;
 
@@ -40,12 +41,69 @@ pub enum ContactSettings {
         gamma_n: Real,
         gamma_t: Real,
     },
+    /// Hertz contact with LIGGGHTS/LAMMPS-style sub-models (paper B).
+    Hertz(HertzSettings),
 }
 
+/// `damping = "hertz" | "yang"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HertzDampingKind {
+    /// LIGGGHTS `model hertz`: restitution-based, `2 sqrt(5/6) |beta(e)| sqrt(S_n m_eff)`.
+    Restitution,
+    /// Paper B Eq. (4): `gamma_n E sqrt(R xi_n)`, `gamma_n` in s (`gamma_n_yang`).
+    Yang { gamma_n: Real },
+}
+
+/// `tangential = "history" | "yang"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TangentialKind {
+    History,
+    Yang,
+}
+
+/// `rolling = "none" | "constant_torque" | "epsd2"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RollingKind {
+    None,
+    ConstantTorque,
+    Epsd2,
+}
+
+/// `cohesion = "none" | "vdw"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CohesionKind {
+    None,
+    /// Paper B Eq. (7)-(8); `cutoff` is the gap beyond touching where it stops (default:
+    /// where the force falls to 1e-3 of its value at `h_min`).
+    VanDerWaals {
+        hamaker_constant: Real,
+        h_min: Real,
+        cutoff: Option<Real>,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct HertzSettings {
+    pub youngs_modulus: Real,
+    pub poisson_ratio: Real,
+    pub restitution: Real,
+    pub friction: Real,
+    pub rolling_friction: Real,
+    pub damping: HertzDampingKind,
+    pub tangential: TangentialKind,
+    pub rolling: RollingKind,
+    pub cohesion: CohesionKind,
+    /// Impact speed (m/s) at which Hertz contacts are linearized for the time step.
+    pub characteristic_velocity: Real,
+}
 #[derive(Clone, Debug, PartialEq)]
 pub struct WallContactSettings {
     pub restitution: Real,
     pub friction: Real,
+    /// Hertz walls: the wall's material (None = the particles') and rolling friction.
+    pub youngs_modulus: Option<Real>,
+    pub poisson_ratio: Option<Real>,
+    pub rolling_friction: Real,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -129,6 +187,7 @@ pub struct Scene {
     pub walls: Vec<WallSettings>,
     pub gravity: Vec3,
     pub time_step: TimeStepRequest,
+    pub integrator: Integrator,
     /// Neighbour skin as a fraction of the largest diameter (scales with coarse-graining).
     pub skin_fraction: Real,
     pub resort_every: u32,

@@ -55,6 +55,21 @@ pub struct RawContact {
     pub sigma: Option<f64>,
     pub gamma_n: Option<f64>,
     pub gamma_t: Option<f64>,
+    // model = "hertz" (LIGGGHTS/LAMMPS words)
+    pub youngs_modulus: Option<f64>,
+    pub poisson_ratio: Option<f64>,
+    pub restitution: Option<f64>,
+    pub friction: Option<f64>,
+    pub rolling_friction: Option<f64>,
+    pub damping: Option<String>,
+    pub gamma_n_yang: Option<f64>,
+    pub tangential: Option<String>,
+    pub rolling: Option<String>,
+    pub cohesion: Option<String>,
+    pub hamaker_constant: Option<f64>,
+    pub h_min: Option<f64>,
+    pub cohesion_cutoff: Option<f64>,
+    pub characteristic_velocity: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -62,6 +77,10 @@ pub struct RawContact {
 pub struct RawWallContact {
     pub restitution: f64,
     pub friction: f64,
+    /// Hertz walls only; default: the particles' material.
+    pub youngs_modulus: Option<f64>,
+    pub poisson_ratio: Option<f64>,
+    pub rolling_friction: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -77,6 +96,7 @@ pub struct RawWall {
 pub struct RawTime {
     pub dt_fraction: Option<f64>,
     pub dt: Option<f64>,
+    pub integrator: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

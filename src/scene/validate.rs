@@ -4,6 +4,7 @@ use std::path::Path;
 
 use super::raw::*;
 use super::*;
+use crate::integrate::Integrator;
 use crate::math::TWO_POW_ONE_SIXTH;
 
 struct Checker<'a> {
@@ -107,7 +108,32 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     }
 
     let contact = match raw.contact.model.as_str() {
+        "hertz" => ContactSettings::Hertz(hertz_contact(&c, &raw.contact)?),
         "wca" => {
+            let rc = &raw.contact;
+            for (field, set) in [
+                ("youngs_modulus", rc.youngs_modulus.is_some()),
+                ("poisson_ratio", rc.poisson_ratio.is_some()),
+                ("restitution", rc.restitution.is_some()),
+                ("friction", rc.friction.is_some()),
+                ("rolling_friction", rc.rolling_friction.is_some()),
+                ("damping", rc.damping.is_some()),
+                ("gamma_n_yang", rc.gamma_n_yang.is_some()),
+                ("tangential", rc.tangential.is_some()),
+                ("rolling", rc.rolling.is_some()),
+                ("cohesion", rc.cohesion.is_some()),
+                ("hamaker_constant", rc.hamaker_constant.is_some()),
+                ("h_min", rc.h_min.is_some()),
+                ("cohesion_cutoff", rc.cohesion_cutoff.is_some()),
+                (
+                    "characteristic_velocity",
+                    rc.characteristic_velocity.is_some(),
+                ),
+            ] {
+                if set {
+                    return Err(c.invalid(format!("contact.{field}"), "set", "only with model = \"hertz\"; the wca model takes epsilon, sigma, gamma_n, gamma_t"));
+                }
+            }
             let epsilon = c.positive(
                 "contact.epsilon",
                 c.required("contact.epsilon", raw.contact.epsilon, "the WCA energy, J")?,
@@ -151,7 +177,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
             return Err(c.invalid(
                 "contact.model",
                 format!("\"{other}\""),
-                "\"wca\" (the seed's model)",
+                "\"wca\" (the seed's model) or \"hertz\"",
             ))
         }
     };
@@ -161,14 +187,31 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
             if !(w.restitution > 0.0 && w.restitution <= 1.0) {
                 return Err(c.invalid("wall_contact.restitution", w.restitution, "0 < e <= 1"));
             }
+            let youngs_modulus = match w.youngs_modulus {
+                Some(y) => Some(c.positive("wall_contact.youngs_modulus", y)?),
+                None => None,
+            };
+            let poisson_ratio = match w.poisson_ratio {
+                Some(nu) => Some(poisson(&c, "wall_contact.poisson_ratio", nu)?),
+                None => None,
+            };
             WallContactSettings {
                 restitution: w.restitution,
                 friction: c.non_negative("wall_contact.friction", w.friction)?,
+                youngs_modulus,
+                poisson_ratio,
+                rolling_friction: c.non_negative(
+                    "wall_contact.rolling_friction",
+                    w.rolling_friction.unwrap_or(0.0),
+                )?,
             }
         }
         None if raw.walls.is_empty() => WallContactSettings {
             restitution: 1.0,
             friction: 0.0,
+            youngs_modulus: None,
+            poisson_ratio: None,
+            rolling_friction: 0.0,
         },
         None => {
             return Err(c.invalid(
@@ -223,6 +266,12 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 "exactly one of dt_fraction (of the contact period) or dt (seconds)",
             ))
         }
+    };
+
+    let integrator = match raw.time.integrator.as_deref() {
+        None | Some("verlet") => Integrator::VelocityVerlet,
+        Some("pcvv") => Integrator::Pcvv,
+        Some(other) => return Err(c.invalid("time.integrator", format!("\"{other}\""), "\"verlet\" (velocity Verlet, default) or \"pcvv\" (predictor-corrector velocity Verlet, paper B Eq. 11-15)")),
     };
 
     let neighbor = raw.neighbor.as_ref();
@@ -422,6 +471,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         walls,
         gravity,
         time_step,
+        integrator,
         skin_fraction,
         resort_every,
         insertions,
@@ -436,8 +486,334 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     })
 }
 
+fn poisson(c: &Checker, field: &str, nu: f64) -> Result<f64, SceneError> {
+    if nu.is_finite() && (-1.0..0.5).contains(&nu) {
+        Ok(nu)
+    } else {
+        Err(c.invalid(field, nu, "-1 <= poisson_ratio < 0.5"))
+    }
+}
+
+/// `[contact] model = "hertz"`: keywords as in LIGGGHTS/LAMMPS.
+fn hertz_contact(c: &Checker, rc: &RawContact) -> Result<HertzSettings, SceneError> {
+    for (field, set) in [
+        ("epsilon", rc.epsilon.is_some()),
+        ("sigma", rc.sigma.is_some()),
+        ("gamma_n", rc.gamma_n.is_some()),
+        ("gamma_t", rc.gamma_t.is_some()),
+    ] {
+        if set {
+            return Err(c.invalid(
+                format!("contact.{field}"),
+                "set",
+                "only with model = \"wca\"; for Yang damping use gamma_n_yang",
+            ));
+        }
+    }
+    let youngs_modulus = c.positive(
+        "contact.youngs_modulus",
+        c.required(
+            "contact.youngs_modulus",
+            rc.youngs_modulus,
+            "Young's modulus of the particles, Pa",
+        )?,
+    )?;
+    let poisson_ratio = poisson(
+        c,
+        "contact.poisson_ratio",
+        c.required(
+            "contact.poisson_ratio",
+            rc.poisson_ratio,
+            "Poisson's ratio of the particles",
+        )?,
+    )?;
+    let friction = c.non_negative(
+        "contact.friction",
+        c.required(
+            "contact.friction",
+            rc.friction,
+            "the Coulomb friction coefficient",
+        )?,
+    )?;
+    let rolling_friction = c.non_negative(
+        "contact.rolling_friction",
+        rc.rolling_friction.unwrap_or(0.0),
+    )?;
+    let damping = match rc.damping.as_deref().unwrap_or("hertz") {
+        "hertz" => {
+            if rc.gamma_n_yang.is_some() {
+                return Err(c.invalid(
+                    "contact.gamma_n_yang",
+                    "set",
+                    "only with damping = \"yang\"",
+                ));
+            }
+            HertzDampingKind::Restitution
+        }
+        "yang" => HertzDampingKind::Yang {
+            gamma_n: c.non_negative(
+                "contact.gamma_n_yang",
+                c.required(
+                    "contact.gamma_n_yang",
+                    rc.gamma_n_yang,
+                    "the Yang damping time gamma_n, s",
+                )?,
+            )?,
+        },
+        other => {
+            return Err(c.invalid(
+                "contact.damping",
+                format!("\"{other}\""),
+                "\"hertz\" (LIGGGHTS restitution-based, default) or \"yang\" (paper B Eq. 4)",
+            ))
+        }
+    };
+    let restitution = match (damping, rc.restitution) {
+        (HertzDampingKind::Restitution, None) => {
+            return Err(c.invalid(
+                "contact.restitution",
+                "missing",
+                "the coefficient of restitution, 0 < e <= 1",
+            ))
+        }
+        (_, Some(e)) if !(e > 0.0 && e <= 1.0) => {
+            return Err(c.invalid("contact.restitution", e, "0 < e <= 1"))
+        }
+        (HertzDampingKind::Yang { .. }, Some(_)) => {
+            return Err(c.invalid(
+                "contact.restitution",
+                "set",
+                "not with damping = \"yang\" (its damping is gamma_n_yang)",
+            ))
+        }
+        (_, e) => e.unwrap_or(1.0),
+    };
+    let tangential =
+        match rc.tangential.as_deref().unwrap_or("history") {
+            "history" => TangentialKind::History,
+            "yang" => TangentialKind::Yang,
+            other => return Err(c.invalid(
+                "contact.tangential",
+                format!("\"{other}\""),
+                "\"history\" (LIGGGHTS tangential history, default) or \"yang\" (paper B Eq. 5)",
+            )),
+        };
+    let rolling = match rc.rolling.as_deref().unwrap_or("none") {
+        "none" => RollingKind::None,
+        "constant_torque" => RollingKind::ConstantTorque,
+        "epsd2" => RollingKind::Epsd2,
+        other => return Err(c.invalid(
+            "contact.rolling",
+            format!("\"{other}\""),
+            "\"none\", \"constant_torque\" (paper B Eq. 10) or \"epsd2\" (LIGGGHTS rolling spring)",
+        )),
+    };
+    if rolling != RollingKind::None && rolling_friction == 0.0 {
+        return Err(c.invalid(
+            "contact.rolling_friction",
+            rolling_friction,
+            "> 0 when rolling is not \"none\"",
+        ));
+    }
+    let cohesion = match rc.cohesion.as_deref().unwrap_or("none") {
+        "none" => {
+            for (field, set) in [
+                ("hamaker_constant", rc.hamaker_constant.is_some()),
+                ("h_min", rc.h_min.is_some()),
+                ("cohesion_cutoff", rc.cohesion_cutoff.is_some()),
+            ] {
+                if set {
+                    return Err(c.invalid(
+                        format!("contact.{field}"),
+                        "set",
+                        "only with cohesion = \"vdw\"",
+                    ));
+                }
+            }
+            CohesionKind::None
+        }
+        "vdw" => {
+            let h_min = c.positive(
+                "contact.h_min",
+                c.required(
+                    "contact.h_min",
+                    rc.h_min,
+                    "the van der Waals cut-off gap, m (e.g. 4e-10)",
+                )?,
+            )?;
+            let cutoff = match rc.cohesion_cutoff {
+                Some(x) if x.is_finite() && x > h_min => Some(x),
+                Some(x) => {
+                    return Err(c.invalid(
+                        "contact.cohesion_cutoff",
+                        x,
+                        format!("a gap > h_min = {h_min} m"),
+                    ))
+                }
+                None => None,
+            };
+            CohesionKind::VanDerWaals {
+                hamaker_constant: c.positive(
+                    "contact.hamaker_constant",
+                    c.required(
+                        "contact.hamaker_constant",
+                        rc.hamaker_constant,
+                        "the Hamaker constant, J",
+                    )?,
+                )?,
+                h_min,
+                cutoff,
+            }
+        }
+        other => {
+            return Err(c.invalid(
+                "contact.cohesion",
+                format!("\"{other}\""),
+                "\"none\" or \"vdw\" (van der Waals, paper B Eq. 7-8)",
+            ))
+        }
+    };
+    Ok(HertzSettings {
+        youngs_modulus,
+        poisson_ratio,
+        restitution,
+        friction,
+        rolling_friction,
+        damping,
+        tangential,
+        rolling,
+        cohesion,
+        characteristic_velocity: c.positive(
+            "contact.characteristic_velocity",
+            rc.characteristic_velocity.unwrap_or(1.0),
+        )?,
+    })
+}
+
 fn names<'a>(list: impl Iterator<Item = &'a String>) -> String {
     list.map(|n| format!("`{n}`"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::*;
+    use std::path::Path;
+
+    /// Paper B's combination in a minimal scene; `contact` replaces the [contact] table body.
+    fn scene_with(contact: &str, time: &str) -> Result<Scene, SceneError> {
+        let text = format!(
+            r#"
+name = "t"
+[domain]
+lo = [0.0, 0.0, 0.0]
+hi = [0.01, 0.01, 0.01]
+[[species]]
+name = "fine"
+diameter = 5e-5
+density = 2500.0
+[contact]
+{contact}
+[time]
+{time}
+[[stage]]
+name = "s"
+duration = 0.1
+"#
+        );
+        Scene::parse(&text, Path::new("case.toml"))
+    }
+
+    const PAPER_B: &str = r#"model = "hertz"
+youngs_modulus = 1e7
+poisson_ratio = 0.29
+friction = 0.3
+rolling_friction = 0.002
+damping = "yang"
+gamma_n_yang = 1e-5
+tangential = "yang"
+rolling = "constant_torque"
+cohesion = "vdw"
+hamaker_constant = 6.5e-20
+h_min = 4e-10"#;
+
+    #[test]
+    fn a_paper_b_hertz_scene_is_read_with_liggghts_keywords_and_pcvv() {
+        let scene = scene_with(PAPER_B, "dt = 1e-8\nintegrator = \"pcvv\"").unwrap();
+        assert_eq!(scene.integrator, Integrator::Pcvv);
+        let ContactSettings::Hertz(h) = scene.contact else {
+            panic!("not hertz")
+        };
+        assert_eq!(h.damping, HertzDampingKind::Yang { gamma_n: 1e-5 });
+        assert_eq!(h.tangential, TangentialKind::Yang);
+        assert_eq!(h.rolling, RollingKind::ConstantTorque);
+        assert_eq!(
+            h.cohesion,
+            CohesionKind::VanDerWaals {
+                hamaker_constant: 6.5e-20,
+                h_min: 4e-10,
+                cutoff: None
+            }
+        );
+    }
+
+    #[test]
+    fn bad_hertz_values_name_the_file_field_value_and_what_is_allowed() {
+        let cases = [
+            (
+                PAPER_B.replace("poisson_ratio = 0.29", "poisson_ratio = 0.7"),
+                "contact.poisson_ratio",
+                "-1 <= poisson_ratio < 0.5",
+            ),
+            (
+                PAPER_B.replace("damping = \"yang\"", "damping = \"tsuji\""),
+                "contact.damping",
+                "\"yang\"",
+            ),
+            (
+                PAPER_B.replace("rolling = \"constant_torque\"", "rolling = \"cdt\""),
+                "contact.rolling",
+                "epsd2",
+            ),
+            (
+                PAPER_B.replace("h_min = 4e-10", ""),
+                "contact.h_min",
+                "van der Waals",
+            ),
+            (
+                PAPER_B.replace("gamma_n_yang = 1e-5", "gamma_n = 1e-5"),
+                "contact.gamma_n",
+                "gamma_n_yang",
+            ),
+            (
+                PAPER_B.replace("damping = \"yang\"", "damping = \"hertz\""),
+                "contact.gamma_n_yang",
+                "only with damping",
+            ),
+        ];
+        for (contact, field, allowed) in cases {
+            let message = scene_with(&contact, "dt = 1e-8").unwrap_err().to_string();
+            assert!(
+                message.starts_with("case.toml: field `")
+                    && message.contains(field)
+                    && message.contains(allowed),
+                "{message}"
+            );
+        }
+        let message = scene_with(PAPER_B, "dt = 1e-8\nintegrator = \"rk4\"")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("time.integrator")
+                && message.contains("\"rk4\"")
+                && message.contains("pcvv"),
+            "{message}"
+        );
+        let message = scene_with("model = \"wca\"\nepsilon = 1.0\nsigma = 4.4545e-5\ngamma_n = 0.0\ngamma_t = 0.0\nfriction = 0.3", "dt = 1e-8").unwrap_err().to_string();
+        assert!(
+            message.contains("contact.friction") && message.contains("hertz"),
+            "{message}"
+        );
+    }
 }

@@ -1,7 +1,9 @@
 //! Walls: finite planes that can be removed during a run, and the particle-wall laws.
 
+mod hertz_wall;
 mod wca_wall;
 
+pub use hertz_wall::{HertzWall, HertzWallSpecies};
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
 use crate::geometry::FinitePlane;
@@ -23,10 +25,17 @@ pub struct WallContact {
 
 /// A particle-wall contact law.
 pub trait WallLaw: Send + Sync {
+    /// Whether the law uses the particle spin and exerts torques (then the world calls
+    /// `force_and_torque` instead of `force`).
+    const NEEDS_ROTATION: bool = false;
     /// Largest centre-to-plane distance at which the wall acts on `species`.
     fn reach(&self, species: usize, radius: Real) -> Real;
     /// Force on the particle; only called when `distance < reach`.
     fn force(&self, contact: &WallContact, dt: Real) -> Vec3;
+    /// Force and torque on a spinning particle; `contact.relative_velocity` is the centre's.
+    fn force_and_torque(&self, contact: &WallContact, _omega: Vec3, dt: Real) -> (Vec3, Vec3) {
+        (self.force(contact, dt), Vec3::ZERO)
+    }
     /// (stiffness, damping coefficient) of the linearized contact, for the time step.
     fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real);
 }
@@ -66,36 +75,52 @@ impl WallSet {
         }
     }
 
+    /// The contacts of the active walls with one particle.
+    #[inline(always)]
+    fn contacts<'a, W: WallLaw>(
+        &'a self,
+        law: &W,
+        particle: &'a WallParticle,
+    ) -> impl Iterator<Item = WallContact> + 'a {
+        let reach = law.reach(particle.species, particle.radius);
+        self.walls
+            .iter()
+            .filter(|w| w.active)
+            .filter_map(move |wall| {
+                let distance = wall.plane.distance(particle.position)?;
+                // Only the front side repels: a particle behind a wall has left through it.
+                (distance > 0.0 && distance < reach).then_some(WallContact {
+                    species: particle.species,
+                    normal: wall.plane.normal,
+                    distance,
+                    relative_velocity: particle.velocity,
+                    radius: particle.radius,
+                    mass: particle.mass,
+                })
+            })
+    }
+
     /// Total force of the active walls on one particle.
     #[inline(always)]
     pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> Vec3 {
-        let WallParticle {
-            species,
-            position,
-            velocity,
-            radius,
-            mass,
-        } = *particle;
-        let reach = law.reach(species, radius);
-        let mut total = Vec3::ZERO;
-        for wall in self.walls.iter().filter(|w| w.active) {
-            let Some(distance) = wall.plane.distance(position) else {
-                continue;
-            };
-            // Only the front side repels: a particle behind a wall has left through it.
-            if distance <= 0.0 || distance >= reach {
-                continue;
-            }
-            let contact = WallContact {
-                species,
-                normal: wall.plane.normal,
-                distance,
-                relative_velocity: velocity,
-                radius,
-                mass,
-            };
-            total += law.force(&contact, dt);
-        }
-        total
+        self.contacts(law, particle)
+            .map(|c| law.force(&c, dt))
+            .sum()
+    }
+
+    /// Total force and torque of the active walls on one spinning particle.
+    #[inline(always)]
+    pub fn force_and_torque_on<W: WallLaw>(
+        &self,
+        law: &W,
+        particle: &WallParticle,
+        omega: Vec3,
+        dt: Real,
+    ) -> (Vec3, Vec3) {
+        self.contacts(law, particle)
+            .fold((Vec3::ZERO, Vec3::ZERO), |(force, torque), c| {
+                let (f, t) = law.force_and_torque(&c, omega, dt);
+                (force + f, torque + t)
+            })
     }
 }

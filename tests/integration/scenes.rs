@@ -7,13 +7,13 @@ use cgdem::coarse_graining::coarse_grain;
 use cgdem::scene::{InsertAmount, Scene};
 
 #[test]
-fn shipped_cases_validate_and_coarse_grain_to_lambda_8() {
+fn shipped_cases_validate_and_coarse_grain_to_lambda_2() {
     for entry in std::fs::read_dir("validation/cases").unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-            let coarse = coarse_grain(&scene, 8).unwrap_or_else(|e| panic!("{e}"));
-            assert_eq!(coarse.lambda, 8);
+            let coarse = coarse_grain(&scene, 2).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(coarse.lambda, 2);
         }
     }
 }

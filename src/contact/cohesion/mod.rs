@@ -1,5 +1,9 @@
 //! Cohesion slot.
 
+mod van_der_waals;
+
+pub use van_der_waals::{vdw_force, vdw_reach, VanDerWaals};
+
 use super::{CohesionModel, Contact};
 use crate::math::Real;
 

@@ -1,5 +1,9 @@
 //! Tangential slot.
 
+mod mindlin;
 mod viscous;
+mod yang;
 
+pub use mindlin::Mindlin;
 pub use viscous::ViscousTangential;
+pub use yang::YangTangential;

@@ -1,6 +1,10 @@
 //! Running a scene: build the world with the scene's laws, run its stages, measure and
 //! write the outputs (summary.json, timeseries.csv, profile.csv, repose.csv, VTK series).
 
+mod hertz;
+
+pub use hertz::{hertz_law, hertz_wall, run_hertz, FromScene, SUPPORTED};
+
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -40,6 +44,12 @@ pub enum RunError {
         file: String,
         index: usize,
         source: InsertionFailed,
+    },
+    #[error("{file}: contact: the combination damping/tangential/rolling/cohesion = {combination} is not compiled; supported: {supported}")]
+    Unsupported {
+        file: String,
+        combination: String,
+        supported: String,
     },
     #[error("cannot write {path}: {message}")]
     Output { path: PathBuf, message: String },
@@ -110,6 +120,7 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> 
             let (law, wall_law) = seed_laws(scene);
             execute(scene, law, wall_law, options)
         }
+        ContactSettings::Hertz(h) => run_hertz(scene, h, options),
     }
 }
 
@@ -120,7 +131,10 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
         sigma,
         gamma_n,
         gamma_t,
-    } = scene.contact;
+    } = scene.contact
+    else {
+        panic!("seed_laws needs a scene with model = \"wca\"");
+    };
     let n = scene.species.len();
     let wca = WcaCoefficients { epsilon, sigma };
     let law = SeedModel::seed(vec![wca; n * n], vec![gamma_n; n * n], vec![gamma_t; n * n]);
@@ -250,7 +264,8 @@ fn execute<L: PairLaw, W: WallLaw>(
         scene.gravity,
         dt,
         neighbor,
-    );
+    )
+    .with_integrator(scene.integrator);
 
     let timeseries_path = out.join("timeseries.csv");
     let mut timeseries = std::io::BufWriter::new(

@@ -1,0 +1,609 @@
+//! Physics of the Hertz family in whole worlds: contact time, restitution, rolling on planes,
+//! van der Waals binding, contact history across rebuilds, integrator energy drift.
+//! Two particles or one, so each test runs well under 2 s in release.
+
+use std::f64::consts::PI;
+
+use super::cohesion::{vdw_force, NoCohesion, VanDerWaals};
+use super::damping::{liggghts_damping_factor, HertzDamping};
+use super::normal::{Hertz, Material};
+use super::rolling::NoRolling;
+use super::tangential::Mindlin;
+use super::{CohesionModel, ContactLaw, HertzHistory, PairLaw};
+use crate::domain::Domain;
+use crate::geometry::FinitePlane;
+use crate::integrate::Integrator;
+use crate::math::{Real, Vec3};
+use crate::particles::Particles;
+use crate::simulation::{NeighborSettings, World};
+use crate::walls::{HertzWall, Wall, WallContact, WallLaw, WallSet};
+
+const RADIUS: Real = 1e-3;
+const DENSITY: Real = 2500.0;
+const MATERIAL: Material = Material {
+    youngs_modulus: 5e6,
+    poisson_ratio: 0.3,
+};
+
+fn mass(radius: Real) -> Real {
+    DENSITY * 4.0 / 3.0 * PI * radius.powi(3)
+}
+
+fn hertz_law<C: CohesionModel>(
+    restitution: Real,
+    friction: Real,
+    cohesion: C,
+) -> ContactLaw<Hertz, HertzDamping, Mindlin, NoRolling, C> {
+    ContactLaw::new(
+        Hertz {
+            y_eff: vec![Material::y_eff(MATERIAL, MATERIAL)],
+            characteristic_velocity: 1.0,
+        },
+        HertzDamping::from_restitution(&[restitution]),
+        Mindlin {
+            g_eff: vec![Material::g_eff(MATERIAL, MATERIAL)],
+            damping_factor: vec![liggghts_damping_factor(restitution)],
+            friction: vec![friction],
+        },
+        NoRolling,
+        cohesion,
+    )
+}
+
+fn floor_wall(restitution: Real, friction: Real) -> HertzWall {
+    HertzWall::new(
+        &[Material::y_eff(MATERIAL, MATERIAL)],
+        restitution,
+        friction,
+        0.0,
+        1.0,
+    )
+}
+
+fn open_box(half: Real, periodic: bool) -> Domain {
+    Domain {
+        lo: Vec3::splat(-half),
+        hi: Vec3::splat(half),
+        periodic: [periodic; 3],
+    }
+}
+
+fn floor(domain: &Domain) -> WallSet {
+    WallSet {
+        walls: vec![Wall {
+            name: "floor".into(),
+            plane: FinitePlane::new(Vec3::new(0.0, 0.0, domain.lo.z), Vec3::Z, 1.0, 1.0),
+            active: true,
+        }],
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn world<L: PairLaw, W: WallLaw>(
+    law: L,
+    wall_law: W,
+    walls: WallSet,
+    domain: Domain,
+    bodies: &[(Vec3, Vec3, Real)],
+    gravity: Vec3,
+    dt: Real,
+    resort_every: u32,
+) -> World<L, W> {
+    let mut particles = Particles::new(false);
+    for (k, &(x, v, r)) in bodies.iter().enumerate() {
+        particles.push(0, x, r, mass(r));
+        particles.velocity[k] = v;
+    }
+    let neighbor = NeighborSettings {
+        skin: 0.3 * RADIUS,
+        resort_every,
+    };
+    World::new(
+        particles, domain, walls, law, wall_law, 1, gravity, dt, neighbor,
+    )
+}
+
+/// Head-on impact at relative speed `v` of two spheres of radius `r`: (contact time, e).
+fn head_on<L: PairLaw>(law: L, r: Real, v: Real, dt: Real) -> (Real, Real) {
+    let (t, e, _) = head_on_with_overlap(law, r, v, dt);
+    (t, e)
+}
+
+/// As `head_on`, also the largest overlap.
+fn head_on_with_overlap<L: PairLaw>(law: L, r: Real, v: Real, dt: Real) -> (Real, Real, Real) {
+    let gap = 2.0 * v * dt;
+    let bodies = [
+        (
+            Vec3::new(-r - gap, 0.0, 0.0),
+            Vec3::new(0.5 * v, 0.0, 0.0),
+            r,
+        ),
+        (
+            Vec3::new(r + gap, 0.0, 0.0),
+            Vec3::new(-0.5 * v, 0.0, 0.0),
+            r,
+        ),
+    ];
+    let mut w = world(
+        law,
+        floor_wall(1.0, 0.0),
+        WallSet::default(),
+        open_box(10.0 * r, false),
+        &bodies,
+        Vec3::ZERO,
+        dt,
+        0,
+    );
+    let (mut started, mut steps, mut largest) = (false, 0u64, 0.0 as Real);
+    for _ in 0..10_000_000 {
+        w.step();
+        let distance = (w.particles.position[1] - w.particles.position[0]).length();
+        largest = largest.max(2.0 * r - distance);
+        let touching = distance < 2.0 * r;
+        if touching {
+            started = true;
+            steps += 1;
+        } else if started {
+            break;
+        }
+    }
+    let rebound = (w.particles.velocity[1] - w.particles.velocity[0]).x / v;
+    (steps as Real * dt, rebound, largest)
+}
+
+#[test]
+fn head_on_impact_matches_the_liggghts_model_hertz_run_of_reference_mapping() {
+    // reference/MAPPING.md: d = 2 mm, rho = 2500, E = 5e6 Pa, nu = 0.3, e = 0.5, approach
+    // 1 m/s, dt = 1e-7 s; LIGGGHTS 3.8.0 gave e = 0.499981886129, contact 2.9410e-4 s,
+    // largest overlap 7.198264e-5 m (LAMMPS tsuji with the mapped coefficient agrees).
+    let (t, e, overlap) = head_on_with_overlap(hertz_law(0.5, 0.5, NoCohesion), RADIUS, 1.0, 1e-7);
+    eprintln!("cgdem: e = {e:.12}, contact {t:.5e} s, largest overlap {overlap:.7e} m");
+    assert!((e - 0.499981886129).abs() < 1e-11);
+    assert!((t - 2.9410e-4).abs() <= 1.5e-7);
+    assert!((overlap / 7.198264e-5 - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn hertz_contact_time_matches_2_87_closed_form_and_scales_as_v_to_minus_one_fifth() {
+    let (m_eff, r_eff, y_eff) = (
+        0.5 * mass(RADIUS),
+        0.5 * RADIUS,
+        Material::y_eff(MATERIAL, MATERIAL),
+    );
+    let mut times = Vec::new();
+    for v in [0.25, 4.0] {
+        let (t, e) = head_on(hertz_law(1.0, 0.0, NoCohesion), RADIUS, v, 1e-7);
+        let closed = Hertz::contact_time(y_eff, r_eff, m_eff, v);
+        eprintln!("v = {v} m/s: contact time {t:.5e} s, closed form {closed:.5e} s, e = {e:.6}");
+        assert!((t / closed - 1.0).abs() < 3e-3, "v = {v}: {t} vs {closed}");
+        assert!((e - 1.0).abs() < 1e-3);
+        times.push(t);
+    }
+    let ratio = times[0] / times[1];
+    eprintln!(
+        "t(0.25)/t(4) = {ratio:.5}, 16^(1/5) = {:.5}",
+        16f64.powf(0.2)
+    );
+    assert!((ratio / 16f64.powf(0.2) - 1.0).abs() < 3e-3);
+}
+
+#[test]
+fn restitution_from_liggghts_damping_matches_the_input_coefficient() {
+    for e in [0.3, 0.5, 0.9] {
+        for v in [0.5, 2.0] {
+            let (_, measured) = head_on(hertz_law(e, 0.0, NoCohesion), RADIUS, v, 1e-7);
+            eprintln!("e = {e}, v = {v} m/s: measured {measured:.6}");
+            assert!(
+                (measured - e).abs() < 1e-3 * e,
+                "e = {e}, v = {v}: {measured}"
+            );
+        }
+    }
+}
+
+/// A sphere on the floor with spin; `(velocity, spin)` after `duration`.
+fn on_floor(
+    v0: Vec3,
+    gravity: Vec3,
+    friction: Real,
+    duration: Real,
+    samples: &[Real],
+) -> Vec<(Vec3, Vec3)> {
+    // A long, narrow box: the cell grid stays small.
+    let domain = Domain {
+        lo: Vec3::new(-0.3, -0.005, -0.005),
+        hi: Vec3::new(0.3, 0.005, 0.005),
+        periodic: [false; 3],
+    };
+    let walls = floor(&domain);
+    let start = Vec3::new(-0.25, 0.0, domain.lo.z + RADIUS);
+    let dt = 2e-5;
+    let mut w = world(
+        hertz_law(0.5, friction, NoCohesion),
+        floor_wall(0.5, friction),
+        walls,
+        domain,
+        &[(start, v0, RADIUS)],
+        gravity,
+        dt,
+        0,
+    );
+    let mut out = Vec::new();
+    let mut next = 0;
+    while w.time < duration {
+        w.step();
+        if next < samples.len() && w.time + 0.5 * dt >= samples[next] {
+            let omega = w
+                .particles
+                .angular
+                .as_ref()
+                .map_or(Vec3::ZERO, |a| a.omega[0]);
+            out.push((w.particles.velocity[0], omega));
+            next += 1;
+        }
+    }
+    out
+}
+
+#[test]
+fn sphere_sliding_on_a_plane_with_friction_ends_rolling_at_five_sevenths_v0() {
+    let mu = 0.3;
+    // Slip ends at t = 2 v0 / (7 mu g) = 0.097 s.
+    let s = on_floor(Vec3::X, Vec3::new(0.0, 0.0, -9.81), mu, 0.2, &[0.2]);
+    let (v, omega) = s[0];
+    eprintln!(
+        "after sliding: v = {:.6} m/s (5/7 = {:.6}), omega_y R = {:.6} m/s",
+        v.x,
+        5.0 / 7.0,
+        omega.y * RADIUS
+    );
+    assert!((v.x / (5.0 / 7.0) - 1.0).abs() < 2e-3);
+    // Rolling without slip: omega x (-R z) = -v, i.e. omega_y = v / R.
+    assert!((omega.y * RADIUS / v.x - 1.0).abs() < 2e-3);
+}
+
+#[test]
+fn sphere_on_an_incline_below_the_friction_angle_rolls_at_five_sevenths_g_sin_theta() {
+    let theta = 20f64.to_radians();
+    let g = 9.81;
+    // Tilted gravity: the floor is the incline.
+    let gravity = Vec3::new(g * theta.sin(), 0.0, -g * theta.cos());
+    let s = on_floor(Vec3::ZERO, gravity, 0.5, 0.2, &[0.1, 0.2]);
+    let acceleration = (s[1].0.x - s[0].0.x) / 0.1;
+    let expected = 5.0 / 7.0 * g * theta.sin();
+    eprintln!("incline: a = {acceleration:.5} m/s^2, 5/7 g sin(theta) = {expected:.5}");
+    assert!((acceleration / expected - 1.0).abs() < 2e-3);
+}
+
+#[test]
+fn van_der_waals_binds_touching_spheres_at_the_overlap_where_hertz_balances_f_at_h_min() {
+    let (r, hamaker, h_min) = (5e-6, 6.5e-20, 4e-10);
+    let vdw = VanDerWaals {
+        hamaker_constant: vec![hamaker],
+        h_min,
+        reach: 100.0 * h_min,
+    };
+    let law = hertz_law(0.5, 0.3, vdw);
+    let bodies = [
+        (Vec3::new(-r, 0.0, 0.0), Vec3::ZERO, r),
+        (Vec3::new(r, 0.0, 0.0), Vec3::ZERO, r),
+    ];
+    let mut w = world(
+        law,
+        floor_wall(1.0, 0.0),
+        WallSet::default(),
+        open_box(1e-4, false),
+        &bodies,
+        Vec3::ZERO,
+        2e-8,
+        0,
+    );
+    for _ in 0..5000 {
+        w.step();
+    }
+    let overlap = 2.0 * r - (w.particles.position[1] - w.particles.position[0]).length();
+    // (4/3) Y_eff sqrt(R_eff) delta^(3/2) = F(h_min).
+    let pull = vdw_force(hamaker, r, r, h_min);
+    let y_eff = Material::y_eff(MATERIAL, MATERIAL);
+    let expected = (3.0 * pull / (4.0 * y_eff * (0.5 * r).sqrt())).powf(2.0 / 3.0);
+    eprintln!("vdW: F(h_min) = {pull:.4e} N, equilibrium overlap {overlap:.5e} m, expected {expected:.5e} m");
+    assert!((overlap / expected - 1.0).abs() < 1e-3);
+    // Pulled apart just beyond h_min the force is Eq. (7) at the gap, below F(h_min).
+    assert!(vdw_force(hamaker, r, r, 2.0 * h_min) < 0.3 * pull);
+}
+
+#[test]
+fn tangential_history_returns_to_zero_when_the_contact_ends() {
+    let v = Vec3::new(0.5, 0.3, 0.0);
+    let bodies = [
+        (Vec3::new(-RADIUS - 1e-6, -0.3 * RADIUS, 0.0), v, RADIUS),
+        (Vec3::new(RADIUS + 1e-6, 0.3 * RADIUS, 0.0), -v, RADIUS),
+    ];
+    let mut w = world(
+        hertz_law(0.5, 0.5, NoCohesion),
+        floor_wall(1.0, 0.0),
+        WallSet::default(),
+        open_box(10.0 * RADIUS, false),
+        &bodies,
+        Vec3::ZERO,
+        1e-7,
+        0,
+    );
+    let mut largest: Real = 0.0;
+    let mut after = 0;
+    while after < 10 {
+        w.step();
+        largest = largest.max(
+            w.history()
+                .iter()
+                .map(|h| h.0.length())
+                .fold(0.0, Real::max),
+        );
+        if largest > 0.0
+            && (w.particles.position[1] - w.particles.position[0]).length() > 2.0 * RADIUS
+        {
+            after += 1;
+        }
+    }
+    let apart = (w.particles.position[1] - w.particles.position[0]).length() > 2.0 * RADIUS;
+    eprintln!(
+        "largest tangential displacement {largest:.3e} m; listed pairs after: {}",
+        w.pairs().len()
+    );
+    assert!(apart && largest > 1e-7);
+    assert!(
+        !w.pairs().is_empty(),
+        "the pair should still be listed (within the skin)"
+    );
+    assert!(w.history().iter().all(|h| h.0 == Vec3::ZERO));
+}
+
+#[test]
+fn tangential_history_survives_a_rebuild_across_a_periodic_face_and_a_resort_mirrored() {
+    let half = 10.0 * RADIUS;
+    let overlap = 2e-5;
+    let bodies = [
+        (
+            Vec3::new(-RADIUS + 0.5 * overlap, 0.0, 0.0),
+            Vec3::new(0.0, 0.02, 0.0),
+            RADIUS,
+        ),
+        (
+            Vec3::new(RADIUS - 0.5 * overlap, 0.0, 0.0),
+            Vec3::new(0.0, -0.02, 0.0),
+            RADIUS,
+        ),
+    ];
+    let mut w = world(
+        hertz_law(1.0, 1.0, NoCohesion),
+        floor_wall(1.0, 0.0),
+        WallSet::default(),
+        open_box(half, true),
+        &bodies,
+        Vec3::ZERO,
+        1e-7,
+        1,
+    );
+    for _ in 0..200 {
+        w.step();
+    }
+    // Freeze the motion: the spring keeps its load, the force no longer changes.
+    w.particles.velocity.fill(Vec3::ZERO);
+    if let Some(a) = &mut w.particles.angular {
+        a.omega.fill(Vec3::ZERO);
+    }
+    w.compute_forces();
+    let by_id = |w: &World<HertzHistory, HertzWall>| {
+        let mut f: Vec<(u32, Vec3, Vec3)> = (0..2)
+            .map(|k| {
+                (
+                    w.particles.id[k],
+                    w.particles.force[k],
+                    w.particles.angular.as_ref().unwrap().torque[k],
+                )
+            })
+            .collect();
+        f.sort_by_key(|x| x.0);
+        f
+    };
+    let before = by_id(&w);
+    assert!(
+        before[0].1.y.abs() > 1e-4,
+        "the spring should be loaded: {:?}",
+        before[0].1
+    );
+    let first_before = w.particles.id[0];
+    // Move the pair so the second sphere crosses the +x face: it wraps to the -x side, gets
+    // the lower cell and comes first after the re-sort; the pair is now seen through an image.
+    let shift = Vec3::new(half - 0.5 * RADIUS, 0.0, 0.0);
+    for x in &mut w.particles.position {
+        *x += shift;
+    }
+    w.rebuild();
+    w.compute_forces();
+    let after = by_id(&w);
+    eprintln!(
+        "first particle id {} -> {}; forces {:?} -> {:?}",
+        first_before, w.particles.id[0], before[0].1, after[0].1
+    );
+    assert_ne!(
+        first_before, w.particles.id[0],
+        "the re-sort should swap the pair"
+    );
+    assert_ne!(w.pairs()[0].image, crate::domain::NO_IMAGE);
+    for (b, a) in before.iter().zip(&after) {
+        assert!(
+            (b.1 - a.1).length() < 1e-9 * b.1.length(),
+            "force {:?} -> {:?}",
+            b.1,
+            a.1
+        );
+        assert!(
+            (b.2 - a.2).length() < 1e-9 * b.2.length().max(1e-12),
+            "torque {:?} -> {:?}",
+            b.2,
+            a.2
+        );
+    }
+}
+
+/// Kinetic energy after `collisions` undamped head-on impacts through periodic images.
+fn undamped_energy_error(integrator: Integrator, dt: Real) -> Real {
+    let half = 2.5 * RADIUS * 2.0;
+    let v = 0.5;
+    let bodies = [
+        (
+            Vec3::new(-0.5 * half, 0.0, 0.0),
+            Vec3::new(v, 0.0, 0.0),
+            RADIUS,
+        ),
+        (
+            Vec3::new(0.5 * half, 0.0, 0.0),
+            Vec3::new(-v, 0.0, 0.0),
+            RADIUS,
+        ),
+    ];
+    let mut w = world(
+        hertz_law(1.0, 0.0, NoCohesion),
+        floor_wall(1.0, 0.0),
+        WallSet::default(),
+        open_box(half, true),
+        &bodies,
+        Vec3::ZERO,
+        dt,
+        0,
+    )
+    .with_integrator(integrator);
+    let e0 = w.kinetic_energy();
+    // Gap 3 d closed at 1 m/s: an impact every 6 ms; 0.1 s is about 16 impacts.
+    while w.time < 0.1 {
+        w.step();
+    }
+    // Let a contact in progress finish.
+    while w.pairs().iter().any(|p| {
+        let d = w.particles.position[p.i as usize]
+            - w.particles.position[p.j as usize]
+            - w.domain.image_shift(p.image);
+        d.length() < 2.0 * RADIUS
+    }) {
+        w.step();
+    }
+    (w.kinetic_energy() - e0).abs() / e0
+}
+
+#[test]
+fn undamped_hertz_impacts_conserve_energy_with_verlet_and_pcvv_alike() {
+    let vv = undamped_energy_error(Integrator::VelocityVerlet, 2e-6);
+    let pcvv = undamped_energy_error(Integrator::Pcvv, 2e-6);
+    eprintln!("relative kinetic-energy drift after ~16 impacts (145 steps each): VV {vv:.3e}, PCVV {pcvv:.3e}");
+    assert!(vv < 5e-5 && pcvv < 5e-5);
+    // For position-only forces PCVV is velocity Verlet written differently.
+    assert!((vv - pcvv).abs() < 1e-9);
+}
+
+/// A linear spring-dashpot against the floor: `F = -k (h - h0) - c v_n` (a test law).
+struct LinearWall {
+    k: Real,
+    c: Real,
+    h0: Real,
+}
+
+impl WallLaw for LinearWall {
+    fn reach(&self, _: usize, _: Real) -> Real {
+        1.0
+    }
+    fn force(&self, c: &WallContact, _: Real) -> Vec3 {
+        (-self.k * (c.distance - self.h0) - self.c * c.relative_velocity.dot(c.normal)) * c.normal
+    }
+    fn linearized(&self, _: usize, _: Real, _: Real) -> (Real, Real) {
+        (self.k, self.c)
+    }
+}
+
+/// Error of a damped oscillator against its exact solution at t = 3 periods.
+fn oscillator_error(integrator: Integrator, damping_ratio: Real, dt: Real) -> Real {
+    let m = mass(RADIUS);
+    let (k, omega) = (100.0, (100.0 / m).sqrt());
+    let c = 2.0 * damping_ratio * (k * m).sqrt();
+    let (h0, amplitude) = (0.01, 1e-3);
+    let domain = Domain {
+        lo: Vec3::new(-0.005, -0.005, 0.0),
+        hi: Vec3::new(0.005, 0.005, 0.02),
+        periodic: [false; 3],
+    };
+    let walls = WallSet {
+        walls: vec![Wall {
+            name: "floor".into(),
+            plane: FinitePlane::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0),
+            active: true,
+        }],
+    };
+    let seed = super::SeedModel::seed(
+        vec![super::normal::WcaCoefficients {
+            epsilon: 1e-12,
+            sigma: 1e-3,
+        }],
+        vec![0.0],
+        vec![0.0],
+    );
+    let mut w = world(
+        seed,
+        LinearWall { k, c, h0 },
+        walls,
+        domain,
+        &[(Vec3::new(0.0, 0.0, h0 + amplitude), Vec3::ZERO, RADIUS)],
+        Vec3::ZERO,
+        dt,
+        0,
+    )
+    .with_integrator(integrator);
+    let t_end = 3.0 * 2.0 * PI / omega;
+    let steps = (t_end / dt).round() as u64;
+    for _ in 0..steps {
+        w.step();
+    }
+    let t = w.time;
+    let omega_d = omega * (1.0 - damping_ratio * damping_ratio).sqrt();
+    let exact = amplitude
+        * (-damping_ratio * omega * t).exp()
+        * ((omega_d * t).cos() + damping_ratio * omega / omega_d * (omega_d * t).sin());
+    (w.particles.position[0].z - h0 - exact).abs() / amplitude
+}
+
+#[test]
+fn verlet_and_pcvv_agree_without_damping_and_differ_on_a_damped_oscillator() {
+    let dt = 2.0 * PI * (mass(RADIUS) / 100.0).sqrt() / 100.0;
+    let (vv0, pc0) = (
+        oscillator_error(Integrator::VelocityVerlet, 0.0, dt),
+        oscillator_error(Integrator::Pcvv, 0.0, dt),
+    );
+    let (vv, pc) = (
+        oscillator_error(Integrator::VelocityVerlet, 0.3, dt),
+        oscillator_error(Integrator::Pcvv, 0.3, dt),
+    );
+    let (vv2, pc2) = (
+        oscillator_error(Integrator::VelocityVerlet, 0.3, 0.5 * dt),
+        oscillator_error(Integrator::Pcvv, 0.3, 0.5 * dt),
+    );
+    eprintln!("oscillator error / amplitude at 3 periods, T/100: undamped VV {vv0:.3e} PCVV {pc0:.3e}; zeta 0.3: VV {vv:.3e} PCVV {pc:.3e}; T/200: VV {vv2:.3e} PCVV {pc2:.3e}");
+    assert!((vv0 - pc0).abs() < 1e-12);
+    // Velocity Verlet feeds the half-step velocity to the dashpot: first order (halving dt
+    // halves the error). PCVV uses the predicted full-step velocity: second order.
+    assert!((vv / vv2 - 2.0).abs() < 0.3, "VV order: {}", vv / vv2);
+    assert!((pc / pc2 - 4.0).abs() < 0.3, "PCVV order: {}", pc / pc2);
+    assert!(pc < 0.2 * vv);
+}
+
+#[test]
+fn coarse_graining_keeps_hertz_restitution_and_stretches_contact_time_by_lambda() {
+    let lambda = 2.0;
+    let (t1, e1) = head_on(hertz_law(0.5, 0.0, NoCohesion), RADIUS, 1.0, 1e-7);
+    // Y, nu and e unchanged; radius lambda R, same density so mass lambda^3 m.
+    let (t2, e2) = head_on(hertz_law(0.5, 0.0, NoCohesion), lambda * RADIUS, 1.0, 1e-7);
+    eprintln!(
+        "lambda = 2: contact time {t1:.5e} -> {t2:.5e} s (ratio {:.5}), e {e1:.6} -> {e2:.6}",
+        t2 / t1
+    );
+    assert!((t2 / t1 / lambda - 1.0).abs() < 2e-3);
+    assert!((e2 - e1).abs() < 1e-3);
+}

@@ -1,0 +1,113 @@
+//! Hertz particle-wall law: the particle law with the wall's radius taken as infinite, so
+//! `R_eff = r` and `m_eff = m`, and `1/Y_eff = (1 - nu_p^2)/Y_p + (1 - nu_w^2)/Y_w`.
+//!
+//! **Normal.** `F_n = (4/3) Y_eff sqrt(r delta) delta`, `delta = r - h` (h the centre-to-plane
+//! distance), with the LIGGGHTS restitution dashpot `-2 sqrt(5/6) |beta(e_w)| sqrt(S_n m) v_n`.
+//!
+//! **Friction.** Not the history spring: a wall would need per-particle-per-wall history.
+//! It is the regularized kinetic Coulomb law of the seed's wall (`wca_wall`):
+//! `-mu N v_t/|v_t|`, `N = max(F_n, 0)`, its magnitude capped at `m_c |v_t| / (2 dt)` so it can
+//! at most halve the contact-point slip per step; `m_c = (2/7) m` is the effective mass of the
+//! contact point of a solid sphere (`1/m_c = 1/m + r^2/I`). The contact-point velocity
+//! includes the spin, and the force exerts a torque about the centre. Static friction is
+//! therefore approximated by a stiff viscous law at tiny slip (about `2 dt F_t / m_c`).
+//!
+//! **Rolling.** Optional constant torque `-mu_r r N w/|w|` (`w` the spin less its component
+//! along the normal), capped to at most halve `|w|` in one step.
+
+use super::{WallContact, WallLaw};
+use crate::contact::damping::liggghts_damping_factor;
+use crate::contact::normal::Hertz;
+use crate::math::{Real, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct HertzWallSpecies {
+    pub y_eff: Real,
+    /// `2 sqrt(5/6) |beta(e_w)|`.
+    pub damping_factor: Real,
+    pub friction: Real,
+    pub rolling_friction: Real,
+}
+
+#[derive(Clone, Debug)]
+pub struct HertzWall {
+    pub species: Vec<HertzWallSpecies>,
+    /// Impact speed at which the contact is linearized for the time step (see `Hertz`).
+    pub characteristic_velocity: Real,
+}
+
+impl HertzWall {
+    pub fn new(
+        y_eff: &[Real],
+        restitution: Real,
+        friction: Real,
+        rolling_friction: Real,
+        characteristic_velocity: Real,
+    ) -> Self {
+        HertzWall {
+            species: y_eff
+                .iter()
+                .map(|&y_eff| HertzWallSpecies {
+                    y_eff,
+                    damping_factor: liggghts_damping_factor(restitution),
+                    friction,
+                    rolling_friction,
+                })
+                .collect(),
+            characteristic_velocity,
+        }
+    }
+}
+
+impl WallLaw for HertzWall {
+    const NEEDS_ROTATION: bool = true;
+
+    fn reach(&self, _: usize, radius: Real) -> Real {
+        radius
+    }
+
+    fn force(&self, contact: &WallContact, dt: Real) -> Vec3 {
+        self.force_and_torque(contact, Vec3::ZERO, dt).0
+    }
+
+    #[inline(always)]
+    fn force_and_torque(&self, c: &WallContact, omega: Vec3, dt: Real) -> (Vec3, Vec3) {
+        let s = &self.species[c.species];
+        let n = c.normal;
+        let delta = c.radius - c.distance;
+        let a = (c.radius * delta).sqrt();
+        let stiffness = 2.0 * s.y_eff * a;
+        let arm = -n * c.distance; // centre to contact point
+        let v = c.relative_velocity + omega.cross(arm);
+        let normal_speed = v.dot(n);
+        let normal_force = 4.0 / 3.0 * s.y_eff * a * delta
+            - s.damping_factor * (stiffness * c.mass).sqrt() * normal_speed;
+        let load = normal_force.max(0.0);
+        let mut force = normal_force * n;
+        let mut torque = Vec3::ZERO;
+        let tangential_velocity = v - normal_speed * n;
+        let slip = tangential_velocity.length();
+        if slip > 0.0 {
+            let no_reversal = (2.0 / 7.0) * c.mass * slip / (2.0 * dt);
+            let friction = -(s.friction * load).min(no_reversal) / slip * tangential_velocity;
+            force += friction;
+            torque += arm.cross(friction);
+        }
+        if s.rolling_friction > 0.0 {
+            let w = omega - omega.dot(n) * n;
+            let spin = w.length();
+            if spin > 0.0 {
+                let no_reversal = spin * 0.4 * c.mass * c.radius * c.radius / (2.0 * dt);
+                torque -= (s.rolling_friction * c.radius * load).min(no_reversal) / spin * w;
+            }
+        }
+        (force, torque)
+    }
+
+    fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real) {
+        let s = &self.species[species];
+        let delta = Hertz::max_overlap(s.y_eff, radius, mass, self.characteristic_velocity);
+        let k = 2.0 * s.y_eff * (radius * delta).sqrt();
+        (k, s.damping_factor * (k * mass).sqrt())
+    }
+}
