@@ -156,7 +156,7 @@ impl Suite {
                     .collect::<Result<Vec<_>, _>>()?
             };
             let angle_tolerance_deg = c.angle_tolerance_deg.unwrap_or(2.0);
-            if !(angle_tolerance_deg > 0.0) {
+            if angle_tolerance_deg.is_nan() || angle_tolerance_deg <= 0.0 {
                 return Err(invalid(
                     format!("case[{k}].angle_tolerance_deg"),
                     angle_tolerance_deg.to_string(),

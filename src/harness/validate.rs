@@ -625,7 +625,9 @@ fn write_case_section(
     )
     .log_x();
     let groups = angles_by_group(runs);
-    let mut series: BTreeMap<(u8, Code), (Vec<(f64, f64)>, Vec<f64>)> = BTreeMap::new();
+    // (rule, code) -> (lambda, mean angle) points and their seed spreads.
+    type AngleSeries = (Vec<(f64, f64)>, Vec<f64>);
+    let mut series: BTreeMap<(u8, Code), AngleSeries> = BTreeMap::new();
     for (&(rule, lambda, code), values) in &groups {
         if let Some((mean, spread)) = mean_spread(values) {
             let entry = series.entry((rule, code)).or_default();
