@@ -27,6 +27,9 @@ enum Command {
         /// Diameters grow by lambda, the particle count falls by lambda^3 (paper A Eq. 3-6).
         #[arg(long, default_value_t = 1)]
         lambda: u32,
+        /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
+        #[arg(long)]
+        seed: Option<u64>,
         /// Output directory (default: runs/<case>-lambda<N>).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -49,6 +52,7 @@ fn main() -> ExitCode {
         Command::Run {
             case,
             lambda,
+            seed,
             out,
             threads,
             quiet,
@@ -69,6 +73,10 @@ fn main() -> ExitCode {
             };
             let result = pool.install(|| Scene::load(&case)
                 .map_err(|e| e.to_string())
+                .map(|scene| match seed {
+                    Some(s) => scene.with_insertion_seed(s),
+                    None => scene,
+                })
                 .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
                 .and_then(|scene| {
                     let out_dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-lambda{}", scene.name, scene.lambda)));

@@ -126,6 +126,26 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
     (law, wall_law)
 }
 
+/// The scene's time step by its rule (and the timescales behind it), for any code that must
+/// run the scene at the same step.
+pub fn time_step(scene: &Scene, force_dt: bool) -> Result<(Real, Timescales, Option<String>), RunError> {
+    match &scene.contact {
+        ContactSettings::Wca { .. } => {
+            let (law, wall_law) = seed_laws(scene);
+            time_step_for(scene, &law, &wall_law, force_dt)
+        }
+    }
+}
+
+fn time_step_for<L: PairLaw, W: WallLaw>(scene: &Scene, law: &L, wall_law: &W, force_dt: bool) -> Result<(Real, Timescales, Option<String>), RunError> {
+    let scales = Timescales::of(&linear_contacts(scene, law, wall_law));
+    let (dt, warning) = timestep::choose(scene.time_step, &scales, force_dt).map_err(|source| RunError::TimeStep {
+        file: scene.source.display().to_string(),
+        source,
+    })?;
+    Ok((dt, scales, warning))
+}
+
 /// Linearized contacts of every species pair and every species against a wall.
 pub fn linear_contacts<L: PairLaw, W: WallLaw>(scene: &Scene, law: &L, wall_law: &W) -> Vec<LinearContact> {
     let n = scene.species.len();
@@ -154,7 +174,9 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(scene: &Scene, law: &L, wall_law:
     contacts
 }
 
-fn build_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError> {
+/// The scene's initial particles, placed by its insertions (the same packing every code
+/// starts from: the LAMMPS harness writes these positions into its data file).
+pub fn initial_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError> {
     let mut particles = Particles::new(rotation);
     for (index, ins) in scene.insertions.iter().enumerate() {
         let species = &scene.species[ins.species];
@@ -191,14 +213,13 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
     let out = &options.out_dir;
     std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
     let file = scene.source.display().to_string();
-    let scales = Timescales::of(&linear_contacts(scene, &law, &wall_law));
-    let (dt, warning) = timestep::choose(scene.time_step, &scales, options.force_dt).map_err(|source| RunError::TimeStep { file: file.clone(), source })?;
+    let (dt, scales, warning) = time_step_for(scene, &law, &wall_law, options.force_dt)?;
     let mut warnings: Vec<String> = warning.into_iter().collect();
     for w in &warnings {
         eprintln!("warning: {w}");
     }
 
-    let particles = build_particles(scene, L::NEEDS_ROTATION)?;
+    let particles = initial_particles(scene, L::NEEDS_ROTATION)?;
     let n_inserted = particles.len();
     let neighbor = NeighborSettings {
         skin: scene.skin_fraction * scene.max_diameter(),
