@@ -8,6 +8,7 @@ pub mod coarse_graining;
 pub mod contact;
 pub mod domain;
 pub mod geometry;
+pub mod harness;
 pub mod insertion;
 pub mod integrate;
 pub mod io;

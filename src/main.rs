@@ -44,11 +44,102 @@ enum Command {
         #[arg(long)]
         force_dt: bool,
     },
+    /// Run a scene in a reference code (deck written from the scene, run, post-processed
+    /// with cgdem's analysis into the same outputs).
+    Reference {
+        #[command(subcommand)]
+        code: ReferenceCode,
+    },
+}
+
+#[derive(Subcommand)]
+enum ReferenceCode {
+    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP); see reference/lammps/SEED_MODEL.md.
+    Lammps {
+        /// The scene file, e.g. validation/cases/aor_collapse.toml.
+        case: PathBuf,
+        /// Coarse-graining level (a power of two), applied before the deck is written.
+        #[arg(long, default_value_t = 1)]
+        lambda: u32,
+        /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output directory (default: runs/<case>-lambda<N>-lammps).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp`); default: serial.
+        #[arg(long)]
+        np: Option<u32>,
+        /// Kill LAMMPS after this many seconds.
+        #[arg(long, default_value_t = 7200)]
+        timeout: u64,
+        /// Write the deck even if the time step exceeds the stable limit.
+        #[arg(long)]
+        force_dt: bool,
+    },
+}
+
+fn reference_lammps(case: &std::path::Path, lambda: u32, seed: Option<u64>, out: Option<PathBuf>, np: Option<u32>, timeout: u64, force_dt: bool) -> Result<ExitCode, String> {
+    use cgdem::harness::lammps::{self, RunStatus, RunnerOptions};
+    let scene = Scene::load(case).map_err(|e| e.to_string())?;
+    let scene = match seed {
+        Some(s) => scene.with_insertion_seed(s),
+        None => scene,
+    };
+    let scene = coarse_grain(&scene, lambda).map_err(|e| e.to_string())?;
+    let out = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda)));
+    let (dt, scales, warning) = cgdem::run::time_step(&scene, force_dt).map_err(|e| e.to_string())?;
+    if let Some(w) = warning {
+        eprintln!("warning: {w}");
+    }
+    let particles = cgdem::run::initial_particles(&scene, false).map_err(|e| e.to_string())?;
+    let deck = lammps::write_deck(&scene, &particles, dt).map_err(|e| e.to_string())?;
+    deck.write_to(&out).map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
+    println!("deck for {} at lambda = {} ({} particles, dt = {dt:.4e} s) in {}", scene.name, scene.lambda, particles.len(), out.display());
+    let options = RunnerOptions {
+        np,
+        timeout: std::time::Duration::from_secs(timeout),
+    };
+    match lammps::run_deck(&out, &options) {
+        RunStatus::Completed { wall_s } => {
+            let summary = lammps::postprocess(&scene, &out, &deck.plan, &scales, wall_s, np.unwrap_or(1) as usize).map_err(|e| e.to_string())?;
+            lammps::write_summary(&summary, &out).map_err(|e| e.to_string())?;
+            println!("LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)", summary.steps, wall_s, summary.particle_steps_per_s);
+            for s in &summary.repose_samples {
+                println!("  t = {} s after `{}` start: repose angle {} deg, run-out {:.4} m", s.time_after_start_s, summary.stages.last().map_or("", |st| st.name.as_str()), s.repose_angle_deg.map_or("-".into(), |a| format!("{a:.2}")), s.runout_m);
+            }
+            println!("outputs in {}", out.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        RunStatus::Skipped { reason, install_hint } => {
+            println!("skipped: {reason}; install with `{install_hint}`");
+            Ok(ExitCode::SUCCESS)
+        }
+        RunStatus::Failed { exit_code, log_tail } => Err(format!("LAMMPS failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}", out.display())),
+        RunStatus::TimedOut { after_s, log_tail } => Err(format!("LAMMPS killed after {after_s:.0} s (--timeout) in {}; log tail:\n{log_tail}", out.display())),
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Reference {
+            code: ReferenceCode::Lammps {
+                case,
+                lambda,
+                seed,
+                out,
+                np,
+                timeout,
+                force_dt,
+            },
+        } => match reference_lammps(&case, lambda, seed, out, np, timeout, force_dt) {
+            Ok(code) => code,
+            Err(message) => {
+                eprintln!("error: {message}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Run {
             case,
             lambda,

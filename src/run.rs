@@ -193,7 +193,8 @@ pub fn initial_particles(scene: &Scene, rotation: bool) -> Result<Particles, Run
     Ok(particles)
 }
 
-fn build_walls(scene: &Scene) -> WallSet {
+/// The scene's walls, all active.
+pub fn scene_walls(scene: &Scene) -> WallSet {
     // Scene walls are bounded by the box: half-extents of the box diagonal cover it.
     let half = scene.domain.length().length();
     WallSet {
@@ -225,7 +226,7 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: scene.resort_every,
     };
-    let mut world = World::new(particles, scene.domain.clone(), build_walls(scene), law, wall_law, scene.species.len(), scene.gravity, dt, neighbor);
+    let mut world = World::new(particles, scene.domain.clone(), scene_walls(scene), law, wall_law, scene.species.len(), scene.gravity, dt, neighbor);
 
     let timeseries_path = out.join("timeseries.csv");
     let mut timeseries = std::io::BufWriter::new(std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?);
