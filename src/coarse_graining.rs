@@ -18,7 +18,9 @@ use crate::timestep::TimeStepRequest;
 pub enum CoarseGrainError {
     #[error("lambda = {0} is not allowed: lambda must be a power of two (1, 2, 4, 8, ...)")]
     NotPowerOfTwo(u32),
-    #[error("{file}: at lambda = {lambda} the particles ({diameter:.4e} m) no longer fit: {reason}")]
+    #[error(
+        "{file}: at lambda = {lambda} the particles ({diameter:.4e} m) no longer fit: {reason}"
+    )]
     TooCoarse {
         file: String,
         lambda: u32,
@@ -69,7 +71,10 @@ pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainErro
     };
     for axis in 0..3 {
         if diameter >= length[axis] {
-            return Err(too_coarse(format!("the box is only {:.4e} m along axis {axis}", length[axis])));
+            return Err(too_coarse(format!(
+                "the box is only {:.4e} m along axis {axis}",
+                length[axis]
+            )));
         }
         let needed = (2.0 + out.skin_fraction) * diameter;
         if out.domain.periodic[axis] && length[axis] < needed {

@@ -21,7 +21,16 @@ pub struct InsertionFailed {
 /// Adds `count` particles of one species (radius, mass) inside `lo..hi` (centres kept one
 /// radius from the region faces), not overlapping each other or existing particles.
 #[allow(clippy::too_many_arguments)]
-pub fn insert_random(particles: &mut Particles, species: u16, radius: Real, mass: Real, lo: Vec3, hi: Vec3, count: u64, seed: u64) -> Result<(), InsertionFailed> {
+pub fn insert_random(
+    particles: &mut Particles,
+    species: u16,
+    radius: Real,
+    mass: Real,
+    lo: Vec3,
+    hi: Vec3,
+    count: u64,
+    seed: u64,
+) -> Result<(), InsertionFailed> {
     let mut rng = Pcg64::seed_from_u64(seed);
     let max_radius = particles.radius.iter().cloned().fold(radius, Real::max);
     let cell = 2.0 * max_radius;
@@ -56,12 +65,14 @@ pub fn insert_random(particles: &mut Particles, species: u16, radius: Real, mass
         let overlaps = (-1..=1).any(|dx| {
             (-1..=1).any(|dy| {
                 (-1..=1).any(|dz| {
-                    grid.get(&[cx + dx, cy + dy, cz + dz]).is_some_and(|members| {
-                        members.iter().any(|&k| {
-                            let reach = radius + particles.radius[k as usize];
-                            (particles.position[k as usize] - p).length_squared() < reach * reach
+                    grid.get(&[cx + dx, cy + dy, cz + dz])
+                        .is_some_and(|members| {
+                            members.iter().any(|&k| {
+                                let reach = radius + particles.radius[k as usize];
+                                (particles.position[k as usize] - p).length_squared()
+                                    < reach * reach
+                            })
                         })
-                    })
                 })
             })
         });

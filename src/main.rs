@@ -11,7 +11,11 @@ use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
 #[derive(Parser)]
-#[command(name = "cgdem", version, about = "Discrete-element solver for powders and granular flow, with coarse-graining")]
+#[command(
+    name = "cgdem",
+    version,
+    about = "Discrete-element solver for powders and granular flow, with coarse-graining"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -76,10 +80,24 @@ enum ReferenceCode {
         /// Write the deck even if the time step exceeds the stable limit.
         #[arg(long)]
         force_dt: bool,
+        /// Do not run: post-process the LAMMPS outputs already in --out (e.g. of a run that
+        /// was stopped; the samples it reached are used).
+        #[arg(long)]
+        postprocess_only: bool,
     },
 }
 
-fn reference_lammps(case: &std::path::Path, lambda: u32, seed: Option<u64>, out: Option<PathBuf>, np: Option<u32>, timeout: u64, force_dt: bool) -> Result<ExitCode, String> {
+#[allow(clippy::too_many_arguments)]
+fn reference_lammps(
+    case: &std::path::Path,
+    lambda: u32,
+    seed: Option<u64>,
+    out: Option<PathBuf>,
+    np: Option<u32>,
+    timeout: u64,
+    force_dt: bool,
+    postprocess_only: bool,
+) -> Result<ExitCode, String> {
     use cgdem::harness::lammps::{self, RunStatus, RunnerOptions};
     let scene = Scene::load(case).map_err(|e| e.to_string())?;
     let scene = match seed {
@@ -87,36 +105,103 @@ fn reference_lammps(case: &std::path::Path, lambda: u32, seed: Option<u64>, out:
         None => scene,
     };
     let scene = coarse_grain(&scene, lambda).map_err(|e| e.to_string())?;
-    let out = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda)));
-    let (dt, scales, warning) = cgdem::run::time_step(&scene, force_dt).map_err(|e| e.to_string())?;
+    let out = out.unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda))
+    });
+    let (dt, scales, warning) =
+        cgdem::run::time_step(&scene, force_dt).map_err(|e| e.to_string())?;
     if let Some(w) = warning {
         eprintln!("warning: {w}");
     }
     let particles = cgdem::run::initial_particles(&scene, false).map_err(|e| e.to_string())?;
     let deck = lammps::write_deck(&scene, &particles, dt).map_err(|e| e.to_string())?;
-    deck.write_to(&out).map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
-    println!("deck for {} at lambda = {} ({} particles, dt = {dt:.4e} s) in {}", scene.name, scene.lambda, particles.len(), out.display());
-    let options = RunnerOptions {
-        np,
-        timeout: std::time::Duration::from_secs(timeout),
+    let finish = |wall_s: f64, note: Option<String>| -> Result<cgdem::run::RunSummary, String> {
+        let mut summary = lammps::postprocess(
+            &scene,
+            &out,
+            &deck.plan,
+            &scales,
+            wall_s,
+            np.unwrap_or(1) as usize,
+        )
+        .map_err(|e| e.to_string())?;
+        summary.warnings.extend(note);
+        lammps::write_summary(&summary, &out).map_err(|e| e.to_string())?;
+        Ok(summary)
     };
-    match lammps::run_deck(&out, &options) {
+    let status = if postprocess_only {
+        let previous = std::fs::read_to_string(out.join(lammps::deck::DECK_FILE)).map_err(|e| {
+            format!(
+                "--postprocess-only: cannot read {}: {e}",
+                out.join(lammps::deck::DECK_FILE).display()
+            )
+        })?;
+        if previous != deck.input {
+            return Err(format!(
+                "--postprocess-only: {} was not written for this case, lambda and seed",
+                out.join(lammps::deck::DECK_FILE).display()
+            ));
+        }
+        RunStatus::Completed { wall_s: f64::NAN }
+    } else {
+        deck.write_to(&out)
+            .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
+        println!(
+            "deck for {} at lambda = {} ({} particles, dt = {dt:.4e} s) in {}",
+            scene.name,
+            scene.lambda,
+            particles.len(),
+            out.display()
+        );
+        let options = RunnerOptions {
+            np,
+            timeout: std::time::Duration::from_secs(timeout),
+        };
+        lammps::run_deck(&out, &options)
+    };
+    match status {
         RunStatus::Completed { wall_s } => {
-            let summary = lammps::postprocess(&scene, &out, &deck.plan, &scales, wall_s, np.unwrap_or(1) as usize).map_err(|e| e.to_string())?;
-            lammps::write_summary(&summary, &out).map_err(|e| e.to_string())?;
-            println!("LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)", summary.steps, wall_s, summary.particle_steps_per_s);
+            let summary = finish(wall_s, None)?;
+            println!(
+                "LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
+                summary.steps, wall_s, summary.particle_steps_per_s
+            );
             for s in &summary.repose_samples {
-                println!("  t = {} s after `{}` start: repose angle {} deg, run-out {:.4} m", s.time_after_start_s, summary.stages.last().map_or("", |st| st.name.as_str()), s.repose_angle_deg.map_or("-".into(), |a| format!("{a:.2}")), s.runout_m);
+                println!(
+                    "  t = {} s after `{}` start: repose angle {} deg, run-out {:.4} m",
+                    s.time_after_start_s,
+                    summary.stages.last().map_or("", |st| st.name.as_str()),
+                    s.repose_angle_deg.map_or("-".into(), |a| format!("{a:.2}")),
+                    s.runout_m
+                );
             }
             println!("outputs in {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
-        RunStatus::Skipped { reason, install_hint } => {
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => {
             println!("skipped: {reason}; install with `{install_hint}`");
             Ok(ExitCode::SUCCESS)
         }
-        RunStatus::Failed { exit_code, log_tail } => Err(format!("LAMMPS failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}", out.display())),
-        RunStatus::TimedOut { after_s, log_tail } => Err(format!("LAMMPS killed after {after_s:.0} s (--timeout) in {}; log tail:\n{log_tail}", out.display())),
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => Err(format!(
+            "LAMMPS failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}",
+            out.display()
+        )),
+        RunStatus::TimedOut { after_s, log_tail } => {
+            // Keep what the run reached: partial outputs and a summary that says so.
+            let note = format!("LAMMPS killed after {after_s:.0} s (--timeout): partial run");
+            let partial = finish(after_s, Some(note))
+                .err()
+                .map_or(String::new(), |e| {
+                    format!(" (post-processing the partial run failed: {e})")
+                });
+            Err(format!("LAMMPS killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}", out.display()))
+        }
     }
 }
 
@@ -124,16 +209,27 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Reference {
-            code: ReferenceCode::Lammps {
-                case,
-                lambda,
-                seed,
-                out,
-                np,
-                timeout,
-                force_dt,
-            },
-        } => match reference_lammps(&case, lambda, seed, out, np, timeout, force_dt) {
+            code:
+                ReferenceCode::Lammps {
+                    case,
+                    lambda,
+                    seed,
+                    out,
+                    np,
+                    timeout,
+                    force_dt,
+                    postprocess_only,
+                },
+        } => match reference_lammps(
+            &case,
+            lambda,
+            seed,
+            out,
+            np,
+            timeout,
+            force_dt,
+            postprocess_only,
+        ) {
             Ok(code) => code,
             Err(message) => {
                 eprintln!("error: {message}");
@@ -155,30 +251,48 @@ fn main() -> ExitCode {
             }
             // The whole run executes inside the pool: parallel loops started from a worker
             // thread run small jobs inline instead of handing them across threads each step.
-            let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build() {
+            let pool = match rayon::ThreadPoolBuilder::new()
+                .num_threads(threads.unwrap_or(0))
+                .build()
+            {
                 Ok(pool) => pool,
                 Err(e) => {
                     eprintln!("error: cannot start the worker threads: {e}");
                     return ExitCode::FAILURE;
                 }
             };
-            let result = pool.install(|| Scene::load(&case)
-                .map_err(|e| e.to_string())
-                .map(|scene| match seed {
-                    Some(s) => scene.with_insertion_seed(s),
-                    None => scene,
-                })
-                .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
-                .and_then(|scene| {
-                    let out_dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-lambda{}", scene.name, scene.lambda)));
-                    let options = RunOptions { out_dir: out_dir.clone(), quiet, force_dt };
-                    run(&scene, &options).map(|summary| (summary, out_dir)).map_err(|e| e.to_string())
-                }));
+            let result = pool.install(|| {
+                Scene::load(&case)
+                    .map_err(|e| e.to_string())
+                    .map(|scene| match seed {
+                        Some(s) => scene.with_insertion_seed(s),
+                        None => scene,
+                    })
+                    .and_then(|scene| coarse_grain(&scene, lambda).map_err(|e| e.to_string()))
+                    .and_then(|scene| {
+                        let out_dir = out.unwrap_or_else(|| {
+                            PathBuf::from("runs")
+                                .join(format!("{}-lambda{}", scene.name, scene.lambda))
+                        });
+                        let options = RunOptions {
+                            out_dir: out_dir.clone(),
+                            quiet,
+                            force_dt,
+                        };
+                        run(&scene, &options)
+                            .map(|summary| (summary, out_dir))
+                            .map_err(|e| e.to_string())
+                    })
+            });
             match result {
                 Ok((summary, out_dir)) => {
                     println!("case {} at lambda = {}: {} particles, {} steps of {:.3e} s, {:.1} s wall time, {:.3e} particle-steps/s", summary.case, summary.lambda, summary.n_particles, summary.steps, summary.dt_s, summary.wall_s, summary.particle_steps_per_s);
                     if let Some(angle) = summary.repose_angle_deg {
-                        println!("repose angle {angle:.2} deg (R^2 = {:.3}), run-out {:.4} m", summary.repose_fit_r2.unwrap_or(f64::NAN), summary.runout_m.unwrap_or(f64::NAN));
+                        println!(
+                            "repose angle {angle:.2} deg (R^2 = {:.3}), run-out {:.4} m",
+                            summary.repose_fit_r2.unwrap_or(f64::NAN),
+                            summary.runout_m.unwrap_or(f64::NAN)
+                        );
                         if let Some(rule) = &summary.repose_rule {
                             println!("  rule: {rule}");
                         }

@@ -58,7 +58,9 @@ impl Particles {
         if let Some(angular) = &mut self.angular {
             angular.omega.push(Vec3::ZERO);
             angular.torque.push(Vec3::ZERO);
-            angular.inv_inertia.push(1.0 / (0.4 * mass * radius * radius));
+            angular
+                .inv_inertia
+                .push(1.0 / (0.4 * mass * radius * radius));
         }
     }
 

@@ -121,14 +121,22 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
     let n = scene.species.len();
     let wca = WcaCoefficients { epsilon, sigma };
     let law = SeedModel::seed(vec![wca; n * n], vec![gamma_n; n * n], vec![gamma_t; n * n]);
-    let per_species: Vec<(WcaCoefficients, Real)> = scene.species.iter().map(|s| (wca, s.mass())).collect();
-    let wall_law = WcaWall::new(&per_species, scene.wall_contact.restitution, scene.wall_contact.friction);
+    let per_species: Vec<(WcaCoefficients, Real)> =
+        scene.species.iter().map(|s| (wca, s.mass())).collect();
+    let wall_law = WcaWall::new(
+        &per_species,
+        scene.wall_contact.restitution,
+        scene.wall_contact.friction,
+    );
     (law, wall_law)
 }
 
 /// The scene's time step by its rule (and the timescales behind it), for any code that must
 /// run the scene at the same step.
-pub fn time_step(scene: &Scene, force_dt: bool) -> Result<(Real, Timescales, Option<String>), RunError> {
+pub fn time_step(
+    scene: &Scene,
+    force_dt: bool,
+) -> Result<(Real, Timescales, Option<String>), RunError> {
     match &scene.contact {
         ContactSettings::Wca { .. } => {
             let (law, wall_law) = seed_laws(scene);
@@ -137,17 +145,28 @@ pub fn time_step(scene: &Scene, force_dt: bool) -> Result<(Real, Timescales, Opt
     }
 }
 
-fn time_step_for<L: PairLaw, W: WallLaw>(scene: &Scene, law: &L, wall_law: &W, force_dt: bool) -> Result<(Real, Timescales, Option<String>), RunError> {
+fn time_step_for<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    law: &L,
+    wall_law: &W,
+    force_dt: bool,
+) -> Result<(Real, Timescales, Option<String>), RunError> {
     let scales = Timescales::of(&linear_contacts(scene, law, wall_law));
-    let (dt, warning) = timestep::choose(scene.time_step, &scales, force_dt).map_err(|source| RunError::TimeStep {
-        file: scene.source.display().to_string(),
-        source,
+    let (dt, warning) = timestep::choose(scene.time_step, &scales, force_dt).map_err(|source| {
+        RunError::TimeStep {
+            file: scene.source.display().to_string(),
+            source,
+        }
     })?;
     Ok((dt, scales, warning))
 }
 
 /// Linearized contacts of every species pair and every species against a wall.
-pub fn linear_contacts<L: PairLaw, W: WallLaw>(scene: &Scene, law: &L, wall_law: &W) -> Vec<LinearContact> {
+pub fn linear_contacts<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    law: &L,
+    wall_law: &W,
+) -> Vec<LinearContact> {
     let n = scene.species.len();
     let mut contacts = Vec::new();
     for (a, sa) in scene.species.iter().enumerate() {
@@ -182,9 +201,22 @@ pub fn initial_particles(scene: &Scene, rotation: bool) -> Result<Particles, Run
         let species = &scene.species[ins.species];
         let count = match ins.amount {
             InsertAmount::Count(n) => n,
-            InsertAmount::SolidVolume(v) => (v / (std::f64::consts::PI / 6.0 * species.diameter.powi(3))).round().max(1.0) as u64,
+            InsertAmount::SolidVolume(v) => (v
+                / (std::f64::consts::PI / 6.0 * species.diameter.powi(3)))
+            .round()
+            .max(1.0) as u64,
         };
-        insert_random(&mut particles, ins.species as u16, species.radius(), species.mass(), ins.lo, ins.hi, count, ins.seed).map_err(|source| RunError::Insertion {
+        insert_random(
+            &mut particles,
+            ins.species as u16,
+            species.radius(),
+            species.mass(),
+            ins.lo,
+            ins.hi,
+            count,
+            ins.seed,
+        )
+        .map_err(|source| RunError::Insertion {
             file: scene.source.display().to_string(),
             index,
             source,
@@ -210,7 +242,12 @@ pub fn scene_walls(scene: &Scene) -> WallSet {
     }
 }
 
-fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: &RunOptions) -> Result<RunSummary, RunError> {
+fn execute<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    law: L,
+    wall_law: W,
+    options: &RunOptions,
+) -> Result<RunSummary, RunError> {
     let out = &options.out_dir;
     std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
     let file = scene.source.display().to_string();
@@ -226,13 +263,28 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: scene.resort_every,
     };
-    let mut world = World::new(particles, scene.domain.clone(), scene_walls(scene), law, wall_law, scene.species.len(), scene.gravity, dt, neighbor);
+    let mut world = World::new(
+        particles,
+        scene.domain.clone(),
+        scene_walls(scene),
+        law,
+        wall_law,
+        scene.species.len(),
+        scene.gravity,
+        dt,
+        neighbor,
+    );
 
     let timeseries_path = out.join("timeseries.csv");
-    let mut timeseries = std::io::BufWriter::new(std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?);
+    let mut timeseries = std::io::BufWriter::new(
+        std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?,
+    );
     writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m").map_err(|e| output_error(&timeseries_path, e))?;
     let mut vtk = if scene.output.vtk_interval > 0.0 {
-        Some(VtkSeries::new(&out.join("vtk"), "particles").map_err(|e| output_error(&out.join("vtk"), e))?)
+        Some(
+            VtkSeries::new(&out.join("vtk"), "particles")
+                .map_err(|e| output_error(&out.join("vtk"), e))?,
+        )
     } else {
         None
     };
@@ -241,12 +293,24 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
     let floor_z = scene.domain.lo.z;
     let heap_profile = |world: &World<L, W>| -> Option<HeapProfile> {
         scene.repose.as_ref().map(|r| {
-            heap::profile(&world.particles.position, &world.particles.radius, r.wall_x, scene.domain.hi.x, floor_z, r.bin_width_diameters * max_diameter)
+            heap::profile(
+                &world.particles.position,
+                &world.particles.radius,
+                r.wall_x,
+                scene.domain.hi.x,
+                floor_z,
+                r.bin_width_diameters * max_diameter,
+            )
         })
     };
     let fit = |profile: &HeapProfile| -> Option<ReposeFit> {
         let r = scene.repose.as_ref()?;
-        heap::repose_angle(profile, 2.0 * max_diameter, r.exclude_wall_fraction, r.exclude_toe_fraction)
+        heap::repose_angle(
+            profile,
+            2.0 * max_diameter,
+            r.exclude_wall_fraction,
+            r.exclude_toe_fraction,
+        )
     };
 
     let total_estimate: Real = scene
@@ -261,7 +325,12 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
         ProgressBar::hidden()
     } else {
         let bar = ProgressBar::new((total_estimate / dt).ceil() as u64);
-        bar.set_style(ProgressStyle::with_template("{msg:>10} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{msg:>10} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
         bar
     };
 
@@ -309,11 +378,27 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
                 let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
                 let wall_height = profile.as_ref().map(|p| p.wall_height());
                 let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-                writeln!(timeseries, "{:.9e},{},{:.9e},{:.9e},{},{},{}", world.time, stage.name, ke, ke / mass.max(Real::MIN_POSITIVE), world.particles.len(), opt(front), opt(wall_height)).map_err(|e| output_error(&timeseries_path, e))?;
-                timeseries.flush().map_err(|e| output_error(&timeseries_path, e))?;
+                writeln!(
+                    timeseries,
+                    "{:.9e},{},{:.9e},{:.9e},{},{},{}",
+                    world.time,
+                    stage.name,
+                    ke,
+                    ke / mass.max(Real::MIN_POSITIVE),
+                    world.particles.len(),
+                    opt(front),
+                    opt(wall_height)
+                )
+                .map_err(|e| output_error(&timeseries_path, e))?;
+                timeseries
+                    .flush()
+                    .map_err(|e| output_error(&timeseries_path, e))?;
                 if let Some(threshold) = settle_threshold {
                     if elapsed >= min_duration && ke / mass < threshold {
-                        ended_by = format!("kinetic energy per mass {:.3e} J/kg < {threshold:.3e} J/kg", ke / mass);
+                        ended_by = format!(
+                            "kinetic energy per mass {:.3e} J/kg < {threshold:.3e} J/kg",
+                            ke / mass
+                        );
                         break;
                     }
                 }
@@ -321,7 +406,9 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
             if let Some(series) = &mut vtk {
                 if world.time + 0.5 * dt >= next_frame {
                     next_frame += scene.output.vtk_interval;
-                    series.write_frame(&world.particles, world.time).map_err(|e| output_error(&out.join("vtk"), e))?;
+                    series
+                        .write_frame(&world.particles, world.time)
+                        .map_err(|e| output_error(&out.join("vtk"), e))?;
                 }
             }
             if next_sample < repose_times.len() && elapsed + 0.5 * dt >= repose_times[next_sample] {
@@ -340,7 +427,10 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
             }
         }
         if settle_threshold.is_some() && ended_by.starts_with("duration") {
-            let w = format!("stage `{}` did not settle within max_duration {duration} s", stage.name);
+            let w = format!(
+                "stage `{}` did not settle within max_duration {duration} s",
+                stage.name
+            );
             eprintln!("warning: {w}");
             warnings.push(w);
         }
@@ -355,7 +445,10 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
     progress.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
     if world.lost > 0 {
-        let w = format!("{} particles left the box through a bounded face and were removed", world.lost);
+        let w = format!(
+            "{} particles left the box through a bounded face and were removed",
+            world.lost
+        );
         eprintln!("warning: {w}");
         warnings.push(w);
     }
@@ -371,10 +464,19 @@ fn execute<L: PairLaw, W: WallLaw>(scene: &Scene, law: L, wall_law: W, options: 
     }
     if !samples.is_empty() {
         let path = out.join("repose.csv");
-        let mut csv = String::from("time_after_start_s,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n");
+        let mut csv = String::from(
+            "time_after_start_s,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
+        );
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
         for s in &samples {
-            csv += &format!("{},{},{},{:.6e},{:.6e}\n", s.time_after_start_s, opt(s.repose_angle_deg), opt(s.repose_fit_r2), s.runout_m, s.wall_height_m);
+            csv += &format!(
+                "{},{},{},{:.6e},{:.6e}\n",
+                s.time_after_start_s,
+                opt(s.repose_angle_deg),
+                opt(s.repose_fit_r2),
+                s.runout_m,
+                s.wall_height_m
+            );
         }
         write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
     }

@@ -46,12 +46,27 @@ pub struct World<L: PairLaw, W: WallLaw> {
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
     #[allow(clippy::too_many_arguments)]
-    pub fn new(particles: Particles, domain: Domain, walls: WallSet, law: L, wall_law: W, n_species: usize, gravity: Vec3, dt: Real, neighbor: NeighborSettings) -> Self {
+    pub fn new(
+        particles: Particles,
+        domain: Domain,
+        walls: WallSet,
+        law: L,
+        wall_law: W,
+        n_species: usize,
+        gravity: Vec3,
+        dt: Real,
+        neighbor: NeighborSettings,
+    ) -> Self {
         let mut particles = particles;
         if L::NEEDS_ROTATION && particles.angular.is_none() {
             let mut rotating = Particles::new(true);
             for k in 0..particles.len() {
-                rotating.push(particles.species[k], particles.position[k], particles.radius[k], particles.mass[k]);
+                rotating.push(
+                    particles.species[k],
+                    particles.position[k],
+                    particles.radius[k],
+                    particles.mass[k],
+                );
                 rotating.velocity[k] = particles.velocity[k];
             }
             particles = rotating;
@@ -140,10 +155,17 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.particles.retain(&keep);
             self.lost += (old_count - self.particles.len()) as u64;
         }
-        let resort = self.neighbor.resort_every > 0 && self.list.builds % self.neighbor.resort_every as u64 == 0;
+        let resort = self.neighbor.resort_every > 0
+            && self
+                .list
+                .builds
+                .is_multiple_of(self.neighbor.resort_every as u64);
         let old_pairs = std::mem::take(&mut self.list.pairs);
         let old_history = std::mem::take(&mut self.history);
-        if let Some(order) = self.list.build(&mut self.particles, &self.domain, self.law.reach(), resort) {
+        if let Some(order) =
+            self.list
+                .build(&mut self.particles, &self.domain, self.law.reach(), resort)
+        {
             // Compose: old index -> (after removal) -> after re-sort.
             let mut sorted_index = vec![0u32; order.len()];
             for (new, &old) in order.iter().enumerate() {
@@ -153,12 +175,21 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 None => sorted_index,
                 Some(first) => first
                     .iter()
-                    .map(|&k| if k == u32::MAX { k } else { sorted_index[k as usize] })
+                    .map(|&k| {
+                        if k == u32::MAX {
+                            k
+                        } else {
+                            sorted_index[k as usize]
+                        }
+                    })
                     .collect(),
             });
         }
-        self.history = self.list.carry_history(&old_pairs, &old_history, remap.as_deref());
-        self.pair_result.resize(self.list.pairs.len(), PairResult::default());
+        self.history = self
+            .list
+            .carry_history(&old_pairs, &old_history, remap.as_deref());
+        self.pair_result
+            .resize(self.list.pairs.len(), PairResult::default());
     }
 
     /// Pair forces (each pair once, in parallel), then a per-particle gather in a fixed
@@ -183,14 +214,23 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let p = &mut self.particles;
         let (list, results) = (&self.list, &self.pair_result);
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
-        let (position, velocity, radius, mass, species) = (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
+        let (position, velocity, radius, mass, species) =
+            (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
         p.force
             .par_iter_mut()
             .enumerate()
             .with_min_len(CHUNK)
             .for_each(|(i, force)| {
                 let mut f = mass[i] * gravity;
-                f += walls.force_on(wall_law, species[i] as usize, position[i], velocity[i], radius[i], mass[i], dt);
+                f += walls.force_on(
+                    wall_law,
+                    species[i] as usize,
+                    position[i],
+                    velocity[i],
+                    radius[i],
+                    mass[i],
+                    dt,
+                );
                 for k in list.out_start[i]..list.out_start[i + 1] {
                     f += results[k as usize].force_on_i;
                 }
@@ -201,16 +241,22 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             });
         if L::NEEDS_ROTATION {
             if let Some(a) = &mut p.angular {
-                a.torque.par_iter_mut().enumerate().with_min_len(CHUNK).for_each(|(i, torque)| {
-                    let mut t = Vec3::ZERO;
-                    for k in list.out_start[i]..list.out_start[i + 1] {
-                        t += results[k as usize].torque_on_i;
-                    }
-                    for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                        t += results[k as usize].torque_on_j;
-                    }
-                    *torque = t;
-                });
+                a.torque
+                    .par_iter_mut()
+                    .enumerate()
+                    .with_min_len(CHUNK)
+                    .for_each(|(i, torque)| {
+                        let mut t = Vec3::ZERO;
+                        for k in list.out_start[i]..list.out_start[i + 1] {
+                            t += results[k as usize].torque_on_i;
+                        }
+                        for &k in
+                            &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize]
+                        {
+                            t += results[k as usize].torque_on_j;
+                        }
+                        *torque = t;
+                    });
             }
         }
     }
@@ -223,7 +269,16 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 /// The force of one listed pair; zero (and history reset) when out of range.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn pair_force<L: PairLaw>(law: &L, p: &Particles, omega: Option<&[Vec3]>, images: &[Vec3; 27], n_species: usize, pair: Pair, history: &mut L::History, dt: Real) -> PairResult {
+fn pair_force<L: PairLaw>(
+    law: &L,
+    p: &Particles,
+    omega: Option<&[Vec3]>,
+    images: &[Vec3; 27],
+    n_species: usize,
+    pair: Pair,
+    history: &mut L::History,
+    dt: Real,
+) -> PairResult {
     let (i, j) = (pair.i as usize, pair.j as usize);
     let d = p.position[i] - (p.position[j] + images[pair.image as usize]);
     let distance_sq = d.length_squared();

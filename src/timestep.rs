@@ -138,7 +138,8 @@ mod tests {
         let (dt, warning) = choose(TimeStepRequest::Explicit(2.0), &scales, true).unwrap();
         assert_eq!(dt, 2.0);
         assert!(warning.unwrap().contains("forced"));
-        let (dt, warning) = choose(TimeStepRequest::FractionOfPeriod(0.05), &scales, false).unwrap();
+        let (dt, warning) =
+            choose(TimeStepRequest::FractionOfPeriod(0.05), &scales, false).unwrap();
         assert!((dt - 0.05 * PI).abs() < 1e-12 && warning.is_none());
     }
 }

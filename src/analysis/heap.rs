@@ -43,7 +43,14 @@ impl HeapProfile {
 }
 
 /// Profile of the particles between `wall_x` and `x_end`, heights above `floor_z`.
-pub fn profile(positions: &[Vec3], radii: &[Real], wall_x: Real, x_end: Real, floor_z: Real, bin_width: Real) -> HeapProfile {
+pub fn profile(
+    positions: &[Vec3],
+    radii: &[Real],
+    wall_x: Real,
+    x_end: Real,
+    floor_z: Real,
+    bin_width: Real,
+) -> HeapProfile {
     let n_bins = ((x_end - wall_x) / bin_width).ceil().max(1.0) as usize;
     let mut heights = vec![0.0; n_bins];
     for (p, &r) in positions.iter().zip(radii) {
@@ -71,7 +78,12 @@ pub struct ReposeFit {
 }
 
 /// Repose angle by the rule in the module doc; None if fewer than 3 bins fall in the window.
-pub fn repose_angle(profile: &HeapProfile, min_depth: Real, exclude_wall: Real, exclude_toe: Real) -> Option<ReposeFit> {
+pub fn repose_angle(
+    profile: &HeapProfile,
+    min_depth: Real,
+    exclude_wall: Real,
+    exclude_toe: Real,
+) -> Option<ReposeFit> {
     let front = profile.front(min_depth);
     let runout = front - profile.wall_x;
     let from = profile.wall_x + exclude_wall * runout;
@@ -106,7 +118,11 @@ fn least_squares(points: &[(Real, Real)]) -> Option<(Real, Real)> {
         return None;
     }
     let slope = sxy / sxx;
-    let r_squared = if syy == 0.0 { 1.0 } else { sxy * sxy / (sxx * syy) };
+    let r_squared = if syy == 0.0 {
+        1.0
+    } else {
+        sxy * sxy / (sxx * syy)
+    };
     Some((slope, r_squared))
 }
 

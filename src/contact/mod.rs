@@ -60,7 +60,13 @@ pub trait NormalModel: Send + Sync {
     /// Elastic force at `contact`; only called when `distance < cutoff`.
     fn response(&self, contact: &Contact) -> NormalResponse;
     /// Stiffness of the linearized contact at its stiffest, for the time step.
-    fn linear_stiffness(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> Real;
+    fn linear_stiffness(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        m_eff: Real,
+    ) -> Real;
 }
 
 pub trait DampingModel: Send + Sync {
@@ -75,7 +81,13 @@ pub trait TangentialModel: Send + Sync {
     /// Whether the model needs particle spin (contact-point velocity, torques).
     const NEEDS_ROTATION: bool;
     /// Tangential force on `i`; `normal_force` is the total normal force magnitude.
-    fn force(&self, contact: &Contact, normal_force: Real, history: &mut Self::History, dt: Real) -> Vec3;
+    fn force(
+        &self,
+        contact: &Contact,
+        normal_force: Real,
+        history: &mut Self::History,
+        dt: Real,
+    ) -> Vec3;
 }
 
 pub trait RollingModel: Send + Sync {
@@ -99,9 +111,21 @@ pub trait PairLaw: Send + Sync {
     /// Largest distance beyond `r_i + r_j` at which any pair still interacts.
     fn reach(&self) -> Real;
     fn cutoff(&self, species_pair: usize, radius_i: Real, radius_j: Real) -> Real;
-    fn evaluate(&self, contact: &Contact, history: &mut Self::History, omega: (Vec3, Vec3), dt: Real) -> PairResult;
+    fn evaluate(
+        &self,
+        contact: &Contact,
+        history: &mut Self::History,
+        omega: (Vec3, Vec3),
+        dt: Real,
+    ) -> PairResult;
     /// (stiffness, damping coefficient) of the linearized contact of two particles.
-    fn linearized(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> (Real, Real);
+    fn linearized(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        m_eff: Real,
+    ) -> (Real, Real);
 }
 
 /// A contact law assembled from five slots.
@@ -138,7 +162,13 @@ where
     }
 
     #[inline(always)]
-    fn evaluate(&self, contact: &Contact, history: &mut T::History, omega: (Vec3, Vec3), dt: Real) -> PairResult {
+    fn evaluate(
+        &self,
+        contact: &Contact,
+        history: &mut T::History,
+        omega: (Vec3, Vec3),
+        dt: Real,
+    ) -> PairResult {
         let touching = contact.distance
             < self
                 .normal
@@ -168,7 +198,9 @@ where
         // centres), plus rolling resistance.
         let arm_i = -contact.normal * (contact.radius_i - 0.5 * contact.overlap);
         let arm_j = contact.normal * (contact.radius_j - 0.5 * contact.overlap);
-        let rolling = self.rolling.torque(contact, normal_force.abs(), omega.0, omega.1);
+        let rolling = self
+            .rolling
+            .torque(contact, normal_force.abs(), omega.0, omega.1);
         PairResult {
             force_on_i,
             torque_on_i: arm_i.cross(tangential) + rolling,
@@ -176,8 +208,16 @@ where
         }
     }
 
-    fn linearized(&self, species_pair: usize, radius_i: Real, radius_j: Real, m_eff: Real) -> (Real, Real) {
-        let k = self.normal.linear_stiffness(species_pair, radius_i, radius_j, m_eff);
+    fn linearized(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        m_eff: Real,
+    ) -> (Real, Real) {
+        let k = self
+            .normal
+            .linear_stiffness(species_pair, radius_i, radius_j, m_eff);
         let gamma = self.damping.linear_coefficient(species_pair, k, m_eff);
         (k, gamma)
     }

@@ -36,7 +36,8 @@ impl FinitePlane {
     #[inline(always)]
     pub fn distance(&self, p: Vec3) -> Option<Real> {
         let d = p - self.point;
-        let inside = d.dot(self.axis_u).abs() <= self.half_u && d.dot(self.axis_v).abs() <= self.half_v;
+        let inside =
+            d.dot(self.axis_u).abs() <= self.half_u && d.dot(self.axis_v).abs() <= self.half_v;
         inside.then(|| d.dot(self.normal))
     }
 }

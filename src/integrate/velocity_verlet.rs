@@ -10,7 +10,13 @@ use crate::math::{Real, Vec3};
 const CHUNK: usize = 1024;
 
 /// Half kick then drift.
-pub fn drift_kick(position: &mut [Vec3], velocity: &mut [Vec3], force: &[Vec3], inv_mass: &[Real], dt: Real) {
+pub fn drift_kick(
+    position: &mut [Vec3],
+    velocity: &mut [Vec3],
+    force: &[Vec3],
+    inv_mass: &[Real],
+    dt: Real,
+) {
     let half = 0.5 * dt;
     position
         .par_iter_mut()

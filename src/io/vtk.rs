@@ -29,8 +29,16 @@ impl VtkSeries {
         let name = format!("{}_{:06}.vtu", self.stem, self.frames.len());
         let path = self.dir.join(&name);
         let n = particles.len() as u64;
-        let points: Vec<f64> = particles.position.iter().flat_map(|p| p.to_array()).collect();
-        let velocity: Vec<f64> = particles.velocity.iter().flat_map(|v| v.to_array()).collect();
+        let points: Vec<f64> = particles
+            .position
+            .iter()
+            .flat_map(|p| p.to_array())
+            .collect();
+        let velocity: Vec<f64> = particles
+            .velocity
+            .iter()
+            .flat_map(|v| v.to_array())
+            .collect();
         let vtk = Vtk {
             version: Version::new((1, 0)),
             title: format!("cgdem particles at t = {time} s"),
@@ -55,11 +63,13 @@ impl VtkSeries {
                 },
             }),
         };
-        vtk.export(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        vtk.export(&path)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         self.frames.push((time, name));
         let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n");
         for (t, file) in &self.frames {
-            pvd += &format!("    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{file}\"/>\n");
+            pvd +=
+                &format!("    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{file}\"/>\n");
         }
         pvd += "  </Collection>\n</VTKFile>\n";
         let index = self.dir.join(format!("{}.pvd", self.stem));

@@ -11,7 +11,12 @@ struct Checker<'a> {
 }
 
 impl Checker<'_> {
-    fn invalid(&self, field: impl Into<String>, value: impl std::fmt::Display, allowed: impl Into<String>) -> SceneError {
+    fn invalid(
+        &self,
+        field: impl Into<String>,
+        value: impl std::fmt::Display,
+        allowed: impl Into<String>,
+    ) -> SceneError {
         SceneError::Invalid {
             file: self.file.to_path_buf(),
             field: field.into(),
@@ -59,7 +64,11 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     let hi = c.vector("domain.hi", raw.domain.hi)?;
     for axis in 0..3 {
         if hi[axis] <= lo[axis] {
-            return Err(c.invalid(format!("domain.hi[{axis}]"), hi[axis], format!("greater than domain.lo[{axis}] = {}", lo[axis])));
+            return Err(c.invalid(
+                format!("domain.hi[{axis}]"),
+                hi[axis],
+                format!("greater than domain.lo[{axis}] = {}", lo[axis]),
+            ));
         }
     }
     let domain = Domain {
@@ -76,11 +85,19 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     for (k, s) in raw.species.iter().enumerate() {
         let diameter = c.positive(&format!("species[{k}].diameter"), s.diameter)?;
         if diameter >= shortest_side {
-            return Err(c.invalid(format!("species[{k}].diameter"), diameter, format!("smaller than the shortest box side, {shortest_side} m")));
+            return Err(c.invalid(
+                format!("species[{k}].diameter"),
+                diameter,
+                format!("smaller than the shortest box side, {shortest_side} m"),
+            ));
         }
         let density = c.positive(&format!("species[{k}].density"), s.density)?;
         if species.iter().any(|t: &Species| t.name == s.name) {
-            return Err(c.invalid(format!("species[{k}].name"), &s.name, "a name not used by another species"));
+            return Err(c.invalid(
+                format!("species[{k}].name"),
+                &s.name,
+                "a name not used by another species",
+            ));
         }
         species.push(Species {
             name: s.name.clone(),
@@ -91,10 +108,30 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
 
     let contact = match raw.contact.model.as_str() {
         "wca" => {
-            let epsilon = c.positive("contact.epsilon", c.required("contact.epsilon", raw.contact.epsilon, "the WCA energy, J")?)?;
-            let sigma = c.positive("contact.sigma", c.required("contact.sigma", raw.contact.sigma, "the WCA length, m")?)?;
-            let gamma_n = c.non_negative("contact.gamma_n", c.required("contact.gamma_n", raw.contact.gamma_n, "the normal dashpot, kg/s")?)?;
-            let gamma_t = c.non_negative("contact.gamma_t", c.required("contact.gamma_t", raw.contact.gamma_t, "the tangential dashpot, kg/s")?)?;
+            let epsilon = c.positive(
+                "contact.epsilon",
+                c.required("contact.epsilon", raw.contact.epsilon, "the WCA energy, J")?,
+            )?;
+            let sigma = c.positive(
+                "contact.sigma",
+                c.required("contact.sigma", raw.contact.sigma, "the WCA length, m")?,
+            )?;
+            let gamma_n = c.non_negative(
+                "contact.gamma_n",
+                c.required(
+                    "contact.gamma_n",
+                    raw.contact.gamma_n,
+                    "the normal dashpot, kg/s",
+                )?,
+            )?;
+            let gamma_t = c.non_negative(
+                "contact.gamma_t",
+                c.required(
+                    "contact.gamma_t",
+                    raw.contact.gamma_t,
+                    "the tangential dashpot, kg/s",
+                )?,
+            )?;
             // The WCA cut-off 2^(1/6) sigma is the particle diameter (paper A); a mismatch
             // would make particles touch before or after they repel.
             for s in &species {
@@ -110,7 +147,13 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 gamma_t,
             }
         }
-        other => return Err(c.invalid("contact.model", format!("\"{other}\""), "\"wca\" (the seed's model)")),
+        other => {
+            return Err(c.invalid(
+                "contact.model",
+                format!("\"{other}\""),
+                "\"wca\" (the seed's model)",
+            ))
+        }
     };
 
     let wall_contact = match &raw.wall_contact {
@@ -127,7 +170,13 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
             restitution: 1.0,
             friction: 0.0,
         },
-        None => return Err(c.invalid("wall_contact", "missing", "a [wall_contact] table with restitution and friction when the scene has walls")),
+        None => {
+            return Err(c.invalid(
+                "wall_contact",
+                "missing",
+                "a [wall_contact] table with restitution and friction when the scene has walls",
+            ))
+        }
     };
 
     let mut walls = Vec::new();
@@ -135,10 +184,18 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         let point = c.vector(&format!("wall[{k}].point"), w.point)?;
         let normal = c.vector(&format!("wall[{k}].normal"), w.normal)?;
         if normal.length() == 0.0 {
-            return Err(c.invalid(format!("wall[{k}].normal"), format!("{:?}", w.normal), "a non-zero vector"));
+            return Err(c.invalid(
+                format!("wall[{k}].normal"),
+                format!("{:?}", w.normal),
+                "a non-zero vector",
+            ));
         }
         if walls.iter().any(|x: &WallSettings| x.name == w.name) {
-            return Err(c.invalid(format!("wall[{k}].name"), &w.name, "a name not used by another wall"));
+            return Err(c.invalid(
+                format!("wall[{k}].name"),
+                &w.name,
+                "a name not used by another wall",
+            ));
         }
         walls.push(WallSettings {
             name: w.name.clone(),
@@ -151,15 +208,31 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
 
     let time_step = match (raw.time.dt_fraction, raw.time.dt) {
         (Some(f), None) if f > 0.0 && f <= 0.5 => TimeStepRequest::FractionOfPeriod(f),
-        (Some(f), None) => return Err(c.invalid("time.dt_fraction", f, "0 < dt_fraction <= 0.5 of the shortest contact period")),
+        (Some(f), None) => {
+            return Err(c.invalid(
+                "time.dt_fraction",
+                f,
+                "0 < dt_fraction <= 0.5 of the shortest contact period",
+            ))
+        }
         (None, Some(dt)) => TimeStepRequest::Explicit(c.positive("time.dt", dt)?),
-        _ => return Err(c.invalid("time", "both or neither of dt_fraction and dt", "exactly one of dt_fraction (of the contact period) or dt (seconds)")),
+        _ => {
+            return Err(c.invalid(
+                "time",
+                "both or neither of dt_fraction and dt",
+                "exactly one of dt_fraction (of the contact period) or dt (seconds)",
+            ))
+        }
     };
 
     let neighbor = raw.neighbor.as_ref();
     let skin_fraction = neighbor.and_then(|n| n.skin_fraction).unwrap_or(0.3);
     if !(skin_fraction > 0.0 && skin_fraction <= 2.0) {
-        return Err(c.invalid("neighbor.skin_fraction", skin_fraction, "0 < skin_fraction <= 2 (of the largest diameter)"));
+        return Err(c.invalid(
+            "neighbor.skin_fraction",
+            skin_fraction,
+            "0 < skin_fraction <= 2 (of the largest diameter)",
+        ));
     }
     let resort_every = neighbor.and_then(|n| n.resort_every).unwrap_or(20);
     let max_diameter = species.iter().map(|s| s.diameter).fold(0.0, f64::max);
@@ -175,18 +248,42 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         let species_index = species
             .iter()
             .position(|s| s.name == ins.species)
-            .ok_or_else(|| c.invalid(format!("insert[{k}].species"), &ins.species, format!("one of the species: {}", names(species.iter().map(|s| &s.name)))))?;
+            .ok_or_else(|| {
+                c.invalid(
+                    format!("insert[{k}].species"),
+                    &ins.species,
+                    format!(
+                        "one of the species: {}",
+                        names(species.iter().map(|s| &s.name))
+                    ),
+                )
+            })?;
         let ilo = c.vector(&format!("insert[{k}].lo"), ins.lo)?;
         let ihi = c.vector(&format!("insert[{k}].hi"), ins.hi)?;
         for axis in 0..3 {
             if ihi[axis] <= ilo[axis] || ilo[axis] < lo[axis] || ihi[axis] > hi[axis] {
-                return Err(c.invalid(format!("insert[{k}].lo/hi[{axis}]"), format!("{} .. {}", ilo[axis], ihi[axis]), format!("a non-empty range inside the domain, {} .. {}", lo[axis], hi[axis])));
+                return Err(c.invalid(
+                    format!("insert[{k}].lo/hi[{axis}]"),
+                    format!("{} .. {}", ilo[axis], ihi[axis]),
+                    format!(
+                        "a non-empty range inside the domain, {} .. {}",
+                        lo[axis], hi[axis]
+                    ),
+                ));
             }
         }
         let amount = match (ins.count, ins.solid_volume) {
             (Some(n), None) if n > 0 => InsertAmount::Count(n),
-            (None, Some(v)) => InsertAmount::SolidVolume(c.positive(&format!("insert[{k}].solid_volume"), v)?),
-            _ => return Err(c.invalid(format!("insert[{k}]"), "count and solid_volume", "exactly one of count (> 0) or solid_volume (m^3)")),
+            (None, Some(v)) => {
+                InsertAmount::SolidVolume(c.positive(&format!("insert[{k}].solid_volume"), v)?)
+            }
+            _ => {
+                return Err(c.invalid(
+                    format!("insert[{k}]"),
+                    "count and solid_volume",
+                    "exactly one of count (> 0) or solid_volume (m^3)",
+                ))
+            }
         };
         insertions.push(Insertion {
             species: species_index,
@@ -204,7 +301,11 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     for (k, s) in raw.stages.iter().enumerate() {
         for name in &s.remove_walls {
             if !walls.iter().any(|w| &w.name == name) {
-                return Err(c.invalid(format!("stage[{k}].remove_walls"), name, format!("one of the walls: {}", names(walls.iter().map(|w| &w.name)))));
+                return Err(c.invalid(
+                    format!("stage[{k}].remove_walls"),
+                    name,
+                    format!("one of the walls: {}", names(walls.iter().map(|w| &w.name))),
+                ));
             }
         }
         let end = match (s.duration, s.until_kinetic_energy_per_mass_below, s.max_duration) {
@@ -231,23 +332,46 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     }
 
     let output = raw.output.as_ref();
-    let vtk_interval = c.non_negative("output.vtk_interval", output.and_then(|o| o.vtk_interval).unwrap_or(0.0))?;
-    let timeseries_interval = c.positive("output.timeseries_interval", output.and_then(|o| o.timeseries_interval).unwrap_or(0.01))?;
+    let vtk_interval = c.non_negative(
+        "output.vtk_interval",
+        output.and_then(|o| o.vtk_interval).unwrap_or(0.0),
+    )?;
+    let timeseries_interval = c.positive(
+        "output.timeseries_interval",
+        output.and_then(|o| o.timeseries_interval).unwrap_or(0.01),
+    )?;
 
     let repose = match &raw.repose {
         None => None,
         Some(r) => {
-            let stage = stages
-                .iter()
-                .find(|s| s.name == r.stage)
-                .ok_or_else(|| c.invalid("repose.stage", &r.stage, format!("one of the stages: {}", names(stages.iter().map(|s| &s.name)))))?;
-            if r.at_times.is_empty() || r.at_times.windows(2).any(|w| w[1] <= w[0]) || r.at_times[0] <= 0.0 {
-                return Err(c.invalid("repose.at_times", format!("{:?}", r.at_times), "one or more increasing times > 0 s after the stage starts"));
+            let stage = stages.iter().find(|s| s.name == r.stage).ok_or_else(|| {
+                c.invalid(
+                    "repose.stage",
+                    &r.stage,
+                    format!(
+                        "one of the stages: {}",
+                        names(stages.iter().map(|s| &s.name))
+                    ),
+                )
+            })?;
+            if r.at_times.is_empty()
+                || r.at_times.windows(2).any(|w| w[1] <= w[0])
+                || r.at_times[0] <= 0.0
+            {
+                return Err(c.invalid(
+                    "repose.at_times",
+                    format!("{:?}", r.at_times),
+                    "one or more increasing times > 0 s after the stage starts",
+                ));
             }
             if let StageEnd::Duration(d) = stage.end {
                 let last = *r.at_times.last().unwrap_or(&0.0);
                 if last > d {
-                    return Err(c.invalid("repose.at_times", last, format!("times within the stage `{}`, which lasts {d} s", stage.name)));
+                    return Err(c.invalid(
+                        "repose.at_times",
+                        last,
+                        format!("times within the stage `{}`, which lasts {d} s", stage.name),
+                    ));
                 }
             }
             let fraction = |field: &str, v: Option<f64>, default: f64| -> Result<f64, SceneError> {
@@ -262,9 +386,20 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 stage: r.stage.clone(),
                 wall_x: r.wall_x,
                 at_times: r.at_times.clone(),
-                bin_width_diameters: c.positive("repose.bin_width_diameters", r.bin_width_diameters.unwrap_or(1.0))?,
-                exclude_wall_fraction: fraction("repose.exclude_wall_fraction", r.exclude_wall_fraction, 0.15)?,
-                exclude_toe_fraction: fraction("repose.exclude_toe_fraction", r.exclude_toe_fraction, 0.15)?,
+                bin_width_diameters: c.positive(
+                    "repose.bin_width_diameters",
+                    r.bin_width_diameters.unwrap_or(1.0),
+                )?,
+                exclude_wall_fraction: fraction(
+                    "repose.exclude_wall_fraction",
+                    r.exclude_wall_fraction,
+                    0.15,
+                )?,
+                exclude_toe_fraction: fraction(
+                    "repose.exclude_toe_fraction",
+                    r.exclude_toe_fraction,
+                    0.15,
+                )?,
             })
         }
     };
@@ -294,5 +429,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
 }
 
 fn names<'a>(list: impl Iterator<Item = &'a String>) -> String {
-    list.map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+    list.map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

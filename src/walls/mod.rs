@@ -58,7 +58,17 @@ impl WallSet {
 
     /// Total force of the active walls on one particle.
     #[inline(always)]
-    pub fn force_on<W: WallLaw>(&self, law: &W, species: usize, position: Vec3, velocity: Vec3, radius: Real, mass: Real, dt: Real) -> Vec3 {
+    #[allow(clippy::too_many_arguments)]
+    pub fn force_on<W: WallLaw>(
+        &self,
+        law: &W,
+        species: usize,
+        position: Vec3,
+        velocity: Vec3,
+        radius: Real,
+        mass: Real,
+        dt: Real,
+    ) -> Vec3 {
         let reach = law.reach(species, radius);
         let mut total = Vec3::ZERO;
         for wall in self.walls.iter().filter(|w| w.active) {

@@ -110,7 +110,10 @@ mod tests {
                 - 24.0 * c.epsilon * c.sigma.powi(6) / r.powi(7);
             let h = r * 1e-7;
             let numeric = -(c.potential(r + h) - c.potential(r - h)) / (2.0 * h);
-            assert!((c.force(r) - closed).abs() <= 1e-12 * closed.abs(), "{overlap_fraction}");
+            assert!(
+                (c.force(r) - closed).abs() <= 1e-12 * closed.abs(),
+                "{overlap_fraction}"
+            );
             assert!((c.force(r) - numeric).abs() <= 1e-5 * closed.abs());
             assert!(c.force(r) > 0.0);
         }

@@ -83,16 +83,25 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         gamma_t,
     } = scene.contact;
     if gamma_n <= 0.0 {
-        return Err(unsupported("gamma_n = 0: LAMMPS sets gamma_t as a multiple of gamma_n".into()));
+        return Err(unsupported(
+            "gamma_n = 0: LAMMPS sets gamma_t as a multiple of gamma_n".into(),
+        ));
     }
-    if !(dt > 0.0) {
+    if !dt.is_finite() || dt <= 0.0 {
         return Err(unsupported(format!("time step {dt} s")));
     }
     let rc = TWO_POW_ONE_SIXTH * sigma;
     let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
     let wall_mass = masses[0];
-    if !scene.walls.is_empty() && masses.iter().any(|&m| (m - wall_mass).abs() > 1e-12 * wall_mass) {
-        return Err(unsupported("walls with species of different masses: fix wall/gran takes one gamma_w for all atoms".into()));
+    if !scene.walls.is_empty()
+        && masses
+            .iter()
+            .any(|&m| (m - wall_mass).abs() > 1e-12 * wall_mass)
+    {
+        return Err(unsupported(
+            "walls with species of different masses: fix wall/gran takes one gamma_w for all atoms"
+                .into(),
+        ));
     }
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
     let (lo, hi) = (scene.domain.lo, scene.domain.hi);
@@ -114,49 +123,132 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     for k in 0..particles.len() {
         let species = particles.species[k] as usize;
         let p = particles.position[k];
-        let _ = writeln!(data, "{} {} {} {} {} {} {}", particles.id[k] + 1, species + 1, g(rc), g(masses[species] / volume), g(p.x), g(p.y), g(p.z));
+        let _ = writeln!(
+            data,
+            "{} {} {} {} {} {} {}",
+            particles.id[k] + 1,
+            species + 1,
+            g(rc),
+            g(masses[species] / volume),
+            g(p.x),
+            g(p.y),
+            g(p.z)
+        );
     }
     data += "\nVelocities\n\n";
     for k in 0..particles.len() {
         let v = particles.velocity[k];
-        let _ = writeln!(data, "{} {} {} {} 0 0 0", particles.id[k] + 1, g(v.x), g(v.y), g(v.z));
+        let _ = writeln!(
+            data,
+            "{} {} {} {} 0 0 0",
+            particles.id[k] + 1,
+            g(v.x),
+            g(v.y),
+            g(v.z)
+        );
     }
 
     let mut d = String::new();
-    let _ = writeln!(d, "# LAMMPS input written by cgdem {} from {} (scene `{}`, lambda = {}).", env!("CARGO_PKG_VERSION"), scene.source.display(), scene.name, scene.lambda);
+    let _ = writeln!(
+        d,
+        "# LAMMPS input written by cgdem {} from {} (scene `{}`, lambda = {}).",
+        env!("CARGO_PKG_VERSION"),
+        scene.source.display(),
+        scene.name,
+        scene.lambda
+    );
     let _ = writeln!(d, "# Model lines: reference/lammps/SEED_MODEL.md. Do not edit: rewrite with `cgdem reference lammps`.");
     d += "units           si\natom_style      sphere\natom_modify     map array\n";
-    let flag = |axis: usize| if scene.domain.periodic[axis] { "p" } else { "f" };
+    let flag = |axis: usize| {
+        if scene.domain.periodic[axis] {
+            "p"
+        } else {
+            "f"
+        }
+    };
     let _ = writeln!(d, "boundary        {} {} {}", flag(0), flag(1), flag(2));
     d += "newton          off\ncomm_modify     vel yes\n";
     let _ = writeln!(d, "read_data       {DATA_FILE}");
     // Diameter rc for the granular contact range; mass from the species' own diameter.
     for (t, m) in masses.iter().enumerate() {
-        let _ = writeln!(d, "set             type {} mass {}   # {}: rho pi d^3/6, d = {} m", t + 1, g(*m), scene.species[t].name, scene.species[t].diameter);
+        let _ = writeln!(
+            d,
+            "set             type {} mass {}   # {}: rho pi d^3/6, d = {} m",
+            t + 1,
+            g(*m),
+            scene.species[t].name,
+            scene.species[t].diameter
+        );
     }
-    let _ = writeln!(d, "pair_style      hybrid/overlay lj/cut {} granular", g(rc));
-    let _ = writeln!(d, "pair_coeff      * * lj/cut {} {} {}", g(epsilon), g(sigma), g(rc));
+    let _ = writeln!(
+        d,
+        "pair_style      hybrid/overlay lj/cut {} granular",
+        g(rc)
+    );
+    let _ = writeln!(
+        d,
+        "pair_coeff      * * lj/cut {} {} {}",
+        g(epsilon),
+        g(sigma),
+        g(rc)
+    );
     let _ = writeln!(d, "pair_coeff      * * granular hooke 0.0 {} damping velocity tangential linear_nohistory {} 1.0e8", g(gamma_n), g(gamma_t / gamma_n));
     d += "pair_modify     pair lj/cut shift yes\n";
-    let _ = writeln!(d, "neighbor        {} bin", g(scene.skin_fraction * scene.max_diameter()));
+    let _ = writeln!(
+        d,
+        "neighbor        {} bin",
+        g(scene.skin_fraction * scene.max_diameter())
+    );
     d += "neigh_modify    every 1 delay 0 check yes\n";
     d += "fix             integ all nve\n";
     let gravity = scene.gravity;
     if gravity.length() > 0.0 {
         let dir = gravity / gravity.length();
-        let _ = writeln!(d, "fix             grav all gravity {} vector {} {} {}", g(gravity.length()), g(dir.x), g(dir.y), g(dir.z));
+        let _ = writeln!(
+            d,
+            "fix             grav all gravity {} vector {} {} {}",
+            g(gravity.length()),
+            g(dir.x),
+            g(dir.y),
+            g(dir.z)
+        );
     }
     let _ = writeln!(d, "timestep        {}", g(dt));
 
     if !scene.walls.is_empty() {
         let stiffness = 4.0 * 72.0 * epsilon / (rc * rc);
-        let gamma_w = 2.0 * restitution_damping_ratio(scene.wall_contact.restitution) * (stiffness * wall_mass).sqrt();
+        let gamma_w = 2.0
+            * restitution_damping_ratio(scene.wall_contact.restitution)
+            * (stiffness * wall_mass).sqrt();
         let x_t = wall_mass / (2.0 * dt * gamma_w);
-        let _ = writeln!(d, "# walls: mirror WCA + dashpot gamma_w = {} kg/s (restitution {}), friction {}", g(gamma_w), scene.wall_contact.restitution, scene.wall_contact.friction);
+        let _ = writeln!(
+            d,
+            "# walls: mirror WCA + dashpot gamma_w = {} kg/s (restitution {}), friction {}",
+            g(gamma_w),
+            scene.wall_contact.restitution,
+            scene.wall_contact.friction
+        );
         for w in &scene.walls {
             let (p, n) = (w.point, w.normal);
-            let _ = writeln!(d, "region          w_{} plane {} {} {} {} {} {} side in units box", w.name, g(p.x), g(p.y), g(p.z), g(n.x), g(n.y), g(n.z));
-            let _ = writeln!(d, "fix             wlj_{0} all wall/region w_{0} lj126 {1} {2} {3}", w.name, g(epsilon), g(0.5 * sigma), g(0.5 * rc));
+            let _ = writeln!(
+                d,
+                "region          w_{} plane {} {} {} {} {} {} side in units box",
+                w.name,
+                g(p.x),
+                g(p.y),
+                g(p.z),
+                g(n.x),
+                g(n.y),
+                g(n.z)
+            );
+            let _ = writeln!(
+                d,
+                "fix             wlj_{0} all wall/region w_{0} lj126 {1} {2} {3}",
+                w.name,
+                g(epsilon),
+                g(0.5 * sigma),
+                g(0.5 * rc)
+            );
             let _ = writeln!(d, "fix             wgran_{0} all wall/gran/region granular hooke 0.0 {1} damping velocity tangential linear_nohistory {2} {3} region w_{0}", w.name, g(gamma_w), g(x_t), g(scene.wall_contact.friction));
         }
     }
@@ -173,9 +265,16 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     for (k, stage) in scene.stages.iter().enumerate() {
         let _ = writeln!(d, "\n# stage `{}`", stage.name);
         for name in &stage.remove_walls {
-            let _ = writeln!(d, "unfix           wlj_{name}\nunfix           wgran_{name}");
+            let _ = writeln!(
+                d,
+                "unfix           wlj_{name}\nunfix           wgran_{name}"
+            );
         }
-        let _ = writeln!(d, "print           \"CGDEM_STAGE {} start $(step)\"", stage.name);
+        let _ = writeln!(
+            d,
+            "print           \"CGDEM_STAGE {} start $(step)\"",
+            stage.name
+        );
         let repose_times: Vec<Real> = match &scene.repose {
             Some(r) if r.stage == stage.name => r.at_times.clone(),
             _ => Vec::new(),
@@ -197,7 +296,11 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
                 if total > done {
                     let _ = writeln!(d, "run             {} post no", total - done);
                 }
-                let _ = writeln!(d, "print           \"CGDEM_STAGE {} end $(step) duration\"", stage.name);
+                let _ = writeln!(
+                    d,
+                    "print           \"CGDEM_STAGE {} end $(step) duration\"",
+                    stage.name
+                );
             }
             StageEnd::Settled {
                 kinetic_energy_per_mass,
@@ -205,7 +308,10 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
                 max_duration,
             } => {
                 if !repose_times.is_empty() {
-                    return Err(unsupported(format!("repose times inside the settle stage `{}`", stage.name)));
+                    return Err(unsupported(format!(
+                        "repose times inside the settle stage `{}`",
+                        stage.name
+                    )));
                 }
                 let chunk_s = dump_every as Real * dt;
                 let min_chunks = (min_duration / chunk_s - 1e-9).ceil().max(0.0) as u64;
@@ -217,7 +323,11 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
                 let _ = writeln!(d, "if              \"${{{var}}} >= {min_chunks} && ${{kepm}} < {}\" then \"print 'CGDEM_STAGE {} end $(step) settled'\" \"jump SELF end_{label}\"", g(kinetic_energy_per_mass), stage.name);
                 let _ = writeln!(d, "next            {var}");
                 let _ = writeln!(d, "jump            SELF loop_{label}");
-                let _ = writeln!(d, "print           \"CGDEM_STAGE {} end $(step) max_duration\"", stage.name);
+                let _ = writeln!(
+                    d,
+                    "print           \"CGDEM_STAGE {} end $(step) max_duration\"",
+                    stage.name
+                );
                 let _ = writeln!(d, "label           end_{label}");
                 let _ = writeln!(d, "variable        {var} delete");
             }

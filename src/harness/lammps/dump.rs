@@ -27,7 +27,10 @@ impl Frame {
     }
 
     pub fn column(&self, name: &str) -> Option<&[Real]> {
-        self.columns.iter().position(|c| c == name).map(|k| self.values[k].as_slice())
+        self.columns
+            .iter()
+            .position(|c| c == name)
+            .map(|k| self.values[k].as_slice())
     }
 }
 
@@ -65,11 +68,13 @@ pub fn parse_dump(text: &str, path: &Path) -> Result<Vec<Frame>, DumpError> {
     let next = |at: &mut usize, what: &str| -> Result<(usize, &str), DumpError> {
         let k = *at;
         *at += 1;
-        lines.get(k).map(|l| (k + 1, *l)).ok_or_else(|| err(k + 1, format!("file ends early: expected {what}")))
+        lines
+            .get(k)
+            .map(|l| (k + 1, *l))
+            .ok_or_else(|| err(k + 1, format!("file ends early: expected {what}")))
     };
     let mut frames: Vec<Frame> = Vec::new();
-    loop {
-        let Some(first) = lines.get(at) else { break };
+    while let Some(first) = lines.get(at) {
         if first.trim().is_empty() {
             at += 1;
             continue;
@@ -79,30 +84,59 @@ pub fn parse_dump(text: &str, path: &Path) -> Result<Vec<Frame>, DumpError> {
             return Err(err(n, format!("expected `ITEM: TIMESTEP`, found `{l}`")));
         }
         let (n, l) = next(&mut at, "the time step")?;
-        let step: u64 = l.trim().parse().map_err(|_| err(n, format!("time step `{l}` is not a non-negative integer")))?;
+        let step: u64 = l
+            .trim()
+            .parse()
+            .map_err(|_| err(n, format!("time step `{l}` is not a non-negative integer")))?;
         let (n, l) = next(&mut at, "ITEM: NUMBER OF ATOMS")?;
         if l.trim() != "ITEM: NUMBER OF ATOMS" {
-            return Err(err(n, format!("expected `ITEM: NUMBER OF ATOMS`, found `{l}`")));
+            return Err(err(
+                n,
+                format!("expected `ITEM: NUMBER OF ATOMS`, found `{l}`"),
+            ));
         }
         let (n, l) = next(&mut at, "the number of atoms")?;
-        let n_atoms: usize = l.trim().parse().map_err(|_| err(n, format!("number of atoms `{l}` is not a non-negative integer")))?;
+        let n_atoms: usize = l.trim().parse().map_err(|_| {
+            err(
+                n,
+                format!("number of atoms `{l}` is not a non-negative integer"),
+            )
+        })?;
         let (n, l) = next(&mut at, "ITEM: BOX BOUNDS")?;
         let Some(boundary) = l.trim().strip_prefix("ITEM: BOX BOUNDS") else {
-            return Err(err(n, format!("expected `ITEM: BOX BOUNDS ...`, found `{l}`")));
+            return Err(err(
+                n,
+                format!("expected `ITEM: BOX BOUNDS ...`, found `{l}`"),
+            ));
         };
         let boundary = boundary.trim().to_string();
         let mut bounds = [[0.0; 2]; 3];
         for (axis, b) in bounds.iter_mut().enumerate() {
             let (n, l) = next(&mut at, "a box bounds line")?;
-            let v: Vec<Real> = l.split_whitespace().map(str::parse).collect::<Result<_, _>>().map_err(|_| err(n, format!("box bounds of axis {axis}: `{l}` is not numbers")))?;
+            let v: Vec<Real> = l
+                .split_whitespace()
+                .map(str::parse)
+                .collect::<Result<_, _>>()
+                .map_err(|_| {
+                    err(
+                        n,
+                        format!("box bounds of axis {axis}: `{l}` is not numbers"),
+                    )
+                })?;
             if v.len() < 2 {
-                return Err(err(n, format!("box bounds of axis {axis}: expected lo hi, found `{l}`")));
+                return Err(err(
+                    n,
+                    format!("box bounds of axis {axis}: expected lo hi, found `{l}`"),
+                ));
             }
             *b = [v[0], v[1]];
         }
         let (n, l) = next(&mut at, "ITEM: ATOMS")?;
         let Some(names) = l.trim().strip_prefix("ITEM: ATOMS") else {
-            return Err(err(n, format!("expected `ITEM: ATOMS <columns>`, found `{l}`")));
+            return Err(err(
+                n,
+                format!("expected `ITEM: ATOMS <columns>`, found `{l}`"),
+            ));
         };
         let columns: Vec<String> = names.split_whitespace().map(String::from).collect();
         if columns.is_empty() {
@@ -110,13 +144,26 @@ pub fn parse_dump(text: &str, path: &Path) -> Result<Vec<Frame>, DumpError> {
         }
         let mut values = vec![Vec::with_capacity(n_atoms); columns.len()];
         for atom in 0..n_atoms {
-            let (n, l) = next(&mut at, &format!("atom line {} of {n_atoms} (step {step})", atom + 1))?;
+            let (n, l) = next(
+                &mut at,
+                &format!("atom line {} of {n_atoms} (step {step})", atom + 1),
+            )?;
             let fields: Vec<&str> = l.split_whitespace().collect();
             if fields.len() != columns.len() {
-                return Err(err(n, format!("atom line has {} values, the header names {} columns ({})", fields.len(), columns.len(), columns.join(" "))));
+                return Err(err(
+                    n,
+                    format!(
+                        "atom line has {} values, the header names {} columns ({})",
+                        fields.len(),
+                        columns.len(),
+                        columns.join(" ")
+                    ),
+                ));
             }
             for (c, f) in fields.iter().enumerate() {
-                let v: Real = f.parse().map_err(|_| err(n, format!("column `{}`: `{f}` is not a number", columns[c])))?;
+                let v: Real = f.parse().map_err(|_| {
+                    err(n, format!("column `{}`: `{f}` is not a number", columns[c]))
+                })?;
                 values[c].push(v);
             }
         }
@@ -157,7 +204,10 @@ mod tests {
         let e = parse_dump(cut, Path::new("run/traj.dump")).unwrap_err();
         assert_eq!(e.line, 22);
         let message = e.to_string();
-        assert!(message.starts_with("run/traj.dump:22: file ends early"), "{message}");
+        assert!(
+            message.starts_with("run/traj.dump:22: file ends early"),
+            "{message}"
+        );
         assert!(message.contains("atom line 2 of 2 (step 10)"), "{message}");
     }
 
@@ -168,6 +218,9 @@ mod tests {
         assert_eq!(e.line, 21);
         assert!(e.to_string().contains("column `x`: `0.1.5`"), "{e}");
         let short = TWO_FRAMES.replace("1 1 0.15 0.2 0.3", "1 1 0.15 0.2");
-        assert!(parse_dump(&short, Path::new("t.dump")).unwrap_err().to_string().contains("4 values, the header names 5"));
+        assert!(parse_dump(&short, Path::new("t.dump"))
+            .unwrap_err()
+            .to_string()
+            .contains("4 values, the header names 5"));
     }
 }

@@ -34,11 +34,19 @@ pub struct FrameParticles {
 }
 
 /// Reads the per-atom state of a frame by column name, species from `type`.
-pub fn frame_particles(frame: &Frame, scene: &Scene, file: &Path) -> Result<FrameParticles, PostprocessError> {
+pub fn frame_particles(
+    frame: &Frame,
+    scene: &Scene,
+    file: &Path,
+) -> Result<FrameParticles, PostprocessError> {
     let column = |name: &str| {
         frame.column(name).ok_or_else(|| PostprocessError::Content {
             file: file.to_path_buf(),
-            message: format!("step {}: no column `{name}` (columns: {})", frame.step, frame.columns.join(" ")),
+            message: format!(
+                "step {}: no column `{name}` (columns: {})",
+                frame.step,
+                frame.columns.join(" ")
+            ),
         })
     };
     let (x, y, z) = (column("x")?, column("y")?, column("z")?);
@@ -52,10 +60,18 @@ pub fn frame_particles(frame: &Frame, scene: &Scene, file: &Path) -> Result<Fram
     };
     for k in 0..frame.len() {
         let t = types[k] as usize;
-        let species = scene.species.get(t.wrapping_sub(1)).ok_or_else(|| PostprocessError::Content {
-            file: file.to_path_buf(),
-            message: format!("step {}: atom type {t} has no species (the scene has {})", frame.step, scene.species.len()),
-        })?;
+        let species =
+            scene
+                .species
+                .get(t.wrapping_sub(1))
+                .ok_or_else(|| PostprocessError::Content {
+                    file: file.to_path_buf(),
+                    message: format!(
+                        "step {}: atom type {t} has no species (the scene has {})",
+                        frame.step,
+                        scene.species.len()
+                    ),
+                })?;
         out.position.push(Vec3::new(x[k], y[k], z[k]));
         out.velocity.push(Vec3::new(vx[k], vy[k], vz[k]));
         out.radius.push(species.radius());
@@ -79,7 +95,9 @@ fn stage_marks(log: &str) -> Vec<StageMark> {
         if f.len() < 4 || f[0] != "CGDEM_STAGE" {
             continue;
         }
-        let Ok(step) = f[3].parse::<u64>() else { continue };
+        let Ok(step) = f[3].parse::<u64>() else {
+            continue;
+        };
         match f[2] {
             "start" => marks.push(StageMark {
                 name: f[1].into(),
@@ -120,7 +138,14 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> PostprocessError {
 }
 
 /// Post-processes a finished LAMMPS run in `dir` into cgdem's output files and summary.
-pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescales, wall_s: Real, ranks: usize) -> Result<RunSummary, PostprocessError> {
+pub fn postprocess(
+    scene: &Scene,
+    dir: &Path,
+    plan: &DeckPlan,
+    scales: &Timescales,
+    wall_s: Real,
+    ranks: usize,
+) -> Result<RunSummary, PostprocessError> {
     let log_path = dir.join(LOG_FILE);
     let log = std::fs::read_to_string(&log_path).map_err(|e| PostprocessError::Content {
         file: log_path.clone(),
@@ -133,10 +158,16 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
     let max_diameter = scene.max_diameter();
     let floor_z = scene.domain.lo.z;
     let heap_profile = |p: &FrameParticles| -> Option<HeapProfile> {
-        scene
-            .repose
-            .as_ref()
-            .map(|r| heap::profile(&p.position, &p.radius, r.wall_x, scene.domain.hi.x, floor_z, r.bin_width_diameters * max_diameter))
+        scene.repose.as_ref().map(|r| {
+            heap::profile(
+                &p.position,
+                &p.radius,
+                r.wall_x,
+                scene.domain.hi.x,
+                floor_z,
+                r.bin_width_diameters * max_diameter,
+            )
+        })
     };
 
     let mut csv = String::from("time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m\n");
@@ -145,9 +176,16 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
         let p = frame_particles(frame, scene, &traj_path)?;
         let stage = marks
             .iter()
-            .find(|m| frame.step > m.start && m.end.as_ref().is_none_or(|(end, _)| frame.step <= *end))
+            .find(|m| {
+                frame.step > m.start && m.end.as_ref().is_none_or(|(end, _)| frame.step <= *end)
+            })
             .map_or("", |m| m.name.as_str());
-        let ke: Real = p.velocity.iter().zip(&p.mass).map(|(v, m)| 0.5 * m * v.length_squared()).sum();
+        let ke: Real = p
+            .velocity
+            .iter()
+            .zip(&p.mass)
+            .map(|(v, m)| 0.5 * m * v.length_squared())
+            .sum();
         let mass: Real = p.mass.iter().sum();
         let profile = heap_profile(&p);
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
@@ -166,10 +204,18 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
     let path = dir.join("timeseries.csv");
     write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
 
+    let mut warnings = vec!["LAMMPS caps wall friction with the wall dashpot force only, cgdem with WCA + dashpot (reference/lammps/SEED_MODEL.md claim 11)".to_string()];
     let mut samples = Vec::new();
     let mut final_profile = None;
     for (_, t, file) in &plan.repose_dumps {
         let path = dir.join(file);
+        if !path.exists() {
+            // A run stopped early (time limit) has only the samples it reached.
+            warnings.push(format!(
+                "no {file}: the run ended before {t} s into the stage"
+            ));
+            continue;
+        }
         let frames = read_dump(&path)?;
         let Some(frame) = frames.last() else {
             return Err(PostprocessError::Content {
@@ -179,7 +225,12 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
         };
         let p = frame_particles(frame, scene, &path)?;
         if let (Some(profile), Some(r)) = (heap_profile(&p), scene.repose.as_ref()) {
-            let fit = heap::repose_angle(&profile, 2.0 * max_diameter, r.exclude_wall_fraction, r.exclude_toe_fraction);
+            let fit = heap::repose_angle(
+                &profile,
+                2.0 * max_diameter,
+                r.exclude_wall_fraction,
+                r.exclude_toe_fraction,
+            );
             samples.push(ReposeSample {
                 time_after_start_s: *t,
                 repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
@@ -190,7 +241,8 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
             final_profile = Some(profile);
         }
     }
-    let final_profile = final_profile.or_else(|| last_state.as_ref().and_then(|(_, p)| heap_profile(p)));
+    let final_profile =
+        final_profile.or_else(|| last_state.as_ref().and_then(|(_, p)| heap_profile(p)));
     if let Some(profile) = &final_profile {
         let path = dir.join("profile.csv");
         let mut csv = String::from("x_m,height_m\n");
@@ -201,21 +253,32 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
     }
     if !samples.is_empty() {
         let path = dir.join("repose.csv");
-        let mut csv = String::from("time_after_start_s,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n");
+        let mut csv = String::from(
+            "time_after_start_s,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
+        );
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
         for s in &samples {
-            csv += &format!("{},{},{},{:.6e},{:.6e}\n", s.time_after_start_s, opt(s.repose_angle_deg), opt(s.repose_fit_r2), s.runout_m, s.wall_height_m);
+            csv += &format!(
+                "{},{},{},{:.6e},{:.6e}\n",
+                s.time_after_start_s,
+                opt(s.repose_angle_deg),
+                opt(s.repose_fit_r2),
+                s.runout_m,
+                s.wall_height_m
+            );
         }
         write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
     }
 
-    let mut warnings = vec!["LAMMPS caps wall friction with the wall dashpot force only, cgdem with WCA + dashpot (reference/lammps/SEED_MODEL.md claim 11)".to_string()];
     let stages: Vec<StageRecord> = marks
         .iter()
         .map(|m| {
             let (end, how) = m.end.clone().unwrap_or((m.start, "did not finish".into()));
             if how == "max_duration" {
-                warnings.push(format!("stage `{}` did not settle within max_duration", m.name));
+                warnings.push(format!(
+                    "stage `{}` did not settle within max_duration",
+                    m.name
+                ));
             }
             StageRecord {
                 name: m.name.clone(),
@@ -226,7 +289,9 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
             }
         })
         .collect();
-    let steps = marks.last().map_or(0, |m| m.end.as_ref().map_or(m.start, |(end, _)| *end));
+    let steps = marks
+        .last()
+        .map_or(0, |m| m.end.as_ref().map_or(m.start, |(end, _)| *end));
     let n_inserted = frames.first().map_or(0, Frame::len);
     let n_final = last_state.as_ref().map_or(0, |(_, p)| p.position.len());
     let (particle_steps, loop_s) = loop_times(&log);
@@ -243,7 +308,7 @@ pub fn postprocess(scene: &Scene, dir: &Path, plan: &DeckPlan, scales: &Timescal
         contact_period_s: scales.shortest_period,
         stable_dt_s: scales.stable_limit,
         simulated_s: steps as Real * dt,
-        wall_s,
+        wall_s: if wall_s.is_finite() { wall_s } else { loop_s },
         particle_steps,
         particle_steps_per_s: particle_steps as Real / loop_s.max(1e-9),
         threads: ranks,

@@ -30,11 +30,22 @@ impl Default for RunnerOptions {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum RunStatus {
-    Completed { wall_s: f64 },
+    Completed {
+        wall_s: f64,
+    },
     /// LAMMPS is not installed: the comparison cannot run, which is not a failure of cgdem.
-    Skipped { reason: String, install_hint: String },
-    Failed { exit_code: Option<i32>, log_tail: String },
-    TimedOut { after_s: f64, log_tail: String },
+    Skipped {
+        reason: String,
+        install_hint: String,
+    },
+    Failed {
+        exit_code: Option<i32>,
+        log_tail: String,
+    },
+    TimedOut {
+        after_s: f64,
+        log_tail: String,
+    },
 }
 
 /// The `lmp` binary: `$CGDEM_LMP`, else `lmp` on `PATH`.
@@ -76,26 +87,53 @@ pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
     };
     let mut argv: Vec<String> = Vec::new();
     if let Some(np) = options.np {
-        argv.extend(["mpirun".into(), "--allow-run-as-root".into(), "-np".into(), np.to_string()]);
+        argv.extend([
+            "mpirun".into(),
+            "--allow-run-as-root".into(),
+            "-np".into(),
+            np.to_string(),
+        ]);
     }
-    argv.extend([lmp.display().to_string(), "-in".into(), DECK_FILE.into(), "-log".into(), LOG_FILE.into()]);
+    argv.extend([
+        lmp.display().to_string(),
+        "-in".into(),
+        DECK_FILE.into(),
+        "-log".into(),
+        LOG_FILE.into(),
+    ]);
     let failed = |message: String| RunStatus::Failed {
         exit_code: None,
         log_tail: message,
     };
-    if let Err(e) = std::fs::write(dir.join("command.txt"), format!("cd {} && {}\n", dir.display(), argv.join(" "))) {
-        return failed(format!("cannot write {}: {e}", dir.join("command.txt").display()));
+    if let Err(e) = std::fs::write(
+        dir.join("command.txt"),
+        format!("cd {} && {}\n", dir.display(), argv.join(" ")),
+    ) {
+        return failed(format!(
+            "cannot write {}: {e}",
+            dir.join("command.txt").display()
+        ));
     }
     let stdout = match std::fs::File::create(dir.join("stdout.txt")) {
         Ok(f) => f,
-        Err(e) => return failed(format!("cannot create {}: {e}", dir.join("stdout.txt").display())),
+        Err(e) => {
+            return failed(format!(
+                "cannot create {}: {e}",
+                dir.join("stdout.txt").display()
+            ))
+        }
     };
     let stderr = match stdout.try_clone() {
         Ok(f) => f,
         Err(e) => return failed(e.to_string()),
     };
     let mut command = Command::new(&argv[0]);
-    command.args(&argv[1..]).current_dir(dir).stdin(Stdio::null()).stdout(stdout).stderr(stderr);
+    command
+        .args(&argv[1..])
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(stderr);
     #[cfg(unix)]
     {
         // Own process group, so a timeout kills mpirun and every rank together.
@@ -122,7 +160,9 @@ pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
             }
             Ok(None) if started.elapsed() >= options.timeout => {
                 #[cfg(unix)]
-                let _ = Command::new("kill").args(["-KILL", &format!("-{}", child.id())]).status();
+                let _ = Command::new("kill")
+                    .args(["-KILL", &format!("-{}", child.id())])
+                    .status();
                 let _ = child.kill();
                 let _ = child.wait();
                 return RunStatus::TimedOut {
