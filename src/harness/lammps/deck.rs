@@ -343,3 +343,53 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         },
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coarse_graining::coarse_grain;
+
+    #[test]
+    fn collapse_deck_has_removable_walls_settle_loop_and_repose_dumps() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("validation/cases/aor_collapse.toml");
+        let scene = coarse_grain(&Scene::load(&path).unwrap(), 8).unwrap();
+        let mut particles = Particles::new(false);
+        let s = &scene.species[0];
+        particles.push(
+            0,
+            crate::math::Vec3::new(0.05, 0.025, 0.1),
+            s.radius(),
+            s.mass(),
+        );
+        let dt = 1e-6;
+        let deck = write_deck(&scene, &particles, dt).unwrap();
+        assert_eq!(deck.plan.dump_every, 10_000);
+        let d = &deck.input;
+        assert!(d.contains("boundary        f p f"));
+        for wall in ["floor", "back", "gate", "end"] {
+            assert!(
+                d.contains(&format!(
+                    "fix             wlj_{wall} all wall/region w_{wall} lj126"
+                )),
+                "{wall}"
+            );
+        }
+        // The gate goes after the settle loop, before the collapse runs.
+        let settle_end = d.find("label           end_stage0").unwrap();
+        let unfix = d.find("unfix           wgran_gate").unwrap();
+        assert!(
+            settle_end < unfix
+                && unfix < d.find("write_dump      all custom repose_0.dump").unwrap()
+        );
+        assert!(!d.contains("unfix           wgran_floor"));
+        // 0.4 s minimum = 40 chunks of 0.01 s, at most 3 s = 300 chunks.
+        assert!(d.contains("variable        chunk0 loop 300"));
+        assert!(d.contains(&format!("${{chunk0}} >= 40 && ${{kepm}} < {}", g(1e-6))));
+        assert_eq!(deck.plan.repose_dumps.len(), 4);
+        // The data file carries the particle with diameter rc and the species mass.
+        let rc = TWO_POW_ONE_SIXTH * (1.203e-3 * 8.0);
+        let density = s.mass() / (std::f64::consts::PI / 6.0 * rc.powi(3));
+        assert!(deck.data.contains(&format!("1 1 {} {}", g(rc), g(density))));
+    }
+}
