@@ -164,7 +164,7 @@ fn reference_lammps(
             let summary = finish(wall_s, None)?;
             println!(
                 "LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
-                summary.steps, wall_s, summary.particle_steps_per_s
+                summary.steps, summary.wall_s, summary.particle_steps_per_s
             );
             for s in &summary.repose_samples {
                 println!(

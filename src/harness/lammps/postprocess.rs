@@ -270,10 +270,15 @@ pub fn postprocess(
         write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
     }
 
+    // An unfinished stage (stopped run) ends at the last frame written.
+    let last_step = frames.last().map_or(0, |f| f.step);
     let stages: Vec<StageRecord> = marks
         .iter()
         .map(|m| {
-            let (end, how) = m.end.clone().unwrap_or((m.start, "did not finish".into()));
+            let (end, how) = m
+                .end
+                .clone()
+                .unwrap_or((last_step.max(m.start), "did not finish".into()));
             if how == "max_duration" {
                 warnings.push(format!(
                     "stage `{}` did not settle within max_duration",
@@ -289,9 +294,11 @@ pub fn postprocess(
             }
         })
         .collect();
-    let steps = marks
-        .last()
-        .map_or(0, |m| m.end.as_ref().map_or(m.start, |(end, _)| *end));
+    let steps = marks.last().map_or(0, |m| {
+        m.end
+            .as_ref()
+            .map_or(last_step.max(m.start), |(end, _)| *end)
+    });
     let n_inserted = frames.first().map_or(0, Frame::len);
     let n_final = last_state.as_ref().map_or(0, |(_, p)| p.position.len());
     let (particle_steps, loop_s) = loop_times(&log);
