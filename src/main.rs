@@ -6,7 +6,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use cgdem::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
+use cgdem::coarse_graining::{
+    coarse_grain, coarse_grain_by, coarse_grain_warnings, CoarseGrainRule,
+};
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
@@ -36,6 +38,9 @@ enum Command {
         /// viscous flows keep their speed; see reference/COARSE_GRAINING.md).
         #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
         cg_rule: CoarseGrainRule,
+        /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
+        #[arg(long)]
+        seed: Option<u64>,
         /// Output directory (default: runs/<case>-lambda<N>).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -54,15 +59,268 @@ enum Command {
         #[arg(long)]
         strict: bool,
     },
+    /// Run a validation suite (validation/suites/*.toml) with cgdem and the reference codes,
+    /// compare the runs and write DIR/index.html, DIR/summary.json, figures and their CSV.
+    Validate {
+        /// The suite: a name in validation/suites (smoke, nightly, full) or a path.
+        #[arg(long, default_value = "smoke")]
+        suite: String,
+        /// Output directory.
+        #[arg(long, default_value = "reports/latest")]
+        out: PathBuf,
+        /// Worker threads for cgdem (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Time limit of one reference-code run, seconds.
+        #[arg(long, default_value_t = 3600)]
+        reference_timeout: u64,
+        /// No per-run progress lines.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Run a scene in a reference code (deck written from the scene, run, post-processed
+    /// with cgdem's analysis into the same outputs).
+    Reference {
+        #[command(subcommand)]
+        code: ReferenceCode,
+    },
+}
+
+#[derive(Subcommand)]
+enum ReferenceCode {
+    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP); see reference/lammps/SEED_MODEL.md.
+    Lammps {
+        /// The scene file, e.g. validation/cases/aor_collapse.toml.
+        case: PathBuf,
+        /// Coarse-graining level (a power of two), applied before the deck is written.
+        #[arg(long, default_value_t = 1)]
+        lambda: u32,
+        /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output directory (default: runs/<case>-lambda<N>-lammps).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp`); default: serial.
+        #[arg(long)]
+        np: Option<u32>,
+        /// Kill LAMMPS after this many seconds.
+        #[arg(long, default_value_t = 7200)]
+        timeout: u64,
+        /// Write the deck even if the time step exceeds the stable limit.
+        #[arg(long)]
+        force_dt: bool,
+        /// Do not run: post-process the LAMMPS outputs already in --out (e.g. of a run that
+        /// was stopped; the samples it reached are used).
+        #[arg(long)]
+        postprocess_only: bool,
+    },
+}
+
+#[allow(clippy::too_many_arguments)]
+fn reference_lammps(
+    case: &std::path::Path,
+    lambda: u32,
+    seed: Option<u64>,
+    out: Option<PathBuf>,
+    np: Option<u32>,
+    timeout: u64,
+    force_dt: bool,
+    postprocess_only: bool,
+) -> Result<ExitCode, String> {
+    use cgdem::harness::lammps::{self, RunStatus, RunnerOptions};
+    let scene = Scene::load(case).map_err(|e| e.to_string())?;
+    let scene = match seed {
+        Some(s) => scene.with_insertion_seed(s),
+        None => scene,
+    };
+    let scene = coarse_grain(&scene, lambda).map_err(|e| e.to_string())?;
+    let out = out.unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda))
+    });
+    let (dt, scales, warning) =
+        cgdem::run::time_step(&scene, force_dt).map_err(|e| e.to_string())?;
+    if let Some(w) = warning {
+        eprintln!("warning: {w}");
+    }
+    let particles = cgdem::run::initial_particles(&scene, false).map_err(|e| e.to_string())?;
+    let deck = lammps::write_deck(&scene, &particles, dt).map_err(|e| e.to_string())?;
+    let finish = |wall_s: f64, note: Option<String>| -> Result<cgdem::run::RunSummary, String> {
+        let mut summary = lammps::postprocess(
+            &scene,
+            &out,
+            &deck.plan,
+            &scales,
+            wall_s,
+            np.unwrap_or(1) as usize,
+        )
+        .map_err(|e| e.to_string())?;
+        summary.warnings.extend(note);
+        lammps::write_summary(&summary, &out).map_err(|e| e.to_string())?;
+        Ok(summary)
+    };
+    let status = if postprocess_only {
+        let previous = std::fs::read_to_string(out.join(lammps::deck::DECK_FILE)).map_err(|e| {
+            format!(
+                "--postprocess-only: cannot read {}: {e}",
+                out.join(lammps::deck::DECK_FILE).display()
+            )
+        })?;
+        if previous != deck.input {
+            return Err(format!(
+                "--postprocess-only: {} was not written for this case, lambda and seed",
+                out.join(lammps::deck::DECK_FILE).display()
+            ));
+        }
+        RunStatus::Completed { wall_s: f64::NAN }
+    } else {
+        deck.write_to(&out)
+            .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
+        println!(
+            "deck for {} at lambda = {} ({} particles, dt = {dt:.4e} s) in {}",
+            scene.name,
+            scene.lambda,
+            particles.len(),
+            out.display()
+        );
+        let options = RunnerOptions {
+            np,
+            timeout: std::time::Duration::from_secs(timeout),
+        };
+        lammps::run_deck(&out, &options)
+    };
+    match status {
+        RunStatus::Completed { wall_s } => {
+            let summary = finish(wall_s, None)?;
+            println!(
+                "LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
+                summary.steps, summary.wall_s, summary.particle_steps_per_s
+            );
+            for s in &summary.repose_samples {
+                println!(
+                    "  t = {} s after `{}` start: repose angle {} deg, run-out {:.4} m",
+                    s.time_after_start_s,
+                    summary.stages.last().map_or("", |st| st.name.as_str()),
+                    s.repose_angle_deg.map_or("-".into(), |a| format!("{a:.2}")),
+                    s.runout_m
+                );
+            }
+            println!("outputs in {}", out.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => {
+            println!("skipped: {reason}; install with `{install_hint}`");
+            Ok(ExitCode::SUCCESS)
+        }
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => Err(format!(
+            "LAMMPS failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}",
+            out.display()
+        )),
+        RunStatus::TimedOut { after_s, log_tail } => {
+            // Keep what the run reached: partial outputs and a summary that says so.
+            let note = format!("LAMMPS killed after {after_s:.0} s (--timeout): partial run");
+            let partial = finish(after_s, Some(note))
+                .err()
+                .map_or(String::new(), |e| {
+                    format!(" (post-processing the partial run failed: {e})")
+                });
+            Err(format!("LAMMPS killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}", out.display()))
+        }
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Validate {
+            suite,
+            out,
+            threads,
+            reference_timeout,
+            quiet,
+        } => {
+            let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
+                PathBuf::from(&suite)
+            } else {
+                PathBuf::from("validation/suites").join(format!("{suite}.toml"))
+            };
+            let pool = match rayon::ThreadPoolBuilder::new()
+                .num_threads(threads.unwrap_or(0))
+                .build()
+            {
+                Ok(pool) => pool,
+                Err(e) => {
+                    eprintln!("error: cannot start the worker threads: {e}");
+                    return ExitCode::FAILURE;
+                }
+            };
+            let options = cgdem::harness::validate::ValidateOptions {
+                suite: suite_path,
+                out: out.clone(),
+                quiet,
+                reference_timeout_s: reference_timeout,
+            };
+            match pool.install(|| cgdem::harness::validate::validate(&options)) {
+                Ok(summary) => {
+                    let failed = summary.comparisons.iter().filter(|c| !c.pass).count();
+                    let runs_failed = summary.runs.iter().filter(|r| r.status == "failed").count();
+                    println!(
+                        "suite {}: {} runs ({} failed, {} skipped), {} comparisons ({} outside tolerance); report in {}",
+                        summary.suite,
+                        summary.runs.len(),
+                        runs_failed,
+                        summary.runs.iter().filter(|r| r.status == "skipped").count(),
+                        summary.comparisons.len(),
+                        failed,
+                        out.join("index.html").display()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Reference {
+            code:
+                ReferenceCode::Lammps {
+                    case,
+                    lambda,
+                    seed,
+                    out,
+                    np,
+                    timeout,
+                    force_dt,
+                    postprocess_only,
+                },
+        } => match reference_lammps(
+            &case,
+            lambda,
+            seed,
+            out,
+            np,
+            timeout,
+            force_dt,
+            postprocess_only,
+        ) {
+            Ok(code) => code,
+            Err(message) => {
+                eprintln!("error: {message}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Run {
             case,
             lambda,
             cg_rule,
+            seed,
             out,
             threads,
             quiet,
@@ -88,6 +346,10 @@ fn main() -> ExitCode {
             let result = pool.install(|| {
                 Scene::load(&case)
                     .map_err(|e| e.to_string())
+                    .map(|scene| match seed {
+                        Some(s) => scene.with_insertion_seed(s),
+                        None => scene,
+                    })
                     .and_then(|scene| {
                         let warnings = coarse_grain_warnings(&scene, lambda);
                         if strict && !warnings.is_empty() {

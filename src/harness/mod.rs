@@ -1,5 +1,7 @@
-//! The validation harness: suites of cases run by cgdem and the reference codes, compared
-//! and reported. The solver core never depends on this module.
+//! The validation harness: writes reference-code inputs for a scene, runs them, turns their
+//! outputs into cgdem's summary format, and runs suites of cases into compared reports.
+//! The solver core never imports this module.
 
+pub mod lammps;
 pub mod suite;
 pub mod validate;

@@ -82,6 +82,8 @@ pub struct ValidateOptions {
     pub suite: PathBuf,
     pub out: PathBuf,
     pub quiet: bool,
+    /// Time limit of one reference-code run, seconds.
+    pub reference_timeout_s: u64,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -300,10 +302,8 @@ fn run_case(
                     };
                     let outcome = match code {
                         Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options.quiet),
-                        other => Err(RunOutcome::Skipped(format!(
-                            "{} runs of this case are not wired into the harness yet",
-                            other.name()
-                        ))),
+                        Code::Lammps => run_lammps(scene, lambda, rule, seed, &dir, options.reference_timeout_s),
+                        Code::Liggghts => Err(RunOutcome::Skipped("LIGGGHTS cannot express the seed's WCA model; Hertz decks for LIGGGHTS are not written yet".into())),
                     };
                     match outcome {
                         Ok(()) => fill_from_summary(&mut record),
@@ -342,15 +342,6 @@ enum RunOutcome {
     Failed(String),
 }
 
-/// The scene with every insertion re-seeded from `seed` (a different random packing).
-pub fn reseeded(scene: &Scene, seed: u64) -> Scene {
-    let mut scene = scene.clone();
-    for (k, ins) in scene.insertions.iter_mut().enumerate() {
-        ins.seed = seed.wrapping_mul(1_000_003).wrapping_add(k as u64);
-    }
-    scene
-}
-
 fn run_cgdem(
     scene: &Scene,
     lambda: u32,
@@ -359,7 +350,7 @@ fn run_cgdem(
     dir: &Path,
     quiet: bool,
 ) -> Result<(), RunOutcome> {
-    let coarse = coarse_grain_by(&reseeded(scene, seed), lambda, rule)
+    let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
     let options = RunOptions {
         out_dir: dir.to_path_buf(),
@@ -369,6 +360,47 @@ fn run_cgdem(
     run(&coarse, &options)
         .map(|_| ())
         .map_err(|e| RunOutcome::Failed(e.to_string()))
+}
+
+fn run_lammps(
+    scene: &Scene,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    timeout_s: u64,
+) -> Result<(), RunOutcome> {
+    use super::lammps::{run_reference, RunStatus, RunnerOptions};
+    let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))?;
+    let options = RunnerOptions {
+        np: None,
+        timeout: std::time::Duration::from_secs(timeout_s),
+    };
+    match run_reference(&coarse, dir, &options).map_err(RunOutcome::Failed)? {
+        (RunStatus::Completed { .. }, _) => Ok(()),
+        (
+            RunStatus::Skipped {
+                reason,
+                install_hint,
+            },
+            _,
+        ) => Err(RunOutcome::Skipped(format!(
+            "{reason}; install with `{install_hint}`"
+        ))),
+        (
+            RunStatus::Failed {
+                exit_code,
+                log_tail,
+            },
+            _,
+        ) => Err(RunOutcome::Failed(format!(
+            "LAMMPS exit code {exit_code:?}; log tail: {log_tail}"
+        ))),
+        (RunStatus::TimedOut { after_s, log_tail }, _) => Err(RunOutcome::Failed(format!(
+            "LAMMPS timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
+        ))),
+    }
 }
 
 fn fill_from_summary(record: &mut RunRecord) {

@@ -34,6 +34,8 @@ pub struct RunOptions {
 
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
+    #[error("{0}")]
+    NotAvailable(String),
     #[error("{file}: time step: {source}")]
     TimeStep {
         file: String,
@@ -124,6 +126,40 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> 
     }
 }
 
+/// The time step cgdem uses for a seed-model scene, with the contact time scales behind it
+/// (the reference decks run at the same step).
+pub fn time_step(
+    scene: &Scene,
+    force_dt: bool,
+) -> Result<(Real, Timescales, Option<String>), RunError> {
+    match &scene.contact {
+        ContactSettings::Wca { .. } => {
+            let (law, wall_law) = seed_laws(scene);
+            time_step_for(scene, &law, &wall_law, force_dt)
+        }
+        ContactSettings::Hertz(_) => Err(RunError::NotAvailable(format!(
+            "{}: the time step of a Hertz scene is chosen when it runs (it depends on the law combination)",
+            scene.source.display()
+        ))),
+    }
+}
+
+pub(crate) fn time_step_for<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    law: &L,
+    wall_law: &W,
+    force_dt: bool,
+) -> Result<(Real, Timescales, Option<String>), RunError> {
+    let scales = Timescales::of(&linear_contacts(scene, law, wall_law));
+    let (dt, warning) = timestep::choose(scene.time_step, &scales, force_dt).map_err(|source| {
+        RunError::TimeStep {
+            file: scene.source.display().to_string(),
+            source,
+        }
+    })?;
+    Ok((dt, scales, warning))
+}
+
 /// The seed's particle law and wall law for a scene with `ContactSettings::Wca`.
 pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
     let ContactSettings::Wca {
@@ -180,7 +216,8 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
     contacts
 }
 
-fn build_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError> {
+/// The scene's particles as inserted, before any step (the reference codes start from them).
+pub fn initial_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError> {
     let mut particles = Particles::new(rotation);
     for (index, ins) in scene.insertions.iter().enumerate() {
         let species = &scene.species[ins.species];
@@ -210,7 +247,8 @@ fn build_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError>
     Ok(particles)
 }
 
-fn build_walls(scene: &Scene) -> WallSet {
+/// The scene's walls as planes bounded by the box.
+pub fn scene_walls(scene: &Scene) -> WallSet {
     // Scene walls are bounded by the box: half-extents of the box diagonal cover it.
     let half = scene.domain.length().length();
     WallSet {
@@ -235,20 +273,13 @@ fn execute<L: PairLaw, W: WallLaw>(
     let out = &options.out_dir;
     std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
     let file = scene.source.display().to_string();
-    let scales = Timescales::of(&linear_contacts(scene, &law, &wall_law));
-    let (dt, warning) =
-        timestep::choose(scene.time_step, &scales, options.force_dt).map_err(|source| {
-            RunError::TimeStep {
-                file: file.clone(),
-                source,
-            }
-        })?;
+    let (dt, scales, warning) = time_step_for(scene, &law, &wall_law, options.force_dt)?;
     let mut warnings: Vec<String> = warning.into_iter().collect();
     for w in &warnings {
         eprintln!("warning: {w}");
     }
 
-    let particles = build_particles(scene, L::NEEDS_ROTATION)?;
+    let particles = initial_particles(scene, L::NEEDS_ROTATION)?;
     let n_inserted = particles.len();
     let neighbor = NeighborSettings {
         skin: scene.skin_fraction * scene.max_diameter(),
@@ -257,7 +288,7 @@ fn execute<L: PairLaw, W: WallLaw>(
     let mut world = World::new(
         particles,
         scene.domain.clone(),
-        build_walls(scene),
+        scene_walls(scene),
         law,
         wall_law,
         scene.species.len(),
@@ -468,37 +499,13 @@ fn execute<L: PairLaw, W: WallLaw>(
     let final_profile = final_profile.or_else(|| heap_profile(&world));
     if let Some(profile) = &final_profile {
         let path = out.join("profile.csv");
-        let mut csv = String::from("x_m,height_m\n");
-        for (k, h) in profile.heights.iter().enumerate() {
-            csv += &format!("{:.6e},{:.6e}\n", profile.bin_centre(k), h);
-        }
-        write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
+        write_atomic(&path, profile_csv(profile).as_bytes()).map_err(|e| output_error(&path, e))?;
     }
     if !samples.is_empty() {
         let path = out.join("repose.csv");
-        let mut csv = String::from(
-            "time_after_start_s,trigger,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
-        );
-        let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
-        for s in &samples {
-            csv += &format!(
-                "{},{},{},{},{:.6e},{:.6e}\n",
-                s.time_after_start_s,
-                s.trigger,
-                opt(s.repose_angle_deg),
-                opt(s.repose_fit_r2),
-                s.runout_m,
-                s.wall_height_m
-            );
-        }
-        write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
+        write_atomic(&path, repose_csv(&samples).as_bytes()).map_err(|e| output_error(&path, e))?;
     }
-    // The headline: the stage-end sample when the scene asks for one, else the last fixed time.
-    let headline = samples
-        .iter()
-        .rev()
-        .find(|s| s.trigger == "stage end")
-        .or(samples.last());
+    let headline = headline_sample(&samples);
     let summary = RunSummary {
         case: scene.name.clone(),
         code: "cgdem".into(),
@@ -555,4 +562,43 @@ fn describe_end(end: &StageEnd) -> String {
             max_duration,
         } => format!("kinetic energy per mass below {kinetic_energy_per_mass:e} J/kg, after at least {min_duration} s and at most {max_duration} s"),
     }
+}
+
+/// `profile.csv`: the heap surface height per bin.
+pub fn profile_csv(profile: &HeapProfile) -> String {
+    let mut csv = String::from("x_m,height_m\n");
+    for (k, h) in profile.heights.iter().enumerate() {
+        csv += &format!("{:.6e},{:.6e}\n", profile.bin_centre(k), h);
+    }
+    csv
+}
+
+/// `repose.csv`: the angle at each measurement.
+pub fn repose_csv(samples: &[ReposeSample]) -> String {
+    let mut csv = String::from(
+        "time_after_start_s,trigger,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
+    );
+    let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
+    for s in samples {
+        csv += &format!(
+            "{},{},{},{},{:.6e},{:.6e}\n",
+            s.time_after_start_s,
+            s.trigger,
+            opt(s.repose_angle_deg),
+            opt(s.repose_fit_r2),
+            s.runout_m,
+            s.wall_height_m
+        );
+    }
+    csv
+}
+
+/// The headline measurement: the stage-end sample when the scene asks for one, else the last
+/// fixed time.
+pub fn headline_sample(samples: &[ReposeSample]) -> Option<&ReposeSample> {
+    samples
+        .iter()
+        .rev()
+        .find(|s| s.trigger == "stage end")
+        .or(samples.last())
 }

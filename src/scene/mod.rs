@@ -220,6 +220,15 @@ impl Scene {
         validate::scene(raw, path)
     }
 
+    /// The same scene with insertion `k` seeded by `seed + k` (a different random packing).
+    pub fn with_insertion_seed(&self, seed: u64) -> Scene {
+        let mut out = self.clone();
+        for (k, ins) in out.insertions.iter_mut().enumerate() {
+            ins.seed = seed.wrapping_add(k as u64);
+        }
+        out
+    }
+
     pub fn max_diameter(&self) -> Real {
         self.species.iter().map(|s| s.diameter).fold(0.0, Real::max)
     }

@@ -1,0 +1,399 @@
+//! The LAMMPS input for a scene with `ContactSettings::Wca`, written from the scene alone.
+//!
+//! The scene must already be coarse-grained (the deck never sees lambda). Every number comes
+//! from the scene, the particles and the time step passed in; the lines follow the verified
+//! forms in `reference/lammps/SEED_MODEL.md`:
+//!
+//! - pair: `hybrid/overlay lj/cut rc granular`, `lj/cut` shifted (exactly the WCA), granular
+//!   `hooke 0.0 gamma_n damping velocity tangential linear_nohistory (gamma_t/gamma_n) 1e8`;
+//!   every atom's diameter is `rc = 2^(1/6) sigma` so the dashpots act exactly while the WCA
+//!   does (cgdem's rule), and the mass is set per type from the species (`rho pi d^3 / 6`).
+//! - walls: each named plane is a `region plane` with a removable pair of fixes
+//!   `wall/region lj126 eps sigma/2 rc/2` (the mirror WCA `Phi(h) = phi(2h)`) and
+//!   `wall/gran/region granular hooke 0.0 gamma_w damping velocity tangential
+//!   linear_nohistory m/(2 dt gamma_w) mu_w`; a stage's `remove_walls` becomes `unfix`.
+//!   Known difference: LAMMPS caps wall friction with the dashpot force only, cgdem with
+//!   WCA + dashpot (SEED_MODEL.md claim 11).
+//! - integration: `fix nve` (no rotation), which splits velocity Verlet exactly as cgdem does.
+//! - stages: a settle stage runs in chunks of one time-series interval and stops at the
+//!   first chunk end after `min_duration` with kinetic energy per mass below the threshold;
+//!   a duration stage runs its steps, stopping at each repose time for a `write_dump`.
+//! - output: `dump custom id type x y z vx vy vz radius` every time-series interval, full
+//!   precision; the log marks stage boundaries with `CGDEM_STAGE` lines.
+
+use std::fmt::Write as _;
+
+use crate::math::{Real, TWO_POW_ONE_SIXTH};
+use crate::particles::Particles;
+use crate::scene::{ContactSettings, Scene, StageEnd};
+use crate::walls::restitution_damping_ratio;
+
+/// File names inside a LAMMPS run directory.
+pub const DECK_FILE: &str = "deck.in";
+pub const DATA_FILE: &str = "particles.data";
+pub const TRAJECTORY_FILE: &str = "traj.dump";
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum DeckError {
+    #[error("{file}: cannot express this scene in LAMMPS: {reason}")]
+    Unsupported { file: String, reason: String },
+}
+
+/// What the deck will do, for post-processing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeckPlan {
+    pub dt: Real,
+    /// Steps between trajectory frames (one time-series interval).
+    pub dump_every: u64,
+    /// (stage, time after the stage starts, dump file) of each repose sample.
+    pub repose_dumps: Vec<(String, Real, String)>,
+}
+
+/// The deck text, the data file text and the plan.
+#[derive(Clone, Debug)]
+pub struct Deck {
+    pub input: String,
+    pub data: String,
+    pub plan: DeckPlan,
+}
+
+impl Deck {
+    /// Writes `deck.in` and `particles.data` into `dir`.
+    pub fn write_to(&self, dir: &std::path::Path) -> std::io::Result<()> {
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(dir.join(DECK_FILE), &self.input)?;
+        std::fs::write(dir.join(DATA_FILE), &self.data)
+    }
+}
+
+fn g(x: Real) -> String {
+    format!("{x:.17e}")
+}
+
+/// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`.
+pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
+    let unsupported = |reason: String| DeckError::Unsupported {
+        file: scene.source.display().to_string(),
+        reason,
+    };
+    let ContactSettings::Wca {
+        epsilon,
+        sigma,
+        gamma_n,
+        gamma_t,
+    } = scene.contact
+    else {
+        return Err(unsupported(
+            "only the seed's WCA model has a LAMMPS deck writer so far (Hertz decks are not written yet)".into(),
+        ));
+    };
+    if gamma_n <= 0.0 {
+        return Err(unsupported(
+            "gamma_n = 0: LAMMPS sets gamma_t as a multiple of gamma_n".into(),
+        ));
+    }
+    if !dt.is_finite() || dt <= 0.0 {
+        return Err(unsupported(format!("time step {dt} s")));
+    }
+    let rc = TWO_POW_ONE_SIXTH * sigma;
+    let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
+    let wall_mass = masses[0];
+    if !scene.walls.is_empty()
+        && masses
+            .iter()
+            .any(|&m| (m - wall_mass).abs() > 1e-12 * wall_mass)
+    {
+        return Err(unsupported(
+            "walls with species of different masses: fix wall/gran takes one gamma_w for all atoms"
+                .into(),
+        ));
+    }
+    let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
+    let (lo, hi) = (scene.domain.lo, scene.domain.hi);
+
+    // Data file: cgdem's own particles, so both codes start from the same packing.
+    let mut data = format!(
+        "LAMMPS data file written by cgdem {} for scene {} (lambda = {})\n\n{} atoms\n{} atom types\n\n",
+        env!("CARGO_PKG_VERSION"),
+        scene.name,
+        scene.lambda,
+        particles.len(),
+        scene.species.len()
+    );
+    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+        let _ = writeln!(data, "{} {} {name}lo {name}hi", g(lo[axis]), g(hi[axis]));
+    }
+    data += "\nAtoms # sphere\n\n";
+    let volume = std::f64::consts::PI / 6.0 * rc.powi(3);
+    for k in 0..particles.len() {
+        let species = particles.species[k] as usize;
+        let p = particles.position[k];
+        let _ = writeln!(
+            data,
+            "{} {} {} {} {} {} {}",
+            particles.id[k] + 1,
+            species + 1,
+            g(rc),
+            g(masses[species] / volume),
+            g(p.x),
+            g(p.y),
+            g(p.z)
+        );
+    }
+    data += "\nVelocities\n\n";
+    for k in 0..particles.len() {
+        let v = particles.velocity[k];
+        let _ = writeln!(
+            data,
+            "{} {} {} {} 0 0 0",
+            particles.id[k] + 1,
+            g(v.x),
+            g(v.y),
+            g(v.z)
+        );
+    }
+
+    let mut d = String::new();
+    let _ = writeln!(
+        d,
+        "# LAMMPS input written by cgdem {} from {} (scene `{}`, lambda = {}).",
+        env!("CARGO_PKG_VERSION"),
+        scene.source.display(),
+        scene.name,
+        scene.lambda
+    );
+    let _ = writeln!(d, "# Model lines: reference/lammps/SEED_MODEL.md. Do not edit: rewrite with `cgdem reference lammps`.");
+    d += "units           si\natom_style      sphere\natom_modify     map array\n";
+    let flag = |axis: usize| {
+        if scene.domain.periodic[axis] {
+            "p"
+        } else {
+            "f"
+        }
+    };
+    let _ = writeln!(d, "boundary        {} {} {}", flag(0), flag(1), flag(2));
+    d += "newton          off\ncomm_modify     vel yes\n";
+    let _ = writeln!(d, "read_data       {DATA_FILE}");
+    // Diameter rc for the granular contact range; mass from the species' own diameter.
+    for (t, m) in masses.iter().enumerate() {
+        let _ = writeln!(
+            d,
+            "set             type {} mass {}   # {}: rho pi d^3/6, d = {} m",
+            t + 1,
+            g(*m),
+            scene.species[t].name,
+            scene.species[t].diameter
+        );
+    }
+    let _ = writeln!(
+        d,
+        "pair_style      hybrid/overlay lj/cut {} granular",
+        g(rc)
+    );
+    let _ = writeln!(
+        d,
+        "pair_coeff      * * lj/cut {} {} {}",
+        g(epsilon),
+        g(sigma),
+        g(rc)
+    );
+    let _ = writeln!(d, "pair_coeff      * * granular hooke 0.0 {} damping velocity tangential linear_nohistory {} 1.0e8", g(gamma_n), g(gamma_t / gamma_n));
+    d += "pair_modify     pair lj/cut shift yes\n";
+    let _ = writeln!(
+        d,
+        "neighbor        {} bin",
+        g(scene.skin_fraction * scene.max_diameter())
+    );
+    d += "neigh_modify    every 1 delay 0 check yes\n";
+    d += "fix             integ all nve\n";
+    let gravity = scene.gravity;
+    if gravity.length() > 0.0 {
+        let dir = gravity / gravity.length();
+        let _ = writeln!(
+            d,
+            "fix             grav all gravity {} vector {} {} {}",
+            g(gravity.length()),
+            g(dir.x),
+            g(dir.y),
+            g(dir.z)
+        );
+    }
+    let _ = writeln!(d, "timestep        {}", g(dt));
+
+    if !scene.walls.is_empty() {
+        let stiffness = 4.0 * 72.0 * epsilon / (rc * rc);
+        let gamma_w = 2.0
+            * restitution_damping_ratio(scene.wall_contact.restitution)
+            * (stiffness * wall_mass).sqrt();
+        let x_t = wall_mass / (2.0 * dt * gamma_w);
+        let _ = writeln!(
+            d,
+            "# walls: mirror WCA + dashpot gamma_w = {} kg/s (restitution {}), friction {}",
+            g(gamma_w),
+            scene.wall_contact.restitution,
+            scene.wall_contact.friction
+        );
+        for w in &scene.walls {
+            let (p, n) = (w.point, w.normal);
+            let _ = writeln!(
+                d,
+                "region          w_{} plane {} {} {} {} {} {} side in units box",
+                w.name,
+                g(p.x),
+                g(p.y),
+                g(p.z),
+                g(n.x),
+                g(n.y),
+                g(n.z)
+            );
+            let _ = writeln!(
+                d,
+                "fix             wlj_{0} all wall/region w_{0} lj126 {1} {2} {3}",
+                w.name,
+                g(epsilon),
+                g(0.5 * sigma),
+                g(0.5 * rc)
+            );
+            let _ = writeln!(d, "fix             wgran_{0} all wall/gran/region granular hooke 0.0 {1} damping velocity tangential linear_nohistory {2} {3} region w_{0}", w.name, g(gamma_w), g(x_t), g(scene.wall_contact.friction));
+        }
+    }
+
+    d += "compute         ke all ke\nvariable        kepm equal c_ke/mass(all)\n";
+    d += "thermo_style    custom step time atoms c_ke v_kepm\n";
+    let _ = writeln!(d, "thermo          {dump_every}");
+    d += "thermo_modify   lost ignore norm no\n";
+    let _ = writeln!(d, "dump            traj all custom {dump_every} {TRAJECTORY_FILE} id type x y z vx vy vz radius");
+    d += "dump_modify     traj format float %.16g sort id\n";
+    d += "run             0 post no\n";
+
+    let mut repose_dumps = Vec::new();
+    for (k, stage) in scene.stages.iter().enumerate() {
+        let _ = writeln!(d, "\n# stage `{}`", stage.name);
+        for name in &stage.remove_walls {
+            let _ = writeln!(
+                d,
+                "unfix           wlj_{name}\nunfix           wgran_{name}"
+            );
+        }
+        let _ = writeln!(
+            d,
+            "print           \"CGDEM_STAGE {} start $(step)\"",
+            stage.name
+        );
+        let repose_times: Vec<Real> = match &scene.repose {
+            Some(r) if r.stage == stage.name => r.at_times.clone(),
+            _ => Vec::new(),
+        };
+        match stage.end {
+            StageEnd::Duration(duration) => {
+                let total = (duration / dt).round() as u64;
+                let mut done = 0;
+                for (j, &t) in repose_times.iter().enumerate() {
+                    let at = ((t / dt).round() as u64).min(total);
+                    if at > done {
+                        let _ = writeln!(d, "run             {} post no", at - done);
+                        done = at;
+                    }
+                    let file = format!("repose_{j}.dump");
+                    let _ = writeln!(d, "write_dump      all custom {file} id type x y z vx vy vz radius modify format float %.16g sort id");
+                    repose_dumps.push((stage.name.clone(), t, file));
+                }
+                if total > done {
+                    let _ = writeln!(d, "run             {} post no", total - done);
+                }
+                let _ = writeln!(
+                    d,
+                    "print           \"CGDEM_STAGE {} end $(step) duration\"",
+                    stage.name
+                );
+            }
+            StageEnd::Settled {
+                kinetic_energy_per_mass,
+                min_duration,
+                max_duration,
+            } => {
+                let chunk_s = dump_every as Real * dt;
+                let min_chunks = (min_duration / chunk_s - 1e-9).ceil().max(0.0) as u64;
+                let max_chunks = ((max_duration / chunk_s).round() as u64).max(1);
+                let (var, label) = (format!("chunk{k}"), format!("stage{k}"));
+                let _ = writeln!(d, "variable        {var} loop {max_chunks}");
+                let _ = writeln!(d, "label           loop_{label}");
+                let _ = writeln!(d, "run             {dump_every} pre no post no");
+                // Fixed-time repose samples inside a stage that ends by itself: the loop
+                // counts chunks of one output interval, so sample j is chunk round(t_j / chunk).
+                for (j, &t) in repose_times.iter().enumerate() {
+                    let chunk = ((t / chunk_s).round() as u64).max(1);
+                    let file = format!("repose_{j}.dump");
+                    let _ = writeln!(d, "if              \"${{{var}}} == {chunk}\" then \"write_dump all custom {file} id type x y z vx vy vz radius modify format float %.16g sort id\"");
+                    repose_dumps.push((stage.name.clone(), t, file));
+                }
+                let _ = writeln!(d, "if              \"${{{var}}} >= {min_chunks} && ${{kepm}} < {}\" then \"print 'CGDEM_STAGE {} end $(step) settled'\" \"jump SELF end_{label}\"", g(kinetic_energy_per_mass), stage.name);
+                let _ = writeln!(d, "next            {var}");
+                let _ = writeln!(d, "jump            SELF loop_{label}");
+                let _ = writeln!(
+                    d,
+                    "print           \"CGDEM_STAGE {} end $(step) max_duration\"",
+                    stage.name
+                );
+                let _ = writeln!(d, "label           end_{label}");
+                let _ = writeln!(d, "variable        {var} delete");
+            }
+        }
+    }
+    Ok(Deck {
+        input: d,
+        data,
+        plan: DeckPlan {
+            dt,
+            dump_every,
+            repose_dumps,
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coarse_graining::coarse_grain;
+
+    #[test]
+    fn collapse_deck_has_removable_walls_settle_loop_and_repose_dumps() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("validation/cases/aor_collapse.toml");
+        let scene = coarse_grain(&Scene::load(&path).unwrap(), 8).unwrap();
+        let mut particles = Particles::new(false);
+        let s = &scene.species[0];
+        particles.push(
+            0,
+            crate::math::Vec3::new(0.05, 0.025, 0.1),
+            s.radius(),
+            s.mass(),
+        );
+        let dt = 1e-6;
+        let deck = write_deck(&scene, &particles, dt).unwrap();
+        assert_eq!(deck.plan.dump_every, 10_000);
+        let d = &deck.input;
+        assert!(d.contains("boundary        f p f"));
+        for wall in ["floor", "back", "gate", "end"] {
+            assert!(
+                d.contains(&format!(
+                    "fix             wlj_{wall} all wall/region w_{wall} lj126"
+                )),
+                "{wall}"
+            );
+        }
+        // The gate goes after the settle loop, before the collapse runs.
+        let settle_end = d.find("label           end_stage0").unwrap();
+        let unfix = d.find("unfix           wgran_gate").unwrap();
+        assert!(settle_end < unfix && unfix < d.find("repose_0.dump").unwrap());
+        assert!(!d.contains("unfix           wgran_floor"));
+        // 0.4 s minimum = 40 chunks of 0.01 s, at most 3 s = 300 chunks.
+        assert!(d.contains("variable        chunk0 loop 300"));
+        assert!(d.contains(&format!("${{chunk0}} >= 40 && ${{kepm}} < {}", g(1e-6))));
+        assert_eq!(deck.plan.repose_dumps.len(), 4);
+        // The data file carries the particle with diameter rc and the species mass.
+        let rc = TWO_POW_ONE_SIXTH * (1.203e-3 * 8.0);
+        let density = s.mass() / (std::f64::consts::PI / 6.0 * rc.powi(3));
+        assert!(deck.data.contains(&format!("1 1 {} {}", g(rc), g(density))));
+    }
+}

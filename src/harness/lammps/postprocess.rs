@@ -1,0 +1,368 @@
+//! LAMMPS dumps turned into cgdem's outputs with cgdem's own analysis (`analysis::heap`):
+//! `timeseries.csv` (same columns), `repose.csv`, `profile.csv` and `summary.json` with
+//! `code = "lammps"`. Particle-steps per second come from LAMMPS's `Loop time` lines.
+
+use std::path::{Path, PathBuf};
+
+use super::deck::{DeckPlan, TRAJECTORY_FILE};
+use super::dump::{read_dump, DumpError, Frame};
+use super::runner::LOG_FILE;
+use crate::analysis::heap::{self, HeapProfile};
+use crate::io::write_atomic;
+use crate::math::{Real, Vec3};
+use crate::run::{headline_sample, profile_csv, repose_csv, ReposeSample, RunSummary, StageRecord};
+use crate::scene::Scene;
+use crate::timestep::Timescales;
+
+#[derive(Debug, thiserror::Error)]
+pub enum PostprocessError {
+    #[error(transparent)]
+    Dump(#[from] DumpError),
+    #[error("{file}: {message}")]
+    Content { file: PathBuf, message: String },
+    #[error("cannot write {path}: {message}")]
+    Output { path: PathBuf, message: String },
+}
+
+/// Positions, radii (the species' own, not LAMMPS's contact radius), masses and velocities
+/// of one frame.
+pub struct FrameParticles {
+    pub position: Vec<Vec3>,
+    pub velocity: Vec<Vec3>,
+    pub radius: Vec<Real>,
+    pub mass: Vec<Real>,
+}
+
+/// Reads the per-atom state of a frame by column name, species from `type`.
+pub fn frame_particles(
+    frame: &Frame,
+    scene: &Scene,
+    file: &Path,
+) -> Result<FrameParticles, PostprocessError> {
+    let column = |name: &str| {
+        frame.column(name).ok_or_else(|| PostprocessError::Content {
+            file: file.to_path_buf(),
+            message: format!(
+                "step {}: no column `{name}` (columns: {})",
+                frame.step,
+                frame.columns.join(" ")
+            ),
+        })
+    };
+    let (x, y, z) = (column("x")?, column("y")?, column("z")?);
+    let (vx, vy, vz) = (column("vx")?, column("vy")?, column("vz")?);
+    let types = column("type")?;
+    let mut out = FrameParticles {
+        position: Vec::new(),
+        velocity: Vec::new(),
+        radius: Vec::new(),
+        mass: Vec::new(),
+    };
+    for k in 0..frame.len() {
+        let t = types[k] as usize;
+        let species =
+            scene
+                .species
+                .get(t.wrapping_sub(1))
+                .ok_or_else(|| PostprocessError::Content {
+                    file: file.to_path_buf(),
+                    message: format!(
+                        "step {}: atom type {t} has no species (the scene has {})",
+                        frame.step,
+                        scene.species.len()
+                    ),
+                })?;
+        out.position.push(Vec3::new(x[k], y[k], z[k]));
+        out.velocity.push(Vec3::new(vx[k], vy[k], vz[k]));
+        out.radius.push(species.radius());
+        out.mass.push(species.mass());
+    }
+    Ok(out)
+}
+
+/// One `CGDEM_STAGE` boundary printed by the deck.
+#[derive(Clone, Debug, PartialEq)]
+struct StageMark {
+    name: String,
+    start: u64,
+    end: Option<(u64, String)>,
+}
+
+fn stage_marks(log: &str) -> Vec<StageMark> {
+    let mut marks: Vec<StageMark> = Vec::new();
+    for line in log.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.len() < 4 || f[0] != "CGDEM_STAGE" {
+            continue;
+        }
+        let Ok(step) = f[3].parse::<u64>() else {
+            continue;
+        };
+        match f[2] {
+            "start" => marks.push(StageMark {
+                name: f[1].into(),
+                start: step,
+                end: None,
+            }),
+            "end" => {
+                if let Some(m) = marks.iter_mut().rev().find(|m| m.name == f[1]) {
+                    m.end = Some((step, f.get(4).copied().unwrap_or("").to_string()));
+                }
+            }
+            _ => {}
+        }
+    }
+    marks
+}
+
+/// (particle-steps, seconds) summed over the `Loop time of T on P procs for N steps with M atoms` lines.
+fn loop_times(log: &str) -> (u64, Real) {
+    let (mut particle_steps, mut seconds) = (0u64, 0.0);
+    for line in log.lines().filter(|l| l.starts_with("Loop time of ")) {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if let (Some(t), Some(n), Some(m)) = (f.get(3), f.get(8), f.get(11)) {
+            if let (Ok(t), Ok(n), Ok(m)) = (t.parse::<Real>(), n.parse::<u64>(), m.parse::<u64>()) {
+                seconds += t;
+                particle_steps += n * m;
+            }
+        }
+    }
+    (particle_steps, seconds)
+}
+
+fn output_error(path: &Path, e: impl std::fmt::Display) -> PostprocessError {
+    PostprocessError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Post-processes a finished LAMMPS run in `dir` into cgdem's output files and summary.
+pub fn postprocess(
+    scene: &Scene,
+    dir: &Path,
+    plan: &DeckPlan,
+    scales: &Timescales,
+    wall_s: Real,
+    ranks: usize,
+) -> Result<RunSummary, PostprocessError> {
+    let log_path = dir.join(LOG_FILE);
+    let log = std::fs::read_to_string(&log_path).map_err(|e| PostprocessError::Content {
+        file: log_path.clone(),
+        message: format!("cannot read: {e}"),
+    })?;
+    let marks = stage_marks(&log);
+    let dt = plan.dt;
+    let traj_path = dir.join(TRAJECTORY_FILE);
+    let frames = read_dump(&traj_path)?;
+    let max_diameter = scene.max_diameter();
+    let floor_z = scene.domain.lo.z;
+    let heap_profile = |p: &FrameParticles| -> Option<HeapProfile> {
+        scene.repose.as_ref().map(|r| {
+            heap::profile(
+                &p.position,
+                &p.radius,
+                r.wall_x,
+                scene.domain.hi.x,
+                floor_z,
+                r.bin_width_diameters * max_diameter,
+            )
+        })
+    };
+
+    let mut csv = String::from("time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m\n");
+    let mut last_state = None;
+    for frame in frames.iter().filter(|f| f.step > 0) {
+        let p = frame_particles(frame, scene, &traj_path)?;
+        let stage = marks
+            .iter()
+            .find(|m| {
+                frame.step > m.start && m.end.as_ref().is_none_or(|(end, _)| frame.step <= *end)
+            })
+            .map_or("", |m| m.name.as_str());
+        let ke: Real = p
+            .velocity
+            .iter()
+            .zip(&p.mass)
+            .map(|(v, m)| 0.5 * m * v.length_squared())
+            .sum();
+        let mass: Real = p.mass.iter().sum();
+        let profile = heap_profile(&p);
+        let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+        csv += &format!(
+            "{:.9e},{},{:.9e},{:.9e},{},{},{}\n",
+            frame.step as Real * dt,
+            stage,
+            ke,
+            ke / mass.max(Real::MIN_POSITIVE),
+            p.position.len(),
+            opt(profile.as_ref().map(|p| p.front(2.0 * max_diameter))),
+            opt(profile.as_ref().map(|p| p.wall_height()))
+        );
+        last_state = Some((frame.step, p));
+    }
+    let path = dir.join("timeseries.csv");
+    write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
+
+    let mut warnings = vec!["LAMMPS caps wall friction with the wall dashpot force only, cgdem with WCA + dashpot (reference/lammps/SEED_MODEL.md claim 11)".to_string()];
+    let mut samples = Vec::new();
+    let mut final_profile = None;
+    for (_, t, file) in &plan.repose_dumps {
+        let path = dir.join(file);
+        if !path.exists() {
+            // A run stopped early (time limit) has only the samples it reached.
+            warnings.push(format!(
+                "no {file}: the run ended before {t} s into the stage"
+            ));
+            continue;
+        }
+        let frames = read_dump(&path)?;
+        let Some(frame) = frames.last() else {
+            return Err(PostprocessError::Content {
+                file: path,
+                message: "no frame".into(),
+            });
+        };
+        let p = frame_particles(frame, scene, &path)?;
+        if let (Some(profile), Some(r)) = (heap_profile(&p), scene.repose.as_ref()) {
+            let fit = heap::repose_angle(
+                &profile,
+                2.0 * max_diameter,
+                r.exclude_wall_fraction,
+                r.exclude_toe_fraction,
+            );
+            samples.push(ReposeSample {
+                time_after_start_s: *t,
+                trigger: "fixed time".into(),
+                repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
+                repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
+                runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
+                wall_height_m: profile.wall_height(),
+            });
+            final_profile = Some(profile);
+        }
+    }
+    let mut final_profile =
+        final_profile.or_else(|| last_state.as_ref().and_then(|(_, p)| heap_profile(p)));
+    // The stage-end measurement: the last trajectory frame of the repose stage.
+    if let Some(r) = scene.repose.as_ref().filter(|r| r.at_stage_end) {
+        if let Some(mark) = marks.iter().find(|m| m.name == r.stage) {
+            let end = mark.end.as_ref().map_or(u64::MAX, |(end, _)| *end);
+            if let Some(frame) = frames
+                .iter()
+                .rev()
+                .find(|f| f.step > mark.start && f.step <= end)
+            {
+                let p = frame_particles(frame, scene, &traj_path)?;
+                if let Some(profile) = heap_profile(&p) {
+                    let fit = heap::repose_angle(
+                        &profile,
+                        2.0 * max_diameter,
+                        r.exclude_wall_fraction,
+                        r.exclude_toe_fraction,
+                    );
+                    samples.push(ReposeSample {
+                        time_after_start_s: (frame.step - mark.start) as Real * dt,
+                        trigger: "stage end".into(),
+                        repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
+                        repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
+                        runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
+                        wall_height_m: profile.wall_height(),
+                    });
+                    final_profile = Some(profile);
+                }
+            }
+        }
+    }
+    if let Some(profile) = &final_profile {
+        let path = dir.join("profile.csv");
+        write_atomic(&path, profile_csv(profile).as_bytes()).map_err(|e| output_error(&path, e))?;
+    }
+    if !samples.is_empty() {
+        let path = dir.join("repose.csv");
+        write_atomic(&path, repose_csv(&samples).as_bytes()).map_err(|e| output_error(&path, e))?;
+    }
+
+    // An unfinished stage (stopped run) ends at the last frame written.
+    let last_step = frames.last().map_or(0, |f| f.step);
+    let stages: Vec<StageRecord> = marks
+        .iter()
+        .map(|m| {
+            let (end, how) = m
+                .end
+                .clone()
+                .unwrap_or((last_step.max(m.start), "did not finish".into()));
+            if how == "max_duration" {
+                warnings.push(format!(
+                    "stage `{}` did not settle within max_duration",
+                    m.name
+                ));
+            }
+            StageRecord {
+                name: m.name.clone(),
+                start_s: m.start as Real * dt,
+                end_s: end as Real * dt,
+                steps: end - m.start,
+                ended_by: how,
+            }
+        })
+        .collect();
+    let steps = marks.last().map_or(0, |m| {
+        m.end
+            .as_ref()
+            .map_or(last_step.max(m.start), |(end, _)| *end)
+    });
+    let n_inserted = frames.first().map_or(0, Frame::len);
+    let n_final = last_state.as_ref().map_or(0, |(_, p)| p.position.len());
+    let (particle_steps, loop_s) = loop_times(&log);
+    let headline = headline_sample(&samples);
+    Ok(RunSummary {
+        case: scene.name.clone(),
+        code: "lammps".into(),
+        lambda: scene.lambda,
+        cg_rule: scene.cg_rule,
+        n_particles: n_final,
+        n_particles_inserted: n_inserted,
+        lost_particles: (n_inserted - n_final.min(n_inserted)) as u64,
+        steps,
+        dt_s: dt,
+        contact_period_s: scales.shortest_period,
+        stable_dt_s: scales.stable_limit,
+        simulated_s: steps as Real * dt,
+        wall_s: if wall_s.is_finite() { wall_s } else { loop_s },
+        particle_steps,
+        particle_steps_per_s: particle_steps as Real / loop_s.max(1e-9),
+        threads: ranks,
+        repose_angle_deg: headline.and_then(|s| s.repose_angle_deg),
+        repose_fit_r2: headline.and_then(|s| s.repose_fit_r2),
+        repose_rule: scene.repose.as_ref().map(|r| format!("as cgdem's (analysis::heap), on the LAMMPS write_dump at {:?} s after stage `{}` began", r.at_times, r.stage)),
+        runout_m: headline.map(|s| s.runout_m),
+        repose_samples: samples,
+        stages,
+        warnings,
+        scene_file: scene.source.display().to_string(),
+        cgdem_version: env!("CARGO_PKG_VERSION").into(),
+    })
+}
+
+/// Writes the summary as `summary.json` in `dir`.
+pub fn write_summary(summary: &RunSummary, dir: &Path) -> Result<(), PostprocessError> {
+    let path = dir.join("summary.json");
+    let json = serde_json::to_string_pretty(summary).map_err(|e| output_error(&path, e))?;
+    write_atomic(&path, json.as_bytes()).map_err(|e| output_error(&path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_marks_and_loop_times_are_read_from_the_log() {
+        let log = "print \"CGDEM_STAGE settle start $(step)\"\nCGDEM_STAGE settle start 0\nLoop time of 2.5 on 1 procs for 100 steps with 10 atoms\nCGDEM_STAGE settle end 400 settled\nCGDEM_STAGE collapse start 400\nLoop time of 1.5 on 1 procs for 100 steps with 8 atoms\nCGDEM_STAGE collapse end 900 duration\n";
+        let marks = stage_marks(log);
+        assert_eq!(marks.len(), 2);
+        assert_eq!(marks[0].end, Some((400, "settled".into())));
+        assert_eq!(marks[1].start, 400);
+        assert_eq!(loop_times(log), (1800, 4.0));
+    }
+}
