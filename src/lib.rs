@@ -4,6 +4,7 @@
 //! coarse-graining, scenes) never depends on the validation harness or on plotting.
 
 pub mod analysis;
+pub mod bodies;
 pub mod coarse_graining;
 pub mod contact;
 pub mod domain;
