@@ -7,6 +7,9 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use cgdem::coarse_graining::coarse_grain;
+use cgdem::geometry::accuracy::format_accuracy_table;
+use cgdem::geometry::screw_feeder::{self, ScrewFeederSpec};
+use cgdem::report::sdf_study::write_sdf_accuracy_study;
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
@@ -45,11 +48,83 @@ enum Command {
         #[arg(long)]
         force_dt: bool,
     },
+    /// Geometry tools: the seed's screw-feeder meshes and the SDF accuracy study.
+    Geometry {
+        #[command(subcommand)]
+        command: GeometryCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum GeometryCommand {
+    /// Write screw.stl, casing.stl, hopper.stl and insertion.stl of paper A's screw feeder
+    /// (reference/SCREW_GEOMETRY.md) and print the layout.
+    ScrewFeeder {
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Measure SDF-grid error, memory and build time against cell size (sphere, cylinder,
+    /// helicoid flight); writes sdf_accuracy.csv and plots.
+    SdfAccuracy {
+        #[arg(long)]
+        out: PathBuf,
+        /// Cell sizes, m.
+        #[arg(long, value_delimiter = ',', default_values_t = [0.016, 0.008, 0.004, 0.002])]
+        cells: Vec<f64>,
+        /// Sample points per grid (within 2 cells of the surface).
+        #[arg(long, default_value_t = 5000)]
+        samples: usize,
+    },
+}
+
+fn geometry(command: GeometryCommand) -> ExitCode {
+    match command {
+        GeometryCommand::ScrewFeeder { out } => {
+            let spec = ScrewFeederSpec::default();
+            match screw_feeder::write_stl_files(&spec, &out) {
+                Ok(paths) => {
+                    for p in paths {
+                        println!("wrote {}", p.display());
+                    }
+                    println!("{:#?}", spec.layout());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        GeometryCommand::SdfAccuracy {
+            out,
+            cells,
+            samples,
+        } => {
+            if cells.is_empty() || cells.iter().any(|&h| !(h > 0.0 && h.is_finite())) {
+                eprintln!("error: --cells must be positive cell sizes in metres, got {cells:?}");
+                return ExitCode::from(2);
+            }
+            match write_sdf_accuracy_study(&out, &cells, samples) {
+                Ok((rows, paths)) => {
+                    print!("{}", format_accuracy_table(&rows));
+                    for p in paths {
+                        println!("wrote {}", p.display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Geometry { command } => geometry(command),
         Command::Run {
             case,
             lambda,
