@@ -168,8 +168,8 @@ mod tests {
         let p = body.to_world(q);
         assert!((p - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-12);
         assert!((body.to_body(p) - q).length() < 1e-12);
-        let (d, n) = body.query(Vec3::new(0.0, 2.0, 0.0), 0.1).unwrap();
-        assert!((d - 0.5).abs() < 1e-12 && (n - Vec3::Y).length() < 1e-12);
+        let (d, n) = body.query(Vec3::new(0.0, 1.55, 0.0), 0.1).unwrap();
+        assert!((d - 0.05).abs() < 1e-12 && (n - Vec3::Y).length() < 1e-12);
         // omega = 2 pi rad/s about z: at (0, 1, 0) the material moves along -x at 2 pi m/s.
         let v = body.surface_velocity(p);
         assert!((v - Vec3::new(-std::f64::consts::TAU, 0.0, 0.0)).length() < 1e-12);
