@@ -19,5 +19,6 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod simulation;
+pub mod sweep;
 pub mod timestep;
 pub mod walls;

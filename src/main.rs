@@ -47,6 +47,10 @@ enum Command {
         /// Run even if the time step exceeds the stable limit (prints a warning).
         #[arg(long)]
         force_dt: bool,
+        /// Screw-speed sweep, e.g. `rpm=20,40,60`: one run per speed of the `[conveying]`
+        /// body into OUT/rpm<N>/, then OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7).
+        #[arg(long)]
+        sweep: Option<String>,
     },
     /// Geometry tools: the seed's screw-feeder meshes and the SDF accuracy study.
     Geometry {
@@ -132,7 +136,28 @@ fn main() -> ExitCode {
             threads,
             quiet,
             force_dt,
+            sweep,
         } => {
+            let speeds: Option<Vec<f64>> = match sweep.as_deref().map(|s| s.strip_prefix("rpm=")) {
+                None => None,
+                Some(Some(list)) => match list
+                    .split(',')
+                    .map(|v| v.trim().parse::<f64>())
+                    .collect::<Result<Vec<_>, _>>()
+                {
+                    Ok(v) if !v.is_empty() && v.iter().all(|x| x.is_finite() && *x > 0.0) => {
+                        Some(v)
+                    }
+                    _ => {
+                        eprintln!("error: --sweep expects rpm=<positive numbers separated by commas>, got `{list}`");
+                        return ExitCode::from(2);
+                    }
+                },
+                Some(None) => {
+                    eprintln!("error: --sweep expects rpm=<list>, e.g. rpm=20,40,60");
+                    return ExitCode::from(2);
+                }
+            };
             if threads == Some(0) {
                 eprintln!("error: --threads must be at least 1");
                 return ExitCode::from(2);
@@ -158,6 +183,16 @@ fn main() -> ExitCode {
                             PathBuf::from("runs")
                                 .join(format!("{}-lambda{}", scene.name, scene.lambda))
                         });
+                        if let Some(speeds) = &speeds {
+                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt)?;
+                            for (rpm, s) in &results {
+                                if let Some(c) = &s.conveying {
+                                    println!("{rpm} rpm: {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (a = {:.3}), wall {:.1} s", c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.fill_ratio, s.wall_s);
+                                }
+                            }
+                            let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
+                            return Ok((last, out_dir));
+                        }
                         let options = RunOptions {
                             out_dir: out_dir.clone(),
                             quiet,
