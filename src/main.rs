@@ -218,8 +218,8 @@ fn main() -> ExitCode {
                     }
                     if let Some(c) = &summary.conveying {
                         println!(
-                            "mass flow {:.4} +- {:.4} kg/s over {:.2}..{:.2} s; fill ratio {:.3}, bulk density {:.1} kg/m3, drive torque {:.2} N m; Eq. (7): {:.4} kg/s (measured a), {:.4} kg/s (a = 1)",
-                            c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.window_s[0], c.window_s[1], c.fill_ratio, c.bulk_density_kg_m3, c.drive_torque_nm, c.eq7_mass_flow_kg_s, c.eq7_full_mass_flow_kg_s
+                            "mass flow {:.4} +- {:.4} kg/s over {:.2}..{:.2} s; fill ratio {:.3} (solid), a = {:.3} (bulk), bulk density {:.1} kg/m3, drive torque {:.2} N m; Eq. (7): {:.4} kg/s (measured a), {:.4} kg/s (a = 1)",
+                            c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.window_s[0], c.window_s[1], c.fill_ratio, c.fill_ratio_bulk, c.bulk_density_kg_m3, c.drive_torque_nm, c.eq7_mass_flow_kg_s, c.eq7_full_mass_flow_kg_s
                         );
                     }
                     println!("outputs in {}", out_dir.display());

@@ -585,6 +585,7 @@ fn execute<L: PairLaw, W: WallLaw>(
             let summary = conveying::summarize(
                 c,
                 scene.bodies[k].rpm,
+                scene.species[0].density,
                 &conveying_samples,
                 t0,
                 t1,

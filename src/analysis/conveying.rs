@@ -62,14 +62,22 @@ pub struct ConveyingSummary {
     pub block_mass_flow_kg_s: Vec<Real>,
     pub mass_flow_kg_s: Real,
     pub mass_flow_std_error_kg_s: Real,
+    /// Solid volume in the screw section over the swept volume (mean over the window).
     pub fill_ratio: Real,
     pub fill_rule: String,
+    /// Eq. (7)'s `a`: bulk volume in the section over the swept volume,
+    /// `fill_ratio * rho_particle / bulk_density`.
+    pub fill_ratio_bulk: Real,
+    /// Bulk density at the hopper bottom at the start of the stage (the settled, full
+    /// hopper; the box may drain later).
     pub bulk_density_kg_m3: Real,
+    /// Mean over the window, for reference (lower if the hopper drains below the box).
+    pub bulk_density_window_kg_m3: Real,
     pub bulk_rule: String,
     pub drive_torque_nm: Real,
     pub drive_power_w: Real,
     pub swept_volume_per_turn_m3: Real,
-    /// Eq. (7) with the measured fill ratio and bulk density.
+    /// Eq. (7) with the measured `a` and bulk density: `fill_ratio * V * ns * rho_particle`.
     pub eq7_mass_flow_kg_s: Real,
     /// Eq. (7) with a = 1 and the measured bulk density.
     pub eq7_full_mass_flow_kg_s: Real,
@@ -81,6 +89,7 @@ pub struct ConveyingSummary {
 pub fn summarize(
     c: &ConveyingSettings,
     rpm: Real,
+    particle_density: Real,
     samples: &[ConveyingSample],
     t0: Real,
     t1: Real,
@@ -109,7 +118,8 @@ pub fn summarize(
     let var = flows.iter().map(|f| (f - mean).powi(2)).sum::<Real>() / (blocks - 1) as Real;
     let n = window.len() as Real;
     let fill = window.iter().map(|s| s.fill_ratio).sum::<Real>() / n;
-    let bulk = window.iter().map(|s| s.bulk_density).sum::<Real>() / n;
+    let bulk_window = window.iter().map(|s| s.bulk_density).sum::<Real>() / n;
+    let bulk = samples[0].bulk_density;
     let per_turn = swept_area(c) * c.pitch;
     let ns = rpm.abs() / 60.0;
     let full = per_turn * ns * bulk;
@@ -126,18 +136,20 @@ pub fn summarize(
             "solid volume of particles with centres in the bore (r < {} m) for {} <= x < {} m along the screw axis, over (pi/4)(Ds^2 - ds^2) times that length; mean of the samples in the window",
             c.bore_radius, c.fill_x[0], c.fill_x[1]
         ),
+        fill_ratio_bulk: fill * particle_density / bulk,
         bulk_density_kg_m3: bulk,
+        bulk_density_window_kg_m3: bulk_window,
         bulk_rule: format!(
-            "mass of particles with centres in the box {:?} .. {:?} over its volume; mean of the samples in the window",
+            "mass of particles with centres in the box {:?} .. {:?} over its volume, at the first sample of the stage",
             c.bulk_lo.to_array(),
             c.bulk_hi.to_array()
         ),
         drive_torque_nm: drive_torque,
         drive_power_w: drive_power,
         swept_volume_per_turn_m3: per_turn,
-        eq7_mass_flow_kg_s: fill * full,
+        eq7_mass_flow_kg_s: fill * per_turn * ns * particle_density,
         eq7_full_mass_flow_kg_s: full,
-        ratio_to_eq7: mean / (fill * full),
+        ratio_to_eq7: mean / (fill * per_turn * ns * particle_density),
     })
 }
 
@@ -168,11 +180,14 @@ mod tests {
                 bulk_density: 800.0,
             })
             .collect();
-        let s = summarize(&c, 60.0, &samples, 0.0, 2.0, 1.0, 1.0).unwrap();
+        let s = summarize(&c, 60.0, 1600.0, &samples, 0.0, 2.0, 1.0, 1.0).unwrap();
         assert!((s.mass_flow_kg_s - 2.0).abs() < 1e-12);
         assert!(s.mass_flow_std_error_kg_s < 1e-12);
         // Seed: (pi/4)(Ds^2 - ds^2) ps = 4.595e-3 m^3 per turn.
         assert!((s.swept_volume_per_turn_m3 - 4.595e-3).abs() < 1e-6);
-        assert!((s.eq7_mass_flow_kg_s - 0.5 * 4.595e-3 * 800.0).abs() < 1e-3);
+        // a = 0.5 solid fraction of the swept volume = 1.0 in bulk volume at 800 / 1600.
+        assert!((s.fill_ratio_bulk - 1.0).abs() < 1e-12);
+        assert!((s.eq7_mass_flow_kg_s - 0.5 * 4.595e-3 * 1600.0).abs() < 1e-2);
+        assert!((s.eq7_full_mass_flow_kg_s - 4.595e-3 * 800.0).abs() < 1e-2);
     }
 }
