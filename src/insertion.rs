@@ -31,6 +31,33 @@ pub fn insert_random(
     count: u64,
     seed: u64,
 ) -> Result<(), InsertionFailed> {
+    insert_random_where(
+        particles,
+        species,
+        radius,
+        mass,
+        lo,
+        hi,
+        count,
+        seed,
+        |_| true,
+    )
+}
+
+/// As [`insert_random`], keeping only positions that `accept` (e.g. inside a mesh region and
+/// clear of bodies).
+#[allow(clippy::too_many_arguments)]
+pub fn insert_random_where(
+    particles: &mut Particles,
+    species: u16,
+    radius: Real,
+    mass: Real,
+    lo: Vec3,
+    hi: Vec3,
+    count: u64,
+    seed: u64,
+    accept: impl Fn(Vec3) -> bool,
+) -> Result<(), InsertionFailed> {
     let mut rng = Pcg64::seed_from_u64(seed);
     let max_radius = particles.radius.iter().cloned().fold(radius, Real::max);
     let cell = 2.0 * max_radius;
@@ -61,6 +88,9 @@ pub fn insert_random(
             rng.gen_range(inner_lo.y..=inner_hi.y),
             rng.gen_range(inner_lo.z..=inner_hi.z),
         );
+        if !accept(p) {
+            continue;
+        }
         let [cx, cy, cz] = key(p);
         let overlaps = (-1..=1).any(|dx| {
             (-1..=1).any(|dy| {

@@ -4,6 +4,7 @@
 //! coarse-graining, scenes) never depends on the validation harness or on plotting.
 
 pub mod analysis;
+pub mod bodies;
 pub mod coarse_graining;
 pub mod contact;
 pub mod domain;
@@ -19,5 +20,6 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod simulation;
+pub mod sweep;
 pub mod timestep;
 pub mod walls;

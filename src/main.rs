@@ -9,6 +9,9 @@ use clap::{Parser, Subcommand, ValueEnum};
 use cgdem::coarse_graining::{
     coarse_grain, coarse_grain_by, coarse_grain_warnings, CoarseGrainRule,
 };
+use cgdem::geometry::accuracy::format_accuracy_table;
+use cgdem::geometry::screw_feeder::{self, ScrewFeederSpec};
+use cgdem::report::sdf_study::write_sdf_accuracy_study;
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::Scene;
 
@@ -58,6 +61,10 @@ enum Command {
         /// model (gravity, cohesion, rolling with Hertz), instead of warning.
         #[arg(long)]
         strict: bool,
+        /// Screw-speed sweep, e.g. `rpm=20,40,60`: one run per speed of the `[conveying]`
+        /// body into OUT/rpm<N>/, then OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7).
+        #[arg(long)]
+        sweep: Option<String>,
     },
     /// Run a validation suite (validation/suites/*.toml) with cgdem and the reference codes,
     /// compare the runs and write DIR/index.html, DIR/summary.json, figures and their CSV.
@@ -83,6 +90,11 @@ enum Command {
     Reference {
         #[command(subcommand)]
         code: ReferenceCode,
+    },
+    /// Geometry tools: the seed's screw-feeder meshes and the SDF accuracy study.
+    Geometry {
+        #[command(subcommand)]
+        command: GeometryCommand,
     },
 }
 
@@ -143,7 +155,7 @@ fn reference_lammps(
     if let Some(w) = warning {
         eprintln!("warning: {w}");
     }
-    let particles = cgdem::run::initial_particles(&scene, false).map_err(|e| e.to_string())?;
+    let particles = cgdem::run::initial_particles(&scene, false, &[]).map_err(|e| e.to_string())?;
     let deck = lammps::write_deck(&scene, &particles, dt).map_err(|e| e.to_string())?;
     let finish = |wall_s: f64, note: Option<String>| -> Result<cgdem::run::RunSummary, String> {
         let mut summary = lammps::postprocess(
@@ -235,6 +247,72 @@ fn reference_lammps(
     }
 }
 
+#[derive(Subcommand)]
+enum GeometryCommand {
+    /// Write screw.stl, casing.stl, hopper.stl and insertion.stl of paper A's screw feeder
+    /// (reference/SCREW_GEOMETRY.md) and print the layout.
+    ScrewFeeder {
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Measure SDF-grid error, memory and build time against cell size (sphere, cylinder,
+    /// helicoid flight); writes sdf_accuracy.csv and plots.
+    SdfAccuracy {
+        #[arg(long)]
+        out: PathBuf,
+        /// Cell sizes, m.
+        #[arg(long, value_delimiter = ',', default_values_t = [0.016, 0.008, 0.004, 0.002])]
+        cells: Vec<f64>,
+        /// Sample points per grid (within 2 cells of the surface).
+        #[arg(long, default_value_t = 5000)]
+        samples: usize,
+    },
+}
+
+fn geometry(command: GeometryCommand) -> ExitCode {
+    match command {
+        GeometryCommand::ScrewFeeder { out } => {
+            let spec = ScrewFeederSpec::default();
+            match screw_feeder::write_stl_files(&spec, &out) {
+                Ok(paths) => {
+                    for p in paths {
+                        println!("wrote {}", p.display());
+                    }
+                    println!("{:#?}", spec.layout());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        GeometryCommand::SdfAccuracy {
+            out,
+            cells,
+            samples,
+        } => {
+            if cells.is_empty() || cells.iter().any(|&h| !(h > 0.0 && h.is_finite())) {
+                eprintln!("error: --cells must be positive cell sizes in metres, got {cells:?}");
+                return ExitCode::from(2);
+            }
+            match write_sdf_accuracy_study(&out, &cells, samples) {
+                Ok((rows, paths)) => {
+                    print!("{}", format_accuracy_table(&rows));
+                    for p in paths {
+                        println!("wrote {}", p.display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
@@ -316,6 +394,7 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Geometry { command } => geometry(command),
         Command::Run {
             case,
             lambda,
@@ -326,7 +405,28 @@ fn main() -> ExitCode {
             quiet,
             force_dt,
             strict,
+            sweep,
         } => {
+            let speeds: Option<Vec<f64>> = match sweep.as_deref().map(|s| s.strip_prefix("rpm=")) {
+                None => None,
+                Some(Some(list)) => match list
+                    .split(',')
+                    .map(|v| v.trim().parse::<f64>())
+                    .collect::<Result<Vec<_>, _>>()
+                {
+                    Ok(v) if !v.is_empty() && v.iter().all(|x| x.is_finite() && *x > 0.0) => {
+                        Some(v)
+                    }
+                    _ => {
+                        eprintln!("error: --sweep expects rpm=<positive numbers separated by commas>, got `{list}`");
+                        return ExitCode::from(2);
+                    }
+                },
+                Some(None) => {
+                    eprintln!("error: --sweep expects rpm=<list>, e.g. rpm=20,40,60");
+                    return ExitCode::from(2);
+                }
+            };
             if threads == Some(0) {
                 eprintln!("error: --threads must be at least 1");
                 return ExitCode::from(2);
@@ -366,6 +466,16 @@ fn main() -> ExitCode {
                     })
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
+                        if let Some(speeds) = &speeds {
+                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt)?;
+                            for (rpm, s) in &results {
+                                if let Some(c) = &s.conveying {
+                                    println!("{rpm} rpm: {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (a = {:.3}), wall {:.1} s", c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.fill_ratio, s.wall_s);
+                                }
+                            }
+                            let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
+                            return Ok((last, out_dir));
+                        }
                         let options = RunOptions {
                             out_dir: out_dir.clone(),
                             quiet,
@@ -388,6 +498,12 @@ fn main() -> ExitCode {
                         if let Some(rule) = &summary.repose_rule {
                             println!("  rule: {rule}");
                         }
+                    }
+                    if let Some(c) = &summary.conveying {
+                        println!(
+                            "mass flow {:.4} +- {:.4} kg/s over {:.2}..{:.2} s; fill ratio {:.3} (solid), a = {:.3} (bulk), bulk density {:.1} kg/m3, drive torque {:.2} N m; Eq. (7): {:.4} kg/s (measured a), {:.4} kg/s (a = 1)",
+                            c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.window_s[0], c.window_s[1], c.fill_ratio, c.fill_ratio_bulk, c.bulk_density_kg_m3, c.drive_torque_nm, c.eq7_mass_flow_kg_s, c.eq7_full_mass_flow_kg_s
+                        );
                     }
                     println!("outputs in {}", out_dir.display());
                     ExitCode::SUCCESS

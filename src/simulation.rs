@@ -6,13 +6,15 @@
 
 use rayon::prelude::*;
 
+use crate::bodies::{Body, BodyLoad};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::domain::Domain;
+use crate::geometry::Aabb;
 use crate::integrate::{drift_kick, kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{Pair, VerletList};
 use crate::particles::Particles;
-use crate::walls::{WallLaw, WallParticle, WallSet};
+use crate::walls::{WallContact, WallLaw, WallParticle, WallSet};
 
 const CHUNK: usize = 512;
 
@@ -38,6 +40,15 @@ pub struct World<L: PairLaw, W: WallLaw> {
     pub steps: u64,
     /// Particles removed because they left the box through a bounded face.
     pub lost: u64,
+    /// Moving or fixed bodies; empty for scenes without bodies, which then pay nothing.
+    bodies: Vec<Body>,
+    /// Per particle, per body (particle-major) load, reduced in fixed order after the gather.
+    body_loads: Vec<BodyLoad>,
+    /// Particles whose centre enters one of these boxes are deleted (e.g. an outlet).
+    delete_regions: Vec<Aabb>,
+    /// Count and mass of particles deleted by `delete_regions`.
+    pub deleted: u64,
+    pub deleted_mass: Real,
     neighbor: NeighborSettings,
     list: VerletList,
     history: Vec<L::History>,
@@ -94,6 +105,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             list: VerletList::new(neighbor.skin),
             history: Vec::new(),
             pair_result: Vec::new(),
+            bodies: Vec::new(),
+            body_loads: Vec::new(),
+            delete_regions: Vec::new(),
+            deleted: 0,
+            deleted_mass: 0.0,
             integrator: Integrator::VelocityVerlet,
             old_force: Vec::new(),
             old_torque: Vec::new(),
@@ -101,6 +117,63 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         world.rebuild();
         world.compute_forces();
         world
+    }
+
+    /// Replaces the bodies (posed at the current time) and re-evaluates the forces.
+    pub fn set_bodies(&mut self, bodies: Vec<Body>) {
+        self.bodies = bodies;
+        let time = self.time;
+        for body in &mut self.bodies {
+            body.set_time(time);
+        }
+        self.compute_forces();
+    }
+
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+
+    /// Starts the motion of the named body now; false if there is none by that name.
+    pub fn start_body(&mut self, name: &str) -> bool {
+        let time = self.time;
+        match self.bodies.iter_mut().find(|b| b.name == name) {
+            Some(body) => {
+                body.start(time);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Boxes in which particles are deleted (checked every step).
+    pub fn set_delete_regions(&mut self, regions: Vec<Aabb>) {
+        self.delete_regions = regions;
+    }
+
+    /// Whether a particle has entered a delete region (then the list is rebuilt, which
+    /// removes it).
+    fn any_in_delete_region(&self) -> bool {
+        !self.delete_regions.is_empty()
+            && self
+                .particles
+                .position
+                .iter()
+                .any(|&x| self.in_delete_region(x))
+    }
+
+    /// Moves the moving bodies to their pose at time `t`.
+    fn pose_bodies_at(&mut self, t: Real) {
+        for body in &mut self.bodies {
+            if body.is_moving() {
+                body.set_time(t);
+            }
+        }
+    }
+
+    fn in_delete_region(&self, p: Vec3) -> bool {
+        self.delete_regions
+            .iter()
+            .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
     }
 
     /// The current pair list (for tests and diagnostics).
@@ -147,9 +220,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 pcvv::predict_rate(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
-        if self.list.needs_rebuild(&self.particles.position) {
+        if self.list.needs_rebuild(&self.particles.position) || self.any_in_delete_region() {
             self.rebuild();
         }
+        self.pose_bodies_at(self.time + dt);
         // F0, T0 after the rebuild, which may reorder particles.
         self.old_force.clone_from(&self.particles.force);
         if Self::ROTATES {
@@ -183,9 +257,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
-        if self.list.needs_rebuild(&self.particles.position) {
+        if self.list.needs_rebuild(&self.particles.position) || self.any_in_delete_region() {
             self.rebuild();
         }
+        self.pose_bodies_at(self.time + dt);
         self.compute_forces();
         let p = &mut self.particles;
         kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
@@ -208,13 +283,23 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 .map(|&x| self.domain.wrap_count(x))
                 .collect()
         });
+        let deleted_before = self.deleted;
         let mut remap: Option<Vec<u32>> = None;
-        let keep: Vec<bool> = self
+        let mut keep: Vec<bool> = self
             .particles
             .position
             .iter()
             .map(|&x| x.is_finite() && self.domain.contains_bounded(x))
             .collect();
+        if !self.delete_regions.is_empty() {
+            for (k, &x) in self.particles.position.iter().enumerate() {
+                if keep[k] && self.in_delete_region(x) {
+                    keep[k] = false;
+                    self.deleted += 1;
+                    self.deleted_mass += self.particles.mass[k];
+                }
+            }
+        }
         if keep.iter().any(|&k| !k) {
             let mut next = 0u32;
             remap = Some(
@@ -231,6 +316,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             );
             self.particles.retain(&keep);
             self.lost += (old_count - self.particles.len()) as u64;
+            self.lost -= self.deleted - deleted_before;
         }
         let resort = self.neighbor.resort_every > 0
             && self
@@ -297,28 +383,58 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let (position, velocity, radius, mass, species) =
             (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
+        let gather = |i: usize| -> (Vec3, WallParticle) {
+            let mut f = mass[i] * gravity;
+            let particle = WallParticle {
+                species: species[i] as usize,
+                position: position[i],
+                velocity: velocity[i],
+                radius: radius[i],
+                mass: mass[i],
+            };
+            f += walls.force_on(wall_law, &particle, dt);
+            for k in list.out_start[i]..list.out_start[i + 1] {
+                f += results[k as usize].force_on_i;
+            }
+            for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
+                f -= results[k as usize].force_on_i;
+            }
+            (f, particle)
+        };
+        if self.bodies.is_empty() {
+            p.force
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(CHUNK)
+                .for_each(|(i, force)| *force = gather(i).0);
+            return;
+        }
+        let bodies = &self.bodies;
+        let n_bodies = bodies.len();
+        self.body_loads
+            .resize(p.force.len() * n_bodies, BodyLoad::default());
         p.force
             .par_iter_mut()
+            .zip(self.body_loads.par_chunks_mut(n_bodies))
             .enumerate()
             .with_min_len(CHUNK)
-            .for_each(|(i, force)| {
-                let mut f = mass[i] * gravity;
-                let particle = WallParticle {
-                    species: species[i] as usize,
-                    position: position[i],
-                    velocity: velocity[i],
-                    radius: radius[i],
-                    mass: mass[i],
-                };
-                f += walls.force_on(wall_law, &particle, dt);
-                for k in list.out_start[i]..list.out_start[i + 1] {
-                    f += results[k as usize].force_on_i;
-                }
-                for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                    f -= results[k as usize].force_on_i;
+            .for_each(|(i, (force, loads))| {
+                let (mut f, particle) = gather(i);
+                for (body, load) in bodies.iter().zip(loads.iter_mut()) {
+                    let (f_body, l) = body_force(body, wall_law, &particle, dt);
+                    f += f_body;
+                    *load = l;
                 }
                 *force = f;
             });
+        // Fixed-order reduction: bitwise identical for any thread count.
+        for (b, body) in self.bodies.iter_mut().enumerate() {
+            let mut total = BodyLoad::default();
+            for loads in self.body_loads.chunks_exact(n_bodies) {
+                total += loads[b];
+            }
+            body.load = total;
+        }
     }
 
     /// The gather for spinning particles: forces and torques of pairs, walls and gravity.
@@ -434,4 +550,38 @@ fn pair_force<L: PairLaw>(
         tangential_velocity: relative_velocity - normal_speed * normal,
     };
     law.evaluate(&contact, history, spins, dt)
+}
+
+/// Force of one body on one particle (the wall law with the SDF distance and normal and the
+/// velocity relative to the body's surface), and the particle's load on the body.
+#[inline(always)]
+fn body_force<W: WallLaw>(
+    body: &Body,
+    law: &W,
+    particle: &WallParticle,
+    dt: Real,
+) -> (Vec3, BodyLoad) {
+    let reach = law.reach(particle.species, particle.radius);
+    let Some((distance, normal)) = body.query(particle.position, reach) else {
+        return (Vec3::ZERO, BodyLoad::default());
+    };
+    // A centre inside the body has passed through it: no force (as for planar walls).
+    if distance <= 0.0 || distance >= reach {
+        return (Vec3::ZERO, BodyLoad::default());
+    }
+    let contact_point = particle.position - distance * normal;
+    let contact = WallContact {
+        species: particle.species,
+        normal,
+        distance,
+        relative_velocity: particle.velocity - body.surface_velocity(contact_point),
+        radius: particle.radius,
+        mass: particle.mass,
+    };
+    let force = law.force(&contact, dt);
+    let load = BodyLoad {
+        force: -force,
+        torque: (contact_point - body.center()).cross(-force),
+    };
+    (force, load)
 }

@@ -3,6 +3,7 @@
 
 pub mod html;
 pub mod plot;
+pub mod sdf_study;
 
 pub use html::{Cell, Report, Section, Status, Table};
 pub use plot::{

@@ -12,13 +12,15 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
+use crate::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
 use crate::analysis::heap::{self, HeapProfile, ReposeFit};
+use crate::bodies::{Body, BodyShape, Motion};
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
-use crate::geometry::FinitePlane;
-use crate::insertion::{insert_random, InsertionFailed};
+use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, SdfGrid};
+use crate::insertion::{insert_random_where, InsertionFailed};
 use crate::io::{vtk::VtkSeries, write_atomic};
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 use crate::scene::{ContactSettings, InsertAmount, Scene, StageEnd};
 use crate::simulation::{NeighborSettings, World};
@@ -52,6 +54,12 @@ pub enum RunError {
         file: String,
         combination: String,
         supported: String,
+    },
+    #[error("{file}: {field}: {message}")]
+    Geometry {
+        file: String,
+        field: String,
+        message: String,
     },
     #[error("cannot write {path}: {message}")]
     Output { path: PathBuf, message: String },
@@ -110,6 +118,10 @@ pub struct RunSummary {
     pub runout_m: Option<Real>,
     pub repose_samples: Vec<ReposeSample>,
     pub stages: Vec<StageRecord>,
+    /// Particles deleted in `[[delete]]` regions, and their mass.
+    pub deleted_particles: u64,
+    pub deleted_mass_kg: Real,
+    pub conveying: Option<ConveyingSummary>,
     pub warnings: Vec<String>,
     pub scene_file: String,
     pub cgdem_version: String,
@@ -203,7 +215,7 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
                 mass: m_eff,
             });
         }
-        if !scene.walls.is_empty() {
+        if !scene.walls.is_empty() || !scene.bodies.is_empty() {
             let (k, gamma) = wall_law.linearized(a, sa.radius(), sa.mass());
             contacts.push(LinearContact {
                 label: format!("{}-wall", sa.name),
@@ -216,11 +228,18 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
     contacts
 }
 
-/// The scene's particles as inserted, before any step (the reference codes start from them).
-pub fn initial_particles(scene: &Scene, rotation: bool) -> Result<Particles, RunError> {
+/// The scene's particles as inserted, before any step (the reference codes start from them);
+/// none overlaps a body.
+pub fn initial_particles(
+    scene: &Scene,
+    rotation: bool,
+    bodies: &[Body],
+) -> Result<Particles, RunError> {
+    let file = scene.source.display().to_string();
     let mut particles = Particles::new(rotation);
     for (index, ins) in scene.insertions.iter().enumerate() {
         let species = &scene.species[ins.species];
+        let radius = species.radius();
         let count = match ins.amount {
             InsertAmount::Count(n) => n,
             InsertAmount::SolidVolume(v) => (v
@@ -228,23 +247,72 @@ pub fn initial_particles(scene: &Scene, rotation: bool) -> Result<Particles, Run
             .round()
             .max(1.0) as u64,
         };
-        insert_random(
+        let region = match &ins.mesh {
+            None => None,
+            Some(source) => Some(source.load().map_err(|message| RunError::Geometry {
+                file: file.clone(),
+                field: format!("insert[{index}].mesh"),
+                message,
+            })?),
+        };
+        let bvh = region.as_ref().map(Bvh::new);
+        let winding = bvh.as_ref().map(FastWindingNumber::new);
+        // Inside the region by at least one radius, and clear of every body.
+        let accept = |p: Vec3| {
+            if let (Some(bvh), Some(winding)) = (&bvh, &winding) {
+                if !winding.is_inside(p) || bvh.nearest_within(p, radius).is_some() {
+                    return false;
+                }
+            }
+            bodies
+                .iter()
+                .all(|b| b.query(p, radius).is_none_or(|(d, _)| d > radius))
+        };
+        insert_random_where(
             &mut particles,
             ins.species as u16,
-            species.radius(),
+            radius,
             species.mass(),
             ins.lo,
             ins.hi,
             count,
             ins.seed,
+            accept,
         )
         .map_err(|source| RunError::Insertion {
-            file: scene.source.display().to_string(),
+            file: file.clone(),
             index,
             source,
         })?;
     }
     Ok(particles)
+}
+
+/// The scene's bodies as SDF grids, posed at t = 0; bodies without a start stage move from
+/// the start.
+fn build_bodies(scene: &Scene) -> Result<Vec<Body>, RunError> {
+    let file = scene.source.display().to_string();
+    let mut bodies = Vec::new();
+    for (k, b) in scene.bodies.iter().enumerate() {
+        let error = |message: String| RunError::Geometry {
+            file: file.clone(),
+            field: format!("body[{k}]"),
+            message,
+        };
+        let mesh = b.mesh.load().map_err(error)?;
+        let padding = b
+            .padding
+            .unwrap_or(3.0 * b.cell_size + scene.max_diameter());
+        let grid =
+            SdfGrid::from_mesh(&mesh, b.cell_size, padding).map_err(|e| error(e.to_string()))?;
+        let motion = Motion::rotation_rpm(b.axis, b.point, b.rpm).with_velocity(b.velocity);
+        let mut body = Body::new(b.name.clone(), BodyShape::Grid(grid), motion);
+        if b.start_stage.is_none() {
+            body.start(0.0);
+        }
+        bodies.push(body);
+    }
+    Ok(bodies)
 }
 
 /// The scene's walls as planes bounded by the box.
@@ -279,7 +347,14 @@ fn execute<L: PairLaw, W: WallLaw>(
         eprintln!("warning: {w}");
     }
 
-    let particles = initial_particles(scene, L::NEEDS_ROTATION)?;
+    let bodies = build_bodies(scene)?;
+    if !bodies.is_empty() && (L::NEEDS_ROTATION || W::NEEDS_ROTATION) {
+        return Err(RunError::NotAvailable(format!(
+            "{}: bodies (SDF walls) are implemented for the seed's model only so far; this scene's contact law rotates the particles",
+            scene.source.display()
+        )));
+    }
+    let particles = initial_particles(scene, L::NEEDS_ROTATION, &bodies)?;
     let n_inserted = particles.len();
     let neighbor = NeighborSettings {
         skin: scene.skin_fraction * scene.max_diameter(),
@@ -297,12 +372,37 @@ fn execute<L: PairLaw, W: WallLaw>(
         neighbor,
     )
     .with_integrator(scene.integrator);
+    if !bodies.is_empty() {
+        world.set_bodies(bodies);
+    }
+    world.set_delete_regions(
+        scene
+            .deletions
+            .iter()
+            .map(|&(min, max)| Aabb { min, max })
+            .collect(),
+    );
+    let body_columns: String = scene
+        .bodies
+        .iter()
+        .map(|b| format!(",axial_torque_{}_nm", b.name))
+        .collect();
+    let conveying_body = scene.conveying.as_ref().and_then(|c| {
+        scene
+            .bodies
+            .iter()
+            .position(|b| b.name == c.body)
+            .map(|k| (c, k))
+    });
+    let mut conveying_samples: Vec<ConveyingSample> = Vec::new();
+    let (mut torque_sum, mut power_sum, mut torque_steps) = (0.0, 0.0, 0u64);
+    let mut conveying_window: Option<(Real, Real)> = None;
 
     let timeseries_path = out.join("timeseries.csv");
     let mut timeseries = std::io::BufWriter::new(
         std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?,
     );
-    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m").map_err(|e| output_error(&timeseries_path, e))?;
+    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{}", if conveying_body.is_some() { ",fill_ratio,bulk_density_kg_m3" } else { "" }).map_err(|e| output_error(&timeseries_path, e))?;
     let mut vtk = if scene.output.vtk_interval > 0.0 {
         Some(
             VtkSeries::new(&out.join("vtk"), "particles")
@@ -384,8 +484,14 @@ fn execute<L: PairLaw, W: WallLaw>(
         for name in &stage.remove_walls {
             world.walls.remove(name);
         }
+        for b in &scene.bodies {
+            if b.start_stage.as_deref() == Some(stage.name.as_str()) {
+                world.start_body(&b.name);
+            }
+        }
         progress.set_message(stage.name.clone());
         let start = world.time;
+        let measuring = conveying_body.filter(|(c, _)| c.stage == stage.name);
         let start_steps = world.steps;
         let (duration, settle_threshold, min_duration) = match stage.end {
             StageEnd::Duration(d) => (d, None, d),
@@ -405,6 +511,14 @@ fn execute<L: PairLaw, W: WallLaw>(
         for k in 1..=stage_steps {
             world.step();
             particle_steps += world.particles.len() as u64;
+            if let Some((c, k)) = measuring {
+                if world.time - start >= c.discard - 0.5 * dt {
+                    let body = &world.bodies()[k];
+                    torque_sum -= body.axial_torque();
+                    power_sum += body.drive_power();
+                    torque_steps += 1;
+                }
+            }
             if k % 256 == 0 {
                 progress.inc(256);
             }
@@ -417,9 +531,33 @@ fn execute<L: PairLaw, W: WallLaw>(
                 let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
                 let wall_height = profile.as_ref().map(|p| p.wall_height());
                 let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+                let mut extra = format!(",{:.9e}", world.deleted_mass);
+                for body in world.bodies() {
+                    extra += &format!(",{:.6e}", body.axial_torque());
+                }
+                if let Some((c, k)) = conveying_body {
+                    let body = &world.bodies()[k];
+                    let p = &world.particles;
+                    let sample = ConveyingSample {
+                        time: world.time,
+                        deleted_mass: world.deleted_mass,
+                        fill_ratio: conveying::fill_ratio(
+                            c,
+                            body.motion.axis,
+                            body.motion.point,
+                            &p.position,
+                            &p.radius,
+                        ),
+                        bulk_density: conveying::bulk_density(c, &p.position, &p.mass),
+                    };
+                    extra += &format!(",{:.6e},{:.6e}", sample.fill_ratio, sample.bulk_density);
+                    if measuring.is_some() {
+                        conveying_samples.push(sample);
+                    }
+                }
                 writeln!(
                     timeseries,
-                    "{:.9e},{},{:.9e},{:.9e},{},{},{}",
+                    "{:.9e},{},{:.9e},{:.9e},{},{},{}{extra}",
                     world.time,
                     stage.name,
                     ke,
@@ -477,6 +615,9 @@ fn execute<L: PairLaw, W: WallLaw>(
             eprintln!("warning: {w}");
             warnings.push(w);
         }
+        if let Some((c, _)) = measuring {
+            conveying_window = Some((start + c.discard, world.time));
+        }
         stages.push(StageRecord {
             name: stage.name.clone(),
             start_s: start,
@@ -496,6 +637,28 @@ fn execute<L: PairLaw, W: WallLaw>(
         warnings.push(w);
     }
 
+    let conveying_summary = match (conveying_body, conveying_window) {
+        (Some((c, k)), Some((t0, t1))) => {
+            let n = torque_steps.max(1) as Real;
+            let summary = conveying::summarize(
+                c,
+                scene.bodies[k].rpm,
+                scene.species[0].density,
+                &conveying_samples,
+                t0,
+                t1,
+                torque_sum / n,
+                power_sum / n,
+            );
+            if summary.is_none() {
+                let w = format!("conveying: too few time-series samples after the discarded {} s for {} blocks; shorten output.timeseries_interval or run longer", c.discard, c.blocks);
+                eprintln!("warning: {w}");
+                warnings.push(w);
+            }
+            summary
+        }
+        _ => None,
+    };
     let final_profile = final_profile.or_else(|| heap_profile(&world));
     if let Some(profile) = &final_profile {
         let path = out.join("profile.csv");
@@ -542,6 +705,9 @@ fn execute<L: PairLaw, W: WallLaw>(
         runout_m: headline.map(|s| s.runout_m),
         repose_samples: samples,
         stages,
+        deleted_particles: world.deleted,
+        deleted_mass_kg: world.deleted_mass,
+        conveying: conveying_summary,
         warnings,
         scene_file: file,
         cgdem_version: env!("CARGO_PKG_VERSION").into(),

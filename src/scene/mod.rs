@@ -124,10 +124,82 @@ pub enum InsertAmount {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Insertion {
     pub species: usize,
+    /// The box sampled; with `mesh`, only positions inside the mesh (by at least one radius)
+    /// are kept.
     pub lo: Vec3,
     pub hi: Vec3,
+    pub mesh: Option<MeshSource>,
     pub amount: InsertAmount,
     pub seed: u64,
+}
+
+/// Where a triangle mesh comes from: an STL file (path relative to the scene file) or, with
+/// the prefix `screw-feeder:`, one part of the seed's screw feeder generated with the default
+/// [`ScrewFeederSpec`](crate::geometry::screw_feeder::ScrewFeederSpec): `screw`, `casing`,
+/// `hopper` or `insertion`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshSource {
+    Stl(PathBuf),
+    ScrewFeeder(String),
+}
+
+impl MeshSource {
+    pub fn load(&self) -> Result<crate::geometry::TriMesh, String> {
+        use crate::geometry::screw_feeder as sf;
+        match self {
+            MeshSource::Stl(path) => {
+                crate::geometry::read_stl(path).map_err(|e| format!("{}: {e}", path.display()))
+            }
+            MeshSource::ScrewFeeder(part) => {
+                let spec = sf::ScrewFeederSpec::default();
+                Ok(match part.as_str() {
+                    "screw" => sf::screw_mesh(&spec),
+                    "casing" => sf::casing_mesh(&spec),
+                    "hopper" => sf::hopper_mesh(&spec),
+                    "insertion" => sf::insertion_region_mesh(&spec),
+                    other => return Err(format!("no screw-feeder part `{other}`")),
+                })
+            }
+        }
+    }
+}
+
+/// A rigid body from a mesh, turned into an SDF grid, with prescribed motion.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodySettings {
+    pub name: String,
+    pub mesh: MeshSource,
+    pub cell_size: Real,
+    /// Grid padding around the mesh; `None`: 3 cells plus the largest particle diameter.
+    pub padding: Option<Real>,
+    pub rpm: Real,
+    pub axis: Vec3,
+    pub point: Vec3,
+    pub velocity: Vec3,
+    /// The stage at whose start the motion begins; `None`: from the start of the run.
+    pub start_stage: Option<String>,
+}
+
+/// Screw-conveyor measurements (paper A Eq. 7) during one stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConveyingSettings {
+    pub stage: String,
+    /// The screw body (its rpm gives n_s).
+    pub body: String,
+    /// Start-up time discarded at the beginning of the stage, s.
+    pub discard: Real,
+    /// Blocks for the standard error of the mass flow.
+    pub blocks: u32,
+    pub outer_diameter: Real,
+    pub shaft_diameter: Real,
+    pub pitch: Real,
+    /// Casing bore radius: particles with centres inside it count for the fill ratio.
+    pub bore_radius: Real,
+    /// Axial range (along x, the screw axis) where the fill ratio is measured.
+    pub fill_x: [Real; 2],
+    /// Box where the bulk density is measured (centres inside count).
+    pub bulk_lo: Vec3,
+    pub bulk_hi: Vec3,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -199,6 +271,10 @@ pub struct Scene {
     pub lambda: u32,
     /// The rule by which it was coarse-grained.
     pub cg_rule: crate::coarse_graining::CoarseGrainRule,
+    pub bodies: Vec<BodySettings>,
+    /// Particles whose centre enters one of these boxes (lo, hi) are deleted.
+    pub deletions: Vec<(Vec3, Vec3)>,
+    pub conveying: Option<ConveyingSettings>,
 }
 
 impl Scene {

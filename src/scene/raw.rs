@@ -28,6 +28,50 @@ pub struct RawScene {
     pub output: Option<RawOutput>,
     #[serde(default)]
     pub repose: Option<RawRepose>,
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<RawBody>,
+    #[serde(default, rename = "delete")]
+    pub deletions: Vec<RawDelete>,
+    #[serde(default)]
+    pub conveying: Option<RawConveying>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBody {
+    pub name: String,
+    pub mesh: String,
+    pub cell_size: f64,
+    pub padding: Option<f64>,
+    #[serde(default)]
+    pub rpm: f64,
+    pub axis: Option<[f64; 3]>,
+    pub point: Option<[f64; 3]>,
+    pub velocity: Option<[f64; 3]>,
+    pub start_stage: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDelete {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConveying {
+    pub stage: String,
+    pub body: String,
+    pub discard: f64,
+    pub blocks: Option<u32>,
+    pub outer_diameter: f64,
+    pub shaft_diameter: f64,
+    pub pitch: f64,
+    pub bore_radius: f64,
+    pub fill_x: [f64; 2],
+    pub bulk_lo: [f64; 3],
+    pub bulk_hi: [f64; 3],
 }
 
 #[derive(Debug, Deserialize)]
@@ -116,6 +160,7 @@ pub struct RawInsertion {
     pub solid_volume: Option<f64>,
     #[serde(default)]
     pub seed: u64,
+    pub mesh: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -338,6 +338,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
             species: species_index,
             lo: ilo,
             hi: ihi,
+            mesh: ins.mesh.as_deref().map(|m| mesh_source(m, file)),
             amount,
             seed: ins.seed,
         });
@@ -460,7 +461,144 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         }
     };
 
+    let mut bodies = Vec::new();
+    for (k, b) in raw.bodies.iter().enumerate() {
+        if b.name.trim().is_empty() || raw.bodies[..k].iter().any(|o| o.name == b.name) {
+            return Err(c.invalid(
+                format!("body[{k}].name"),
+                &b.name,
+                "a non-empty name used by no other body",
+            ));
+        }
+        if let Some(stage) = &b.start_stage {
+            if !raw.stages.iter().any(|s| &s.name == stage) {
+                return Err(c.invalid(
+                    format!("body[{k}].start_stage"),
+                    stage,
+                    format!(
+                        "one of the stages: {}",
+                        names(raw.stages.iter().map(|s| &s.name))
+                    ),
+                ));
+            }
+        }
+        if !b.rpm.is_finite() {
+            return Err(c.invalid(
+                format!("body[{k}].rpm"),
+                b.rpm,
+                "a finite number (rev/min, sign = sense about axis)",
+            ));
+        }
+        let axis = c.vector(
+            &format!("body[{k}].axis"),
+            b.axis.unwrap_or([0.0, 0.0, 1.0]),
+        )?;
+        if axis.length() < 1e-12 {
+            return Err(c.invalid(
+                format!("body[{k}].axis"),
+                format!("{axis:?}"),
+                "a non-zero vector",
+            ));
+        }
+        bodies.push(BodySettings {
+            name: b.name.clone(),
+            mesh: mesh_source(&b.mesh, file),
+            cell_size: c.positive(&format!("body[{k}].cell_size"), b.cell_size)?,
+            padding: b
+                .padding
+                .map(|p| c.positive(&format!("body[{k}].padding"), p))
+                .transpose()?,
+            rpm: b.rpm,
+            axis: axis.normalize(),
+            point: c.vector(&format!("body[{k}].point"), b.point.unwrap_or([0.0; 3]))?,
+            velocity: c.vector(
+                &format!("body[{k}].velocity"),
+                b.velocity.unwrap_or([0.0; 3]),
+            )?,
+            start_stage: b.start_stage.clone(),
+        });
+    }
+    let mut deletions = Vec::new();
+    for (k, d) in raw.deletions.iter().enumerate() {
+        let dlo = c.vector(&format!("delete[{k}].lo"), d.lo)?;
+        let dhi = c.vector(&format!("delete[{k}].hi"), d.hi)?;
+        if dlo.cmpge(dhi).any() {
+            return Err(c.invalid(
+                format!("delete[{k}].hi"),
+                format!("{dhi:?}"),
+                format!("greater than lo = {dlo:?} on every axis"),
+            ));
+        }
+        deletions.push((dlo, dhi));
+    }
+    let conveying = match &raw.conveying {
+        None => None,
+        Some(cv) => {
+            if !raw.stages.iter().any(|s| s.name == cv.stage) {
+                return Err(c.invalid(
+                    "conveying.stage",
+                    &cv.stage,
+                    format!(
+                        "one of the stages: {}",
+                        names(raw.stages.iter().map(|s| &s.name))
+                    ),
+                ));
+            }
+            if !bodies.iter().any(|b| b.name == cv.body) {
+                return Err(c.invalid(
+                    "conveying.body",
+                    &cv.body,
+                    format!(
+                        "one of the bodies: {}",
+                        names(bodies.iter().map(|b| &b.name))
+                    ),
+                ));
+            }
+            let outer_diameter = c.positive("conveying.outer_diameter", cv.outer_diameter)?;
+            let shaft_diameter = c.positive("conveying.shaft_diameter", cv.shaft_diameter)?;
+            if shaft_diameter >= outer_diameter {
+                return Err(c.invalid(
+                    "conveying.shaft_diameter",
+                    shaft_diameter,
+                    format!("less than outer_diameter = {outer_diameter}"),
+                ));
+            }
+            if cv.fill_x[1] <= cv.fill_x[0] {
+                return Err(c.invalid(
+                    "conveying.fill_x",
+                    format!("{:?}", cv.fill_x),
+                    "an increasing range [x0, x1]",
+                ));
+            }
+            let bulk_lo = c.vector("conveying.bulk_lo", cv.bulk_lo)?;
+            let bulk_hi = c.vector("conveying.bulk_hi", cv.bulk_hi)?;
+            if bulk_lo.cmpge(bulk_hi).any() {
+                return Err(c.invalid(
+                    "conveying.bulk_hi",
+                    format!("{bulk_hi:?}"),
+                    format!("greater than bulk_lo = {bulk_lo:?} on every axis"),
+                ));
+            }
+            Some(ConveyingSettings {
+                stage: cv.stage.clone(),
+                body: cv.body.clone(),
+                discard: c.non_negative("conveying.discard", cv.discard)?,
+                blocks: cv.blocks.unwrap_or(5).max(2),
+                outer_diameter,
+                shaft_diameter,
+                pitch: c.positive("conveying.pitch", cv.pitch)?,
+                bore_radius: c.positive("conveying.bore_radius", cv.bore_radius)?,
+                fill_x: cv.fill_x,
+                bulk_lo,
+                bulk_hi,
+            })
+        }
+    };
+
     Ok(Scene {
+        bodies,
+        deletions,
+        conveying,
         name: raw.name,
         description: raw.description,
         source: file.to_path_buf(),
@@ -688,6 +826,14 @@ fn hertz_contact(c: &Checker, rc: &RawContact) -> Result<HertzSettings, SceneErr
             rc.characteristic_velocity.unwrap_or(1.0),
         )?,
     })
+}
+
+/// `screw-feeder:<part>` or an STL path relative to the scene file.
+fn mesh_source(text: &str, file: &Path) -> MeshSource {
+    match text.strip_prefix("screw-feeder:") {
+        Some(part) => MeshSource::ScrewFeeder(part.to_string()),
+        None => MeshSource::Stl(file.parent().unwrap_or(Path::new(".")).join(text)),
+    }
 }
 
 fn names<'a>(list: impl Iterator<Item = &'a String>) -> String {

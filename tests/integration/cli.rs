@@ -112,3 +112,50 @@ fn a_small_run_writes_summary_timeseries_profile_and_a_vtk_series() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn geometry_commands_write_the_screw_feeder_meshes_and_the_sdf_study() {
+    let dir = std::env::temp_dir().join(format!("cgdem-geometry-{}", std::process::id()));
+    let out = cgdem()
+        .args(["geometry", "screw-feeder", "--out"])
+        .arg(dir.join("feeder"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("outlet_x"));
+    for name in ["screw.stl", "casing.stl", "hopper.stl", "insertion.stl"] {
+        // The casing and the insertion region are unions of closed pieces that touch or
+        // overlap (see screw_feeder.rs), so the strict reader's manifold check is skipped.
+        let (mesh, _) =
+            cgdem::geometry::read_stl_unchecked(&dir.join("feeder").join(name)).unwrap();
+        assert!(!mesh.triangles.is_empty(), "{name}");
+    }
+    let out = cgdem()
+        .args([
+            "geometry",
+            "sdf-accuracy",
+            "--cells",
+            "0.04,0.02",
+            "--samples",
+            "200",
+            "--out",
+        ])
+        .arg(dir.join("sdf"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("sdf").join("sdf_accuracy.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 3 * 2, "{csv}");
+    for stem in ["sdf_error", "sdf_memory", "sdf_build_time"] {
+        assert!(dir.join("sdf").join(format!("{stem}.png")).exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -25,7 +25,7 @@ pub fn run_reference(
     options: &RunnerOptions,
 ) -> Result<(RunStatus, Option<RunSummary>), String> {
     let (dt, scales, _) = crate::run::time_step(scene, false).map_err(|e| e.to_string())?;
-    let particles = crate::run::initial_particles(scene, false).map_err(|e| e.to_string())?;
+    let particles = crate::run::initial_particles(scene, false, &[]).map_err(|e| e.to_string())?;
     let deck = write_deck(scene, &particles, dt).map_err(|e| e.to_string())?;
     deck.write_to(out)
         .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;

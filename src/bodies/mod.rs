@@ -1,0 +1,10 @@
+//! Moving bodies: rigid shapes (an SDF grid from an STL or an analytic SDF) with prescribed
+//! motion, acting on particles through the scene's wall law (paper A sec. 5.3).
+
+mod body;
+mod motion;
+mod shape;
+
+pub use body::{Body, BodyLoad};
+pub use motion::Motion;
+pub use shape::BodyShape;

@@ -1,0 +1,57 @@
+//! The shape of a body in its own frame: a signed-distance grid or an analytic SDF.
+
+use crate::geometry::{Aabb, AxisAlignedBox, Cylinder, Sdf, SdfGrid, Sphere};
+use crate::math::{Real, Vec3};
+
+/// A body's shape in the body frame. An enum rather than a trait object: the match is
+/// predictable and inlined in the force loop.
+#[derive(Clone, Debug)]
+pub enum BodyShape {
+    /// Trilinear SDF grid (paper A Eq. 8-10), e.g. from an STL; no contact outside the grid.
+    Grid(SdfGrid),
+    Sphere(Sphere),
+    Cylinder(Cylinder),
+    Box(AxisAlignedBox),
+}
+
+impl BodyShape {
+    /// Signed distance (negative inside) and outward unit normal at `p`, or `None` where the
+    /// shape has no data (outside a grid).
+    #[inline(always)]
+    pub fn query(&self, p: Vec3) -> Option<(Real, Vec3)> {
+        match self {
+            BodyShape::Grid(grid) => grid.query(p),
+            BodyShape::Sphere(s) => Some((s.distance(p), s.normal(p))),
+            BodyShape::Cylinder(c) => Some((c.distance(p), c.normal(p))),
+            BodyShape::Box(b) => Some((b.distance(p), b.normal(p))),
+        }
+    }
+
+    /// A box in the body frame outside which the shape is not seen (a grid's extent, or the
+    /// solid's bounds).
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            BodyShape::Grid(grid) => grid.bounds(),
+            BodyShape::Sphere(s) => Aabb {
+                min: s.center - Vec3::splat(s.radius),
+                max: s.center + Vec3::splat(s.radius),
+            },
+            BodyShape::Cylinder(c) => {
+                let a = c.axis;
+                let half = Vec3::new(
+                    c.radius * (1.0 - a.x * a.x).max(0.0).sqrt() + 0.5 * c.height * a.x.abs(),
+                    c.radius * (1.0 - a.y * a.y).max(0.0).sqrt() + 0.5 * c.height * a.y.abs(),
+                    c.radius * (1.0 - a.z * a.z).max(0.0).sqrt() + 0.5 * c.height * a.z.abs(),
+                );
+                Aabb {
+                    min: c.center - half,
+                    max: c.center + half,
+                }
+            }
+            BodyShape::Box(b) => Aabb {
+                min: b.center - b.half_extents,
+                max: b.center + b.half_extents,
+            },
+        }
+    }
+}
