@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # The project's test command (README quick start; CI runs it through .ci/run).
-# Installs what the tests need, then checks formatting, lints and runs every test.
+# Installs what the tests need, checks formatting and lints, runs every test, then runs the
+# smoke validation suite (cgdem and LAMMPS) and checks its report in a real browser.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# Reference codes: the golden tests against LAMMPS/LIGGGHTS run whenever they are present.
-# Installing them needs root and apt; without them those tests report themselves skipped.
+# Reference codes: the golden tests against LAMMPS run whenever it is present. Installing
+# needs root and apt; without them those tests and runs report themselves skipped.
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     bash scripts/install-references.sh || echo "note: reference codes not installed; their tests will be skipped"
 fi
@@ -13,3 +14,21 @@ fi
 cargo fmt --all -- --check
 cargo clippy --release --all-targets -- -D warnings
 cargo test --release
+
+# The smoke suite: every part of the harness on a small collapse (a few minutes).
+report=target/smoke-report
+rm -rf "$report"
+cargo run --release --quiet -- validate --suite smoke --out "$report" --quiet
+python3 - "$report/summary.json" <<'PY'
+import json, sys
+summary = json.load(open(sys.argv[1]))
+failed = [r for r in summary["runs"] if r["status"] == "failed"]
+for r in failed:
+    print(f"smoke run failed: {r['code']} lambda={r['lambda']} seed={r['seed']}: {r['reason']}")
+sys.exit(1 if failed else 0)
+PY
+if [ "$(id -u)" = 0 ] || command -v chromium >/dev/null 2>&1; then
+    bash scripts/check-report-in-browser.sh "$report/index.html"
+else
+    echo "note: chromium not available and cannot be installed without root; report not checked in a browser"
+fi
