@@ -328,15 +328,9 @@ fn main() -> ExitCode {
             } else {
                 PathBuf::from("validation/suites").join(format!("{suite}.toml"))
             };
-            let pool = match rayon::ThreadPoolBuilder::new()
-                .num_threads(threads.unwrap_or(0))
-                .build()
-            {
+            let pool = match worker_pool(threads) {
                 Ok(pool) => pool,
-                Err(e) => {
-                    eprintln!("error: cannot start the worker threads: {e}");
-                    return ExitCode::FAILURE;
-                }
+                Err(code) => return code,
             };
             let options = cgdem::harness::validate::ValidateOptions {
                 suite: suite_path,
@@ -427,21 +421,9 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            if threads == Some(0) {
-                eprintln!("error: --threads must be at least 1");
-                return ExitCode::from(2);
-            }
-            // The whole run executes inside the pool: parallel loops started from a worker
-            // thread run small jobs inline instead of handing them across threads each step.
-            let pool = match rayon::ThreadPoolBuilder::new()
-                .num_threads(threads.unwrap_or(0))
-                .build()
-            {
+            let pool = match worker_pool(threads) {
                 Ok(pool) => pool,
-                Err(e) => {
-                    eprintln!("error: cannot start the worker threads: {e}");
-                    return ExitCode::FAILURE;
-                }
+                Err(code) => return code,
             };
             let result = pool.install(|| {
                 Scene::load(&case)
@@ -526,4 +508,21 @@ fn default_out_dir(scene: &Scene) -> PathBuf {
         }
     }
     PathBuf::from("runs").join(name)
+}
+
+/// The worker pool a command runs inside. Running the whole simulation inside it means
+/// parallel loops started from a worker thread run small jobs inline instead of handing them
+/// across threads every step.
+fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, ExitCode> {
+    if threads == Some(0) {
+        eprintln!("error: --threads must be at least 1");
+        return Err(ExitCode::from(2));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| {
+            eprintln!("error: cannot start the worker threads: {e}");
+            ExitCode::FAILURE
+        })
 }

@@ -136,19 +136,7 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     ])
     .caption("Summary: every comparison against its stated tolerance");
     for c in &summary.comparisons {
-        table.row([
-            Cell::text(&c.case),
-            Cell::text(&c.kind),
-            Cell::text(&c.what),
-            Cell::num(format!("{:.2}", c.difference)),
-            Cell::num(format!("{:.2}", c.combined_spread)),
-            Cell::num(format!("{:.2}", c.tolerance)),
-            if c.pass {
-                Cell::pass("pass")
-            } else {
-                Cell::fail("fail")
-            },
-        ]);
+        table.row(std::iter::once(Cell::text(&c.case)).chain(comparison_cells(c)));
     }
     let mut run_table = Table::new([
         "case",
@@ -203,6 +191,22 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         .write(&html_path)
         .map_err(|e| output_error(&html_path, e))?;
     Ok(summary)
+}
+
+/// A comparison's table cells: kind, what, difference, spread, tolerance, verdict.
+fn comparison_cells(c: &Comparison) -> [Cell; 6] {
+    [
+        Cell::text(&c.kind),
+        Cell::text(&c.what),
+        Cell::num(format!("{:.2}", c.difference)),
+        Cell::num(format!("{:.2}", c.combined_spread)),
+        Cell::num(format!("{:.2}", c.tolerance)),
+        if c.pass {
+            Cell::pass("pass")
+        } else {
+            Cell::fail("fail")
+        },
+    ]
 }
 
 fn rule_name(rule: CoarseGrainRule) -> &'static str {
@@ -719,18 +723,7 @@ fn write_case_section(
         "verdict",
     ]);
     for c in comparisons {
-        table.row([
-            Cell::text(&c.kind),
-            Cell::text(&c.what),
-            Cell::num(format!("{:.2}", c.difference)),
-            Cell::num(format!("{:.2}", c.combined_spread)),
-            Cell::num(format!("{:.2}", c.tolerance)),
-            if c.pass {
-                Cell::pass("pass")
-            } else {
-                Cell::fail("fail")
-            },
-        ]);
+        table.row(comparison_cells(c));
     }
     section.table(table);
     let rule = scene.repose.as_ref().map(|_| {

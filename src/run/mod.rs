@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
 use crate::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
-use crate::analysis::heap::{self, HeapProfile, ReposeFit};
+use crate::analysis::heap::{self, HeapProfile};
 use crate::bodies::{Body, BodyShape, Motion};
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
@@ -22,7 +22,7 @@ use crate::insertion::{insert_random_where, InsertionFailed};
 use crate::io::{vtk::VtkSeries, write_atomic};
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
-use crate::scene::{ContactSettings, InsertAmount, Scene, StageEnd};
+use crate::scene::{ContactSettings, InsertAmount, ReposeSettings, Scene, StageEnd};
 use crate::simulation::{NeighborSettings, World};
 use crate::timestep::{self, LinearContact, Timescales, UnstableTimeStep};
 use crate::walls::{Wall, WallLaw, WallSet, WcaWall};
@@ -82,6 +82,32 @@ pub struct ReposeSample {
     pub repose_fit_r2: Option<Real>,
     pub runout_m: Real,
     pub wall_height_m: Real,
+}
+
+impl ReposeSample {
+    /// Measures a heap profile by the scene's repose rule (the same for every code).
+    pub fn measure(
+        profile: &HeapProfile,
+        rule: &ReposeSettings,
+        max_diameter: Real,
+        time_after_start_s: Real,
+        trigger: &str,
+    ) -> ReposeSample {
+        let fit = heap::repose_angle(
+            profile,
+            2.0 * max_diameter,
+            rule.exclude_wall_fraction,
+            rule.exclude_toe_fraction,
+        );
+        ReposeSample {
+            time_after_start_s,
+            trigger: trigger.to_string(),
+            repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
+            repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
+            runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
+            wall_height_m: profile.wall_height(),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -426,30 +452,16 @@ fn execute<L: PairLaw, W: WallLaw>(
             )
         })
     };
-    let fit = |profile: &HeapProfile| -> Option<ReposeFit> {
-        let r = scene.repose.as_ref()?;
-        heap::repose_angle(
-            profile,
-            2.0 * max_diameter,
-            r.exclude_wall_fraction,
-            r.exclude_toe_fraction,
-        )
-    };
     let sample = |world: &World<L, W>,
                   time_after_start_s: Real,
                   trigger: &str|
      -> Option<(ReposeSample, HeapProfile)> {
+        let rule = scene.repose.as_ref()?;
         let profile = heap_profile(world)?;
-        let f = fit(&profile);
-        let sample = ReposeSample {
-            time_after_start_s,
-            trigger: trigger.to_string(),
-            repose_angle_deg: f.as_ref().map(|f| f.angle_deg),
-            repose_fit_r2: f.as_ref().map(|f| f.r_squared),
-            runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
-            wall_height_m: profile.wall_height(),
-        };
-        Some((sample, profile))
+        Some((
+            ReposeSample::measure(&profile, rule, max_diameter, time_after_start_s, trigger),
+            profile,
+        ))
     };
 
     let total_estimate: Real = scene

@@ -225,20 +225,13 @@ pub fn postprocess(
         };
         let p = frame_particles(frame, scene, &path)?;
         if let (Some(profile), Some(r)) = (heap_profile(&p), scene.repose.as_ref()) {
-            let fit = heap::repose_angle(
+            samples.push(ReposeSample::measure(
                 &profile,
-                2.0 * max_diameter,
-                r.exclude_wall_fraction,
-                r.exclude_toe_fraction,
-            );
-            samples.push(ReposeSample {
-                time_after_start_s: *t,
-                trigger: "fixed time".into(),
-                repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
-                repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
-                runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
-                wall_height_m: profile.wall_height(),
-            });
+                r,
+                max_diameter,
+                *t,
+                "fixed time",
+            ));
             final_profile = Some(profile);
         }
     }
@@ -255,20 +248,14 @@ pub fn postprocess(
             {
                 let p = frame_particles(frame, scene, &traj_path)?;
                 if let Some(profile) = heap_profile(&p) {
-                    let fit = heap::repose_angle(
+                    let t = (frame.step - mark.start) as Real * dt;
+                    samples.push(ReposeSample::measure(
                         &profile,
-                        2.0 * max_diameter,
-                        r.exclude_wall_fraction,
-                        r.exclude_toe_fraction,
-                    );
-                    samples.push(ReposeSample {
-                        time_after_start_s: (frame.step - mark.start) as Real * dt,
-                        trigger: "stage end".into(),
-                        repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
-                        repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
-                        runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
-                        wall_height_m: profile.wall_height(),
-                    });
+                        r,
+                        max_diameter,
+                        t,
+                        "stage end",
+                    ));
                     final_profile = Some(profile);
                 }
             }
