@@ -604,6 +604,7 @@ fn execute<L: PairLaw, W: WallLaw>(
                 if let Some((s, profile)) = sample(&world, repose_times[next_sample], "fixed time")
                 {
                     samples.push(s);
+                    write_measurements(out, &samples, &profile)?;
                     final_profile = Some(profile);
                 }
                 next_sample += 1;
@@ -616,6 +617,7 @@ fn execute<L: PairLaw, W: WallLaw>(
         if measures_at_end {
             if let Some((s, profile)) = sample(&world, world.time - start, "stage end") {
                 samples.push(s);
+                write_measurements(out, &samples, &profile)?;
                 final_profile = Some(profile);
             }
         }
@@ -671,14 +673,10 @@ fn execute<L: PairLaw, W: WallLaw>(
         }
         _ => None,
     };
-    let final_profile = final_profile.or_else(|| heap_profile(&world));
-    if let Some(profile) = &final_profile {
-        let path = out.join("profile.csv");
-        write_atomic(&path, profile_csv(profile).as_bytes()).map_err(|e| output_error(&path, e))?;
-    }
-    if !samples.is_empty() {
-        let path = out.join("repose.csv");
-        write_atomic(&path, repose_csv(&samples).as_bytes()).map_err(|e| output_error(&path, e))?;
+    if final_profile.is_none() {
+        if let Some(profile) = heap_profile(&world) {
+            write_measurements(out, &samples, &profile)?;
+        }
     }
     let headline = headline_sample(&samples);
     let summary = RunSummary {
@@ -779,4 +777,20 @@ pub fn headline_sample(samples: &[ReposeSample]) -> Option<&ReposeSample> {
         .rev()
         .find(|s| s.trigger == "stage end")
         .or(samples.last())
+}
+
+/// Writes `repose.csv` (all samples so far) and `profile.csv` (the latest profile) as soon as
+/// a measurement is taken, so a run stopped later keeps them.
+fn write_measurements(
+    out: &Path,
+    samples: &[ReposeSample],
+    profile: &HeapProfile,
+) -> Result<(), RunError> {
+    let path = out.join("profile.csv");
+    write_atomic(&path, profile_csv(profile).as_bytes()).map_err(|e| output_error(&path, e))?;
+    if !samples.is_empty() {
+        let path = out.join("repose.csv");
+        write_atomic(&path, repose_csv(samples).as_bytes()).map_err(|e| output_error(&path, e))?;
+    }
+    Ok(())
 }
