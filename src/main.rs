@@ -6,14 +6,12 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use cgdem::coarse_graining::{
-    coarse_grain, coarse_grain_by, coarse_grain_warnings, CoarseGrainRule,
-};
+use cgdem::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
 use cgdem::geometry::accuracy::format_accuracy_table;
 use cgdem::geometry::screw_feeder::{self, ScrewFeederSpec};
 use cgdem::report::sdf_study::write_sdf_accuracy_study;
 use cgdem::run::{run, RunOptions};
-use cgdem::scene::Scene;
+use cgdem::scene::{Override, Scene};
 
 #[derive(Parser)]
 #[command(
@@ -61,6 +59,10 @@ enum Command {
         /// model (gravity, cohesion, rolling with Hertz), instead of warning.
         #[arg(long)]
         strict: bool,
+        /// Override a scene field before validation, e.g. `--set wall_contact.friction=0.0`
+        /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// Screw-speed sweep, e.g. `rpm=20,40,60`: one run per speed of the `[conveying]`
         /// body into OUT/rpm<N>/, then OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7).
         #[arg(long)]
@@ -84,6 +86,11 @@ enum Command {
         /// No per-run progress lines.
         #[arg(long)]
         quiet: bool,
+        /// Reuse runs already in OUT/runs that are exactly this suite's (same scene digest
+        /// for cgdem, same deck for a reference code): resumes an interrupted suite, or
+        /// rebuilds the report without re-running.
+        #[arg(long)]
+        reuse: bool,
     },
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).
@@ -107,12 +114,19 @@ enum ReferenceCode {
         /// Coarse-graining level (a power of two), applied before the deck is written.
         #[arg(long, default_value_t = 1)]
         lambda: u32,
+        /// Coarse-graining rule, as for `cgdem run`.
+        #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
+        cg_rule: CoarseGrainRule,
         /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
         #[arg(long)]
         seed: Option<u64>,
         /// Output directory (default: runs/<case>-lambda<N>-lammps).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Override a scene field before validation, e.g. `--set wall_contact.friction=0.0`
+        /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp`); default: serial.
         #[arg(long)]
         np: Option<u32>,
@@ -129,81 +143,50 @@ enum ReferenceCode {
     },
 }
 
-#[allow(clippy::too_many_arguments)]
-fn reference_lammps(
-    case: &std::path::Path,
-    lambda: u32,
-    seed: Option<u64>,
-    out: Option<PathBuf>,
-    np: Option<u32>,
-    timeout: u64,
-    force_dt: bool,
-    postprocess_only: bool,
-) -> Result<ExitCode, String> {
-    use cgdem::harness::lammps::{self, RunStatus, RunnerOptions};
-    let scene = Scene::load(case).map_err(|e| e.to_string())?;
-    let scene = match seed {
-        Some(s) => scene.with_insertion_seed(s),
-        None => scene,
-    };
-    let scene = coarse_grain(&scene, lambda).map_err(|e| e.to_string())?;
+fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
+    use cgdem::harness::lammps::{self, ReferenceOptions, RunStatus, RunnerOptions};
+    let ReferenceCode::Lammps {
+        case,
+        lambda,
+        cg_rule,
+        seed,
+        out,
+        np,
+        timeout,
+        force_dt,
+        postprocess_only,
+        set,
+    } = args;
+    let scene = load_scene(&case, &set, seed)?;
+    let scene = coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())?;
     let out = out.unwrap_or_else(|| {
         PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda))
     });
-    let (dt, scales, warning) =
-        cgdem::run::time_step(&scene, force_dt).map_err(|e| e.to_string())?;
-    if let Some(w) = warning {
-        eprintln!("warning: {w}");
-    }
-    let particles = cgdem::run::initial_particles(&scene, false, &[]).map_err(|e| e.to_string())?;
-    let deck = lammps::write_deck(&scene, &particles, dt).map_err(|e| e.to_string())?;
-    let finish = |wall_s: f64, note: Option<String>| -> Result<cgdem::run::RunSummary, String> {
-        let mut summary = lammps::postprocess(
-            &scene,
-            &out,
-            &deck.plan,
-            &scales,
-            wall_s,
-            np.unwrap_or(1) as usize,
-        )
-        .map_err(|e| e.to_string())?;
-        summary.warnings.extend(note);
-        lammps::write_summary(&summary, &out).map_err(|e| e.to_string())?;
-        Ok(summary)
-    };
-    let status = if postprocess_only {
-        let previous = std::fs::read_to_string(out.join(lammps::deck::DECK_FILE)).map_err(|e| {
-            format!(
-                "--postprocess-only: cannot read {}: {e}",
-                out.join(lammps::deck::DECK_FILE).display()
-            )
-        })?;
-        if previous != deck.input {
-            return Err(format!(
-                "--postprocess-only: {} was not written for this case, lambda and seed",
-                out.join(lammps::deck::DECK_FILE).display()
-            ));
-        }
-        RunStatus::Completed { wall_s: f64::NAN }
-    } else {
-        deck.write_to(&out)
-            .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
-        println!(
-            "deck for {} at lambda = {} ({} particles, dt = {dt:.4e} s) in {}",
-            scene.name,
-            scene.lambda,
-            particles.len(),
-            out.display()
-        );
-        let options = RunnerOptions {
+    let options = ReferenceOptions {
+        runner: RunnerOptions {
             np,
             timeout: std::time::Duration::from_secs(timeout),
-        };
-        lammps::run_deck(&out, &options)
+        },
+        force_dt,
+        postprocess_only,
     };
-    match status {
-        RunStatus::Completed { wall_s } => {
-            let summary = finish(wall_s, None)?;
+    let run = lammps::run_reference(&scene, &out, &options)?;
+    if let Some(w) = &run.dt_warning {
+        eprintln!("warning: {w}");
+    }
+    if !postprocess_only {
+        println!(
+            "deck for {} at lambda = {} ({} particles, dt = {:.4e} s) in {}",
+            scene.name,
+            scene.lambda,
+            run.n_particles,
+            run.dt,
+            out.display()
+        );
+    }
+    match run.status {
+        RunStatus::Completed { .. } => {
+            let summary = run.summary.expect("a completed run is post-processed");
             println!(
                 "LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
                 summary.steps, summary.wall_s, summary.particle_steps_per_s
@@ -235,16 +218,30 @@ fn reference_lammps(
             out.display()
         )),
         RunStatus::TimedOut { after_s, log_tail } => {
-            // Keep what the run reached: partial outputs and a summary that says so.
-            let note = format!("LAMMPS killed after {after_s:.0} s (--timeout): partial run");
-            let partial = finish(after_s, Some(note))
-                .err()
-                .map_or(String::new(), |e| {
-                    format!(" (post-processing the partial run failed: {e})")
-                });
-            Err(format!("LAMMPS killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}", out.display()))
+            // The partial outputs are kept, with a summary that says so when it could be made.
+            let partial = run.partial_error.map_or(String::new(), |e| {
+                format!(" (post-processing the partial run failed: {e})")
+            });
+            Err(format!(
+                "LAMMPS killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}",
+                out.display()
+            ))
         }
     }
+}
+
+/// Reads a scene with its `--set` overrides and, when given, an insertion seed.
+fn load_scene(case: &std::path::Path, set: &[String], seed: Option<u64>) -> Result<Scene, String> {
+    let overrides = set
+        .iter()
+        .map(|o| Override::parse(o, std::path::Path::new("--set")))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let scene = Scene::load_with_overrides(case, &overrides).map_err(|e| e.to_string())?;
+    Ok(match seed {
+        Some(s) => scene.with_insertion_seed(s),
+        None => scene,
+    })
 }
 
 #[derive(Subcommand)]
@@ -322,6 +319,7 @@ fn main() -> ExitCode {
             threads,
             reference_timeout,
             quiet,
+            reuse,
         } => {
             let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
                 PathBuf::from(&suite)
@@ -337,6 +335,7 @@ fn main() -> ExitCode {
                 out: out.clone(),
                 quiet,
                 reference_timeout_s: reference_timeout,
+                reuse,
             };
             match pool.install(|| cgdem::harness::validate::validate(&options)) {
                 Ok(summary) => {
@@ -360,28 +359,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Reference {
-            code:
-                ReferenceCode::Lammps {
-                    case,
-                    lambda,
-                    seed,
-                    out,
-                    np,
-                    timeout,
-                    force_dt,
-                    postprocess_only,
-                },
-        } => match reference_lammps(
-            &case,
-            lambda,
-            seed,
-            out,
-            np,
-            timeout,
-            force_dt,
-            postprocess_only,
-        ) {
+        Command::Reference { code } => match reference_lammps(code) {
             Ok(code) => code,
             Err(message) => {
                 eprintln!("error: {message}");
@@ -400,6 +378,7 @@ fn main() -> ExitCode {
             force_dt,
             strict,
             sweep,
+            set,
         } => {
             let speeds: Option<Vec<f64>> = match sweep.as_deref().map(|s| s.strip_prefix("rpm=")) {
                 None => None,
@@ -426,12 +405,7 @@ fn main() -> ExitCode {
                 Err(code) => return code,
             };
             let result = pool.install(|| {
-                Scene::load(&case)
-                    .map_err(|e| e.to_string())
-                    .map(|scene| match seed {
-                        Some(s) => scene.with_insertion_seed(s),
-                        None => scene,
-                    })
+                load_scene(&case, &set, seed)
                     .and_then(|scene| {
                         let warnings = coarse_grain_warnings(&scene, lambda);
                         if strict && !warnings.is_empty() {

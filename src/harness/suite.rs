@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::coarse_graining::CoarseGrainRule;
+use crate::scene::{Override, Scene, SceneError};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -36,6 +37,22 @@ pub struct SuiteCase {
     /// Largest acceptable repose-angle difference between codes or levels, degrees, when
     /// it is not already within the combined seed spread.
     pub angle_tolerance_deg: f64,
+    /// Scene overrides (`KEY=VALUE`) that make this case a variant of its file.
+    pub overrides: Vec<Override>,
+    /// The variant's name, appended to the scene's name (`aor_collapse-smooth-walls`) in run
+    /// directories and the report; required with `set`.
+    pub variant: Option<String>,
+}
+
+impl SuiteCase {
+    /// The case's scene: its file with the overrides applied, named after the variant.
+    pub fn load_scene(&self) -> Result<Scene, SceneError> {
+        let mut scene = Scene::load_with_overrides(&self.file, &self.overrides)?;
+        if let Some(v) = &self.variant {
+            scene.name = format!("{}-{v}", scene.name);
+        }
+        Ok(scene)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -84,6 +101,9 @@ struct RawCase {
     cg_rules: Vec<String>,
     seeds: Vec<u64>,
     angle_tolerance_deg: Option<f64>,
+    #[serde(default)]
+    set: Vec<String>,
+    variant: Option<String>,
 }
 
 impl Suite {
@@ -92,7 +112,12 @@ impl Suite {
             file: path.to_path_buf(),
             source,
         })?;
-        let raw: RawSuite = toml::from_str(&text).map_err(|e| SuiteError::Syntax {
+        Suite::parse(&text, path)
+    }
+
+    /// Validates suite text; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Suite, SuiteError> {
+        let raw: RawSuite = toml::from_str(text).map_err(|e| SuiteError::Syntax {
             file: path.to_path_buf(),
             message: e.to_string().trim_end().replace('\n', "\n  "),
         })?;
@@ -163,6 +188,40 @@ impl Suite {
                     "a number of degrees > 0",
                 ));
             }
+            let overrides = c
+                .set
+                .iter()
+                .map(|o| Override::parse(o, path))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| {
+                    invalid(
+                        format!("case[{k}].set"),
+                        format!("{:?}", c.set),
+                        &e.to_string(),
+                    )
+                })?;
+            let variant_ok = |v: &str| {
+                !v.is_empty()
+                    && v.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            };
+            match &c.variant {
+                Some(v) if !variant_ok(v) => {
+                    return Err(invalid(
+                        format!("case[{k}].variant"),
+                        format!("\"{v}\""),
+                        "a name of letters, digits, `-` and `_`",
+                    ))
+                }
+                None if !overrides.is_empty() => {
+                    return Err(invalid(
+                        format!("case[{k}].variant"),
+                        "(missing)".into(),
+                        "a name for the variant that `set` makes, e.g. variant = \"smooth-walls\"",
+                    ))
+                }
+                _ => {}
+            }
             cases.push(SuiteCase {
                 file: c.file,
                 codes,
@@ -170,6 +229,8 @@ impl Suite {
                 cg_rules,
                 seeds: c.seeds,
                 angle_tolerance_deg,
+                overrides,
+                variant: c.variant,
             });
         }
         Ok(Suite {
@@ -178,5 +239,49 @@ impl Suite {
             source: path.to_path_buf(),
             cases,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CASE: &str = "name = \"t\"\n[[case]]\nfile = \"validation/cases/aor_smoke.toml\"\ncodes = [\"cgdem\"]\nlambdas = [8]\nseeds = [1]\n";
+
+    #[test]
+    fn a_variant_overrides_its_scene_and_is_named_after_it() {
+        let text =
+            format!("{CASE}set = [\"wall_contact.friction=0.0\"]\nvariant = \"smooth-walls\"\n");
+        let suite = Suite::parse(&text, Path::new("s.toml")).unwrap();
+        let scene = suite.cases[0].load_scene().unwrap();
+        let plain = Scene::load(Path::new("validation/cases/aor_smoke.toml")).unwrap();
+        assert_eq!(scene.name, format!("{}-smooth-walls", plain.name));
+        assert_ne!(scene.digest(), plain.digest());
+        assert_ne!(scene.wall_contact, plain.wall_contact);
+    }
+
+    #[test]
+    fn set_needs_a_variant_name_and_valid_overrides() {
+        let e = Suite::parse(
+            &format!("{CASE}set = [\"wall_contact.friction=0.0\"]\n"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("case[0].variant") && e.contains("(missing)"),
+            "{e}"
+        );
+        let e = Suite::parse(
+            &format!("{CASE}set = [\"friction\"]\nvariant = \"v\"\n"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("case[0].set") && e.contains("KEY=VALUE"), "{e}");
+        let e = Suite::parse(&format!("{CASE}variant = \"a b\"\n"), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("case[0].variant"), "{e}");
     }
 }

@@ -37,6 +37,8 @@ pub struct RunRecord {
     pub repose_angle_deg: Option<f64>,
     pub repose_fit_r2: Option<f64>,
     pub runout_m: Option<f64>,
+    /// The run was not repeated: its directory already held it (`--reuse`).
+    pub reused: bool,
 }
 
 /// One judged comparison.
@@ -84,6 +86,11 @@ pub struct ValidateOptions {
     pub quiet: bool,
     /// Time limit of one reference-code run, seconds.
     pub reference_timeout_s: u64,
+    /// Reuse a run directory that already holds this exact run (an interrupted suite resumes;
+    /// a report is rebuilt without re-running): cgdem's when its summary's scene digest
+    /// matches, a reference code's when its deck is the one the case writes now (its dumps are
+    /// post-processed again by the current code).
+    pub reuse: bool,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -96,7 +103,7 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
     let provenance = provenance(&suite, options);
     for case in &suite.cases {
-        let scene = Scene::load(&case.file).map_err(|e| ValidateError::Case {
+        let scene = case.load_scene().map_err(|e| ValidateError::Case {
             file: case.file.clone(),
             message: e.to_string(),
         })?;
@@ -152,6 +159,7 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     .caption("Runs");
     for r in &summary.runs {
         let status = match r.status.as_str() {
+            "ok" if r.reused => Cell::pass("ok (reused)"),
             "ok" => Cell::pass("ok"),
             "skipped" => {
                 Cell::skipped(format!("skipped: {}", r.reason.clone().unwrap_or_default()))
@@ -303,10 +311,13 @@ fn run_case(
                         repose_angle_deg: None,
                         repose_fit_r2: None,
                         runout_m: None,
+                        reused: false,
                     };
                     let outcome = match code {
-                        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options.quiet),
-                        Code::Lammps => run_lammps(scene, lambda, rule, seed, &dir, options.reference_timeout_s),
+                        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options)
+                            .map(|reused| record.reused = reused),
+                        Code::Lammps => run_lammps(scene, lambda, rule, seed, &dir, options)
+                            .map(|reused| record.reused = reused),
                         Code::Liggghts => Err(RunOutcome::Skipped("LIGGGHTS cannot express the seed's WCA model; Hertz decks for LIGGGHTS are not written yet".into())),
                     };
                     match outcome {
@@ -346,24 +357,35 @@ enum RunOutcome {
     Failed(String),
 }
 
+/// Runs cgdem, or with `--reuse` takes the run already in `dir`; true when reused.
 fn run_cgdem(
     scene: &Scene,
     lambda: u32,
     rule: CoarseGrainRule,
     seed: u64,
     dir: &Path,
-    quiet: bool,
-) -> Result<(), RunOutcome> {
+    options: &ValidateOptions,
+) -> Result<bool, RunOutcome> {
     let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
-    let options = RunOptions {
+    if options.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+        return Ok(true);
+    }
+    let run_options = RunOptions {
         out_dir: dir.to_path_buf(),
-        quiet,
+        quiet: options.quiet,
         force_dt: false,
     };
-    run(&coarse, &options)
-        .map(|_| ())
+    run(&coarse, &run_options)
+        .map(|_| false)
         .map_err(|e| RunOutcome::Failed(e.to_string()))
+}
+
+/// The scene digest in `dir/summary.json`, if a finished run left one.
+fn finished_digest(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value.get("scene_digest")?.as_str().map(str::to_string)
 }
 
 fn run_lammps(
@@ -372,36 +394,45 @@ fn run_lammps(
     rule: CoarseGrainRule,
     seed: u64,
     dir: &Path,
-    timeout_s: u64,
-) -> Result<(), RunOutcome> {
-    use super::lammps::{run_reference, RunStatus, RunnerOptions};
+    validate: &ValidateOptions,
+) -> Result<bool, RunOutcome> {
+    use super::lammps::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
     let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
-    let options = RunnerOptions {
-        np: None,
-        timeout: std::time::Duration::from_secs(timeout_s),
+    let mut options = ReferenceOptions {
+        runner: RunnerOptions {
+            np: None,
+            timeout: std::time::Duration::from_secs(validate.reference_timeout_s),
+        },
+        ..ReferenceOptions::default()
     };
-    match run_reference(&coarse, dir, &options).map_err(RunOutcome::Failed)? {
-        (RunStatus::Completed { .. }, _) => Ok(()),
-        (
-            RunStatus::Skipped {
-                reason,
-                install_hint,
-            },
-            _,
-        ) => Err(RunOutcome::Skipped(format!(
+    // A finished run whose deck is the one this case writes now is post-processed again,
+    // not repeated; anything else (no run, another deck, a failed post-processing) runs.
+    if validate.reuse && dir.join("summary.json").exists() {
+        options.postprocess_only = true;
+        if let Ok(run) = run_reference(&coarse, dir, &options) {
+            if run.summary.is_some() {
+                return Ok(true);
+            }
+        }
+        options.postprocess_only = false;
+    }
+    let run = run_reference(&coarse, dir, &options).map_err(RunOutcome::Failed)?;
+    match run.status {
+        RunStatus::Completed { .. } => Ok(false),
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => Err(RunOutcome::Skipped(format!(
             "{reason}; install with `{install_hint}`"
         ))),
-        (
-            RunStatus::Failed {
-                exit_code,
-                log_tail,
-            },
-            _,
-        ) => Err(RunOutcome::Failed(format!(
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => Err(RunOutcome::Failed(format!(
             "LAMMPS exit code {exit_code:?}; log tail: {log_tail}"
         ))),
-        (RunStatus::TimedOut { after_s, log_tail }, _) => Err(RunOutcome::Failed(format!(
+        RunStatus::TimedOut { after_s, log_tail } => Err(RunOutcome::Failed(format!(
             "LAMMPS timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
         ))),
     }

@@ -150,6 +150,8 @@ pub struct RunSummary {
     pub conveying: Option<ConveyingSummary>,
     pub warnings: Vec<String>,
     pub scene_file: String,
+    /// `Scene::digest` of the (coarse-grained) scene this run simulated.
+    pub scene_digest: String,
     pub cgdem_version: String,
 }
 
@@ -720,6 +722,7 @@ fn execute<L: PairLaw, W: WallLaw>(
         conveying: conveying_summary,
         warnings,
         scene_file: file,
+        scene_digest: scene.digest(),
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
     };
     let path = out.join("summary.json");

@@ -1,10 +1,12 @@
 //! Scene files: TOML read into raw structs, then validated once into typed settings.
 
 mod error;
+mod overrides;
 mod raw;
 mod validate;
 
 pub use error::SceneError;
+pub use overrides::Override;
 
 use std::path::{Path, PathBuf};
 
@@ -287,6 +289,15 @@ impl Scene {
         Scene::parse(&text, path)
     }
 
+    /// Reads a scene file, applies `KEY=VALUE` overrides to its text, then validates it.
+    pub fn load_with_overrides(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Unreadable {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Scene::parse(&overrides::apply_overrides(&text, path, overrides)?, path)
+    }
+
     /// Validates scene text; `path` is used in messages.
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         let raw: raw::RawScene = toml::from_str(text).map_err(|e| SceneError::Syntax {
@@ -303,6 +314,20 @@ impl Scene {
             ins.seed = seed.wrapping_add(k as u64);
         }
         out
+    }
+
+    /// A fingerprint of everything that decides a run (parameters, coarse-graining, seeds; not
+    /// the file's path): equal digests mean the same simulation, so a finished run can be
+    /// reused instead of repeated (`cgdem validate --reuse`). FNV-1a over the settings' debug
+    /// text, so it changes whenever a setting or the settings' layout changes.
+    pub fn digest(&self) -> String {
+        let mut settings = self.clone();
+        settings.source = PathBuf::new();
+        let text = format!("{settings:?}");
+        let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+        });
+        format!("{hash:016x}")
     }
 
     pub fn max_diameter(&self) -> Real {

@@ -331,6 +331,7 @@ pub fn postprocess(
         stages,
         warnings,
         scene_file: scene.source.display().to_string(),
+        scene_digest: scene.digest(),
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
     })
 }
