@@ -37,6 +37,12 @@ pub struct SuiteCase {
     /// Largest acceptable repose-angle difference between codes or levels, degrees, when
     /// it is not already within the combined seed spread.
     pub angle_tolerance_deg: f64,
+    /// Largest acceptable |ratio - 1| of the characteristic flow times (`t_half`, the time
+    /// for the front to cover half its largest advance) between codes or levels.
+    pub time_ratio_tolerance: f64,
+    /// Largest acceptable gap between two front-position histories, as a fraction of the
+    /// box length.
+    pub front_tolerance: f64,
     /// Scene overrides (`KEY=VALUE`) that make this case a variant of its file.
     pub overrides: Vec<Override>,
     /// The variant's name, appended to the scene's name (`aor_collapse-smooth-walls`) in run
@@ -101,6 +107,8 @@ struct RawCase {
     cg_rules: Vec<String>,
     seeds: Vec<u64>,
     angle_tolerance_deg: Option<f64>,
+    time_ratio_tolerance: Option<f64>,
+    front_tolerance: Option<f64>,
     #[serde(default)]
     set: Vec<String>,
     variant: Option<String>,
@@ -188,6 +196,21 @@ impl Suite {
                     "a number of degrees > 0",
                 ));
             }
+            let fraction = |field: &str, value: Option<f64>, default: f64| {
+                let v = value.unwrap_or(default);
+                if v.is_finite() && v > 0.0 && v < 1.0 {
+                    Ok(v)
+                } else {
+                    Err(invalid(
+                        format!("case[{k}].{field}"),
+                        v.to_string(),
+                        "a fraction between 0 and 1 (exclusive)",
+                    ))
+                }
+            };
+            let time_ratio_tolerance =
+                fraction("time_ratio_tolerance", c.time_ratio_tolerance, 0.10)?;
+            let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
             let overrides = c
                 .set
                 .iter()
@@ -229,6 +252,8 @@ impl Suite {
                 cg_rules,
                 seeds: c.seeds,
                 angle_tolerance_deg,
+                time_ratio_tolerance,
+                front_tolerance,
                 overrides,
                 variant: c.variant,
             });

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::dynamics::{flow_difference, FlowSeries};
 use super::suite::{Code, Suite, SuiteCase};
 use crate::coarse_graining::{coarse_grain_by, CoarseGrainRule};
 use crate::io::write_atomic;
@@ -47,7 +48,13 @@ pub struct Comparison {
     pub case: String,
     /// "codes" (two codes at one level) or "levels" (one code at two levels).
     pub kind: String,
+    /// "final state" (repose angle, in degrees) or "dynamics" (characteristic-time ratio
+    /// `t_half`, judged as |ratio - 1|, and the front-history gap): a pair is similar only if
+    /// both pass.
+    pub part: String,
     pub what: String,
+    /// The numbers behind the verdict, in words.
+    pub detail: String,
     pub difference: f64,
     pub combined_spread: f64,
     pub tolerance: f64,
@@ -135,13 +142,14 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     let mut table = Table::new([
         "case",
         "comparison",
+        "part",
         "what",
         "difference",
         "combined seed spread",
         "tolerance",
         "verdict",
     ])
-    .caption("Summary: every comparison against its stated tolerance");
+    .caption("Summary: every comparison against its stated tolerance (final state: repose angle in degrees; dynamics: |t_half ratio - 1| and the front-history gap)");
     for c in &summary.comparisons {
         table.row(std::iter::once(Cell::text(&c.case)).chain(comparison_cells(c)));
     }
@@ -202,9 +210,10 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
 }
 
 /// A comparison's table cells: kind, what, difference, spread, tolerance, verdict.
-fn comparison_cells(c: &Comparison) -> [Cell; 6] {
+fn comparison_cells(c: &Comparison) -> [Cell; 7] {
     [
         Cell::text(&c.kind),
+        Cell::text(&c.part),
         Cell::text(&c.what),
         Cell::num(format!("{:.2}", c.difference)),
         Cell::num(format!("{:.2}", c.combined_spread)),
@@ -477,9 +486,11 @@ fn mean_spread(values: &[f64]) -> Option<(f64, f64)> {
 }
 
 type Group = (CoarseGrainRule, u32, Code);
+/// A group of runs: (coarse-graining rule as u8, lambda, code).
+type GroupKey = (u8, u32, Code);
 
-fn angles_by_group(runs: &[RunRecord]) -> BTreeMap<(u8, u32, Code), Vec<f64>> {
-    let mut groups: BTreeMap<(u8, u32, Code), Vec<f64>> = BTreeMap::new();
+fn angles_by_group(runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<f64>> {
+    let mut groups: BTreeMap<GroupKey, Vec<f64>> = BTreeMap::new();
     for r in runs {
         if let Some(a) = r.repose_angle_deg {
             groups
@@ -499,66 +510,168 @@ fn rule_of(index: u8) -> CoarseGrainRule {
     }
 }
 
-fn compare(scene: &Scene, case: &SuiteCase, runs: &[RunRecord]) -> Vec<Comparison> {
-    let groups = angles_by_group(runs);
-    let stats: BTreeMap<(u8, u32, Code), (f64, f64)> = groups
-        .iter()
-        .filter_map(|(k, v)| mean_spread(v).map(|s| (*k, s)))
-        .collect();
+/// The pairs a case compares: codes against each other at each level and rule ("codes"),
+/// and each code's neighbouring levels under each rule ("levels"), finer first.
+fn comparison_pairs(keys: &[GroupKey]) -> Vec<(&'static str, GroupKey, GroupKey)> {
     let mut out = Vec::new();
-    let judge = |kind: &str, what: String, a: (f64, f64), b: (f64, f64)| {
-        let difference = (a.0 - b.0).abs();
-        let combined_spread = (a.1 * a.1 + b.1 * b.1).sqrt();
-        let within_spread = difference <= combined_spread;
-        Comparison {
-            case: scene.name.clone(),
-            kind: kind.into(),
-            what,
-            difference,
-            combined_spread,
-            tolerance: case.angle_tolerance_deg,
-            within_spread,
-            pass: within_spread || difference <= case.angle_tolerance_deg,
-        }
-    };
-    // Codes against each other at each level.
-    for (&(rule, lambda, code_a), &a) in &stats {
-        for (&(rule_b, lambda_b, code_b), &b) in &stats {
+    for &(rule, lambda, code_a) in keys {
+        for &(rule_b, lambda_b, code_b) in keys {
             if rule == rule_b && lambda == lambda_b && code_a < code_b {
-                out.push(judge(
-                    "codes",
-                    format!(
-                        "repose angle, {} vs {}, lambda = {lambda} ({})",
-                        code_a.name(),
-                        code_b.name(),
-                        rule_name(rule_of(rule))
-                    ),
-                    a,
-                    b,
-                ));
+                out.push(("codes", (rule, lambda, code_a), (rule, lambda, code_b)));
             }
         }
     }
-    // Each code's neighbouring levels (coarsening similarity of the final state).
-    for (&(rule, lambda, code), &a) in &stats {
-        let finer = stats
+    for &(rule, lambda, code) in keys {
+        let finer = keys
             .iter()
-            .filter(|(&(r, l, c), _)| r == rule && c == code && l < lambda)
-            .max_by_key(|(&(_, l, _), _)| l);
-        if let Some((&(_, finer_lambda, _), &b)) = finer {
-            out.push(judge(
-                "levels",
-                format!(
-                    "repose angle, {} lambda = {finer_lambda} vs {lambda} ({})",
-                    code.name(),
-                    rule_name(rule_of(rule))
-                ),
-                b,
-                a,
-            ));
+            .filter(|&&(r, l, c)| r == rule && c == code && l < lambda)
+            .max_by_key(|&&(_, l, _)| l);
+        if let Some(&f) = finer {
+            out.push(("levels", f, (rule, lambda, code)));
         }
     }
     out
+}
+
+fn pair_name(kind: &str, a: GroupKey, b: GroupKey) -> String {
+    let rule = rule_name(rule_of(a.0));
+    if kind == "codes" {
+        format!(
+            "{} vs {}, lambda = {} ({rule})",
+            a.2.name(),
+            b.2.name(),
+            a.1
+        )
+    } else {
+        format!("{} lambda = {} vs {} ({rule})", a.2.name(), a.1, b.1)
+    }
+}
+
+/// The ratio of characteristic times the derivation in reference/COARSE_GRAINING.md
+/// predicts between two groups: 1 between codes and under the bulk-viscosity rule; under the
+/// seed rule between 1 (inertial collapse) and the lambda ratio (viscous collapse).
+fn predicted_time_ratio(kind: &str, a: GroupKey, b: GroupKey) -> String {
+    match (kind, rule_of(a.0)) {
+        ("levels", CoarseGrainRule::Seed) => format!(
+            "1 (inertial) to {} (viscous): bulk viscosity ~ lambda gamma/d",
+            b.1 as f64 / a.1 as f64
+        ),
+        _ => "1".into(),
+    }
+}
+
+fn compare(scene: &Scene, case: &SuiteCase, runs: &[RunRecord]) -> Vec<Comparison> {
+    let groups = angles_by_group(runs);
+    let stats: BTreeMap<GroupKey, (f64, f64)> = groups
+        .iter()
+        .filter_map(|(k, v)| mean_spread(v).map(|s| (*k, s)))
+        .collect();
+    let flows = flows_by_group(scene, runs);
+    let mut keys: Vec<GroupKey> = stats.keys().chain(flows.keys()).copied().collect();
+    keys.sort();
+    keys.dedup();
+    let box_length = scene.domain.hi.x - scene.domain.lo.x;
+    let mut out = Vec::new();
+    for (kind, a, b) in comparison_pairs(&keys) {
+        let what = pair_name(kind, a, b);
+        if let (Some(&sa), Some(&sb)) = (stats.get(&a), stats.get(&b)) {
+            let difference = (sa.0 - sb.0).abs();
+            let combined_spread = (sa.1 * sa.1 + sb.1 * sb.1).sqrt();
+            let within_spread = difference <= combined_spread;
+            out.push(Comparison {
+                case: scene.name.clone(),
+                kind: kind.into(),
+                part: "final state".into(),
+                what: what.clone(),
+                detail: format!(
+                    "repose angle {:.1} +- {:.1} vs {:.1} +- {:.1} deg",
+                    sa.0, sa.1, sb.0, sb.1
+                ),
+                difference,
+                combined_spread,
+                tolerance: case.angle_tolerance_deg,
+                within_spread,
+                pass: within_spread || difference <= case.angle_tolerance_deg,
+            });
+        }
+        if let (Some(fa), Some(fb)) = (flows.get(&a), flows.get(&b)) {
+            if let Some(c) = compare_flows(scene, case, kind, (a, fa), (b, fb), box_length) {
+                out.push(Comparison { what, ..c });
+            }
+        }
+    }
+    out
+}
+
+/// The dynamics part of a comparison: the ratio of the seeds' mean `t_half` (judged against
+/// 1 within `time_ratio_tolerance`, or within the combined relative spread) and the gap
+/// between the seed-mean front histories (within `front_tolerance` of the box length).
+fn compare_flows(
+    scene: &Scene,
+    case: &SuiteCase,
+    kind: &str,
+    (a, fa): (GroupKey, &Vec<FlowSeries>),
+    (b, fb): (GroupKey, &Vec<FlowSeries>),
+    box_length: f64,
+) -> Option<Comparison> {
+    let ta: Vec<f64> = fa.iter().filter_map(FlowSeries::t_half).collect();
+    let tb: Vec<f64> = fb.iter().filter_map(FlowSeries::t_half).collect();
+    let (ma, sa) = mean_spread(&ta)?;
+    let (mb, sb) = mean_spread(&tb)?;
+    let ratio = mb / ma;
+    let relative_spread = ratio * ((sa / ma).powi(2) + (sb / mb).powi(2)).sqrt();
+    let difference = (ratio - 1.0).abs();
+    let within_spread = difference <= relative_spread;
+    let step = FLOW_GRID_S;
+    let mean_a = FlowSeries::mean(fa, step)?;
+    let mean_b = FlowSeries::mean(fb, step)?;
+    let gap = flow_difference(&mean_a, &mean_b, box_length, step)?;
+    let front_ok = gap.front_max <= case.front_tolerance;
+    Some(Comparison {
+        case: scene.name.clone(),
+        kind: kind.into(),
+        part: "dynamics".into(),
+        what: String::new(),
+        detail: format!(
+            "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {}); \
+             front gap max {:.3}, mean {:.3} of the box length (tolerance {}); wall height gap \
+             max {:.3}, mean {:.3} of the initial height; kinetic energy gap max {:.3}, mean {:.3} \
+             of the peak",
+            predicted_time_ratio(kind, a, b),
+            gap.front_max,
+            gap.front_mean,
+            case.front_tolerance,
+            gap.wall_height_max,
+            gap.wall_height_mean,
+            gap.kinetic_energy_max,
+            gap.kinetic_energy_mean,
+        ),
+        difference,
+        combined_spread: relative_spread,
+        tolerance: case.time_ratio_tolerance,
+        within_spread,
+        pass: (within_spread || difference <= case.time_ratio_tolerance) && front_ok,
+    })
+}
+
+/// Spacing of the common time grid on which flow histories are averaged and compared.
+const FLOW_GRID_S: f64 = 0.01;
+
+/// Every successful run's flow during the measured stage, per group.
+fn flows_by_group(scene: &Scene, runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<FlowSeries>> {
+    let mut groups: BTreeMap<GroupKey, Vec<FlowSeries>> = BTreeMap::new();
+    let Some(stage) = scene.repose.as_ref().map(|r| r.stage.as_str()) else {
+        return groups;
+    };
+    for r in runs.iter().filter(|r| r.status == "ok") {
+        if let Some(flow) = FlowSeries::read(&r.dir, stage) {
+            groups
+                .entry((r.cg_rule as u8, r.lambda, r.code))
+                .or_default()
+                .push(flow);
+        }
+    }
+    groups
 }
 
 fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
@@ -619,14 +732,6 @@ fn write_case_section(
         "distance from the remaining wall x [m]",
         "surface height h(x) [m]",
     );
-    let mut front = Figure::new(
-        format!(
-            "{}: front position after the gate opens (first seed)",
-            scene.name
-        ),
-        "time after the gate opens t [s]",
-        "front position x_f [m]",
-    );
     let mut keys: Vec<Group> = ok_runs
         .iter()
         .map(|r| (r.cg_rule, r.lambda, r.code))
@@ -658,28 +763,6 @@ fn write_case_section(
             )
             .style(SeriesStyle::Line),
         );
-        if let Some(first) = members.first() {
-            let stage = scene
-                .repose
-                .as_ref()
-                .map(|r| r.stage.clone())
-                .unwrap_or_default();
-            let rows: Vec<_> = read_csv(&first.dir.join("timeseries.csv"))
-                .into_iter()
-                .filter(|row| row.get("stage") == Some(&stage))
-                .collect();
-            let t0 = rows
-                .first()
-                .and_then(|r| number(r, "time_s"))
-                .unwrap_or(0.0);
-            let points = rows
-                .iter()
-                .filter_map(|row| Some((number(row, "time_s")? - t0, number(row, "front_m")?)))
-                .collect();
-            front
-                .series
-                .push(Series::new(label(code, lambda, rule), points).style(SeriesStyle::Line));
-        }
     }
     let files = write_figure(&dir, "profiles", &profiles).map_err(figure_error)?;
     section.figure(&files, "heap profiles", "Free-surface height against distance from the remaining wall at the measurement time, averaged over seeds.").map_err(|e| output_error(&dir, e))?;
@@ -716,9 +799,6 @@ fn write_case_section(
     let files = write_figure(&dir, "repose_angle", &angles).map_err(figure_error)?;
     section.figure(&files, "repose angle per level", "Mean repose angle over seeds; error bars are the sample standard deviation across seeds.").map_err(|e| output_error(&dir, e))?;
 
-    let files = write_figure(&dir, "front_position", &front).map_err(figure_error)?;
-    section.figure(&files, "front position against time", "Furthest point where the deposit is at least two diameters deep, against time after the gate opens.").map_err(|e| output_error(&dir, e))?;
-
     let bars: Vec<(String, String, f64, Option<f64>)> = keys
         .iter()
         .filter_map(|&(rule, lambda, code)| {
@@ -745,18 +825,7 @@ fn write_case_section(
     .map_err(figure_error)?;
     section.figure(&files, "throughput per code and level", "Particle-steps per second (mean and spread over seeds); wall time includes insertion and output.").map_err(|e| output_error(&dir, e))?;
 
-    let mut table = Table::new([
-        "comparison",
-        "what",
-        "difference [deg]",
-        "combined spread [deg]",
-        "tolerance [deg]",
-        "verdict",
-    ]);
-    for c in comparisons {
-        table.row(comparison_cells(c));
-    }
-    section.table(table);
+    write_similarity(section, scene, case, runs, comparisons, &dir)?;
     let rule = scene.repose.as_ref().map(|_| {
         "The repose angle is measured by the rule stated in each run's summary.json (repose_rule)."
     });
@@ -764,4 +833,188 @@ fn write_case_section(
         section.paragraph(rule);
     }
     Ok(())
+}
+
+/// The case's similarity section: for every compared pair, the final state and the dynamics
+/// judged separately (a pair is similar only if both pass), and the flow histories behind the
+/// dynamics, mean over seeds, one line per code, level and rule.
+fn write_similarity(
+    section: &mut crate::report::Section,
+    scene: &Scene,
+    case: &SuiteCase,
+    runs: &[RunRecord],
+    comparisons: &[Comparison],
+    dir: &Path,
+) -> Result<(), ValidateError> {
+    let figure_error = |e: crate::report::PlotError| output_error(dir, e);
+    let sub = section.subsection("Similarity: final state and dynamics");
+    sub.paragraph(format!(
+        "A pair of codes or levels is similar only if both its final state (repose angle within \
+         {} deg or within the combined seed spread) and its dynamics agree: the characteristic \
+         time t_half (time for the front to cover half its largest advance after the gate \
+         opens, mean over seeds) in a ratio within 1 +- {} (or within the combined spread), and \
+         the seed-mean front histories within {} of the box length at all times. The predicted \
+         time ratios are derived in reference/COARSE_GRAINING.md.",
+        case.angle_tolerance_deg, case.time_ratio_tolerance, case.front_tolerance
+    ));
+    let mut table = Table::new(["pair", "final state", "dynamics", "similar", "numbers"])
+        .caption("Final-state and dynamic similarity, judged separately");
+    let mut pairs: Vec<&str> = comparisons.iter().map(|c| c.what.as_str()).collect();
+    pairs.dedup();
+    for what in pairs {
+        let part = |name: &str| {
+            comparisons
+                .iter()
+                .find(|c| c.what == what && c.part == name)
+        };
+        let verdict = |c: Option<&Comparison>| match c {
+            Some(c) if c.pass => Cell::pass("agrees"),
+            Some(_) => Cell::fail("differs"),
+            None => Cell::skipped("not measured"),
+        };
+        let (fs, dy) = (part("final state"), part("dynamics"));
+        let similar = match (fs.map(|c| c.pass), dy.map(|c| c.pass)) {
+            (Some(true), Some(true)) => Cell::pass("yes"),
+            (Some(false), Some(false)) => Cell::fail("no: final state and dynamics"),
+            (Some(false), _) => Cell::fail("no: final state"),
+            (_, Some(false)) => Cell::fail("no: dynamics"),
+            _ => Cell::skipped("incomplete"),
+        };
+        let numbers = [fs, dy]
+            .iter()
+            .flatten()
+            .map(|c| c.detail.clone())
+            .collect::<Vec<_>>()
+            .join("; ");
+        table.row([
+            Cell::text(what),
+            verdict(fs),
+            verdict(dy),
+            similar,
+            Cell::text(numbers),
+        ]);
+    }
+    sub.table(table);
+
+    let flows = flows_by_group(scene, runs);
+    let time_axis = "time after the gate opens t [s]";
+    let mut front = Figure::new(
+        format!("{}: front position (mean over seeds)", scene.name),
+        time_axis,
+        "front position x_f [m]",
+    );
+    let mut height = Figure::new(
+        format!(
+            "{}: height at the remaining wall (mean over seeds)",
+            scene.name
+        ),
+        time_axis,
+        "wall height h_w [m]",
+    );
+    let mut energy = Figure::new(
+        format!("{}: kinetic energy (mean over seeds)", scene.name),
+        time_axis,
+        "kinetic energy per mass [J/kg]",
+    )
+    .log_y();
+    for (&(rule, lambda, code), series) in &flows {
+        let Some(mean) = FlowSeries::mean(series, FLOW_GRID_S) else {
+            continue;
+        };
+        let name = label(code, lambda, rule_of(rule));
+        let points = |v: &[f64]| {
+            mean.time_s
+                .iter()
+                .copied()
+                .zip(v.iter().copied())
+                .collect::<Vec<_>>()
+        };
+        front
+            .series
+            .push(Series::new(name.clone(), points(&mean.front_m)).style(SeriesStyle::Line));
+        height
+            .series
+            .push(Series::new(name.clone(), points(&mean.wall_height_m)).style(SeriesStyle::Line));
+        let positive = points(&mean.kinetic_energy_per_mass)
+            .into_iter()
+            .filter(|p| p.1 > 0.0)
+            .collect();
+        energy
+            .series
+            .push(Series::new(name, positive).style(SeriesStyle::Line));
+    }
+    // The repose angle at the fixed times after the gate opens, mean and spread over seeds.
+    let mut angle = Figure::new(
+        format!(
+            "{}: repose angle at fixed times (mean over seeds)",
+            scene.name
+        ),
+        time_axis,
+        "repose angle [deg]",
+    );
+    let mut keys: Vec<GroupKey> = runs
+        .iter()
+        .filter(|r| r.status == "ok")
+        .map(|r| (r.cg_rule as u8, r.lambda, r.code))
+        .collect();
+    keys.sort();
+    keys.dedup();
+    for key in keys {
+        let mut by_time: BTreeMap<u64, Vec<f64>> = BTreeMap::new();
+        for r in runs
+            .iter()
+            .filter(|r| r.status == "ok" && (r.cg_rule as u8, r.lambda, r.code) == key)
+        {
+            for (t, a) in fixed_time_angles(&r.dir) {
+                by_time.entry(t.to_bits()).or_default().push(a);
+            }
+        }
+        let (points, errors): (Vec<(f64, f64)>, Vec<f64>) = by_time
+            .iter()
+            .filter_map(|(t, v)| mean_spread(v).map(|(m, s)| ((f64::from_bits(*t), m), s)))
+            .unzip();
+        if !points.is_empty() {
+            angle.series.push(
+                Series::new(label(key.2, key.1, rule_of(key.0)), points)
+                    .y_err(errors)
+                    .style(SeriesStyle::LineMarkers),
+            );
+        }
+    }
+    for (stem, fig, title, caption) in [
+        ("front_position", &front, "front position against time", "Furthest point where the deposit is at least two diameters deep, against time after the gate opens; mean over seeds (a run that came to rest holds its last value)."),
+        ("wall_height", &height, "height at the remaining wall against time", "Surface height next to the remaining wall; mean over seeds."),
+        ("kinetic_energy", &energy, "kinetic energy against time", "Kinetic energy per unit mass; mean over seeds."),
+        ("angle_vs_time", &angle, "repose angle at fixed times", "Repose angle by the case's rule at fixed times after the gate opens (the heap is still flowing at the early ones); error bars are the spread over seeds."),
+    ] {
+        let files = write_figure(dir, stem, fig).map_err(figure_error)?;
+        sub.figure(&files, title, caption).map_err(|e| output_error(dir, e))?;
+    }
+    Ok(())
+}
+
+/// (time after the stage start, angle) of a run's fixed-time repose samples.
+fn fixed_time_angles(dir: &Path) -> Vec<(f64, f64)> {
+    let Ok(text) = std::fs::read_to_string(dir.join("summary.json")) else {
+        return Vec::new();
+    };
+    let Ok(value) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    value
+        .get("repose_samples")
+        .and_then(|v| v.as_array())
+        .map(|samples| {
+            samples
+                .iter()
+                .filter(|s| s.get("trigger").and_then(|v| v.as_str()) == Some("fixed time"))
+                .filter_map(|s| {
+                    Some((
+                        s.get("time_after_start_s")?.as_f64()?,
+                        s.get("repose_angle_deg")?.as_f64()?,
+                    ))
+                })
+                .collect()
+        })
+        .unwrap_or_default()
 }

@@ -1,0 +1,231 @@
+//! How a collapse unfolds, not only where it ends: the flow time series every run writes
+//! (`timeseries.csv`: front position, height at the remaining wall, kinetic energy), their
+//! mean over seeds, the characteristic time `t_half`, and the differences between two runs'
+//! series after normalising (issue: coarsening fidelity beyond the final heap).
+
+use std::path::Path;
+
+/// One run's (or a mean over seeds') flow during the measured stage, time from its start.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FlowSeries {
+    pub time_s: Vec<f64>,
+    /// Furthest x where the deposit is at least two diameters deep.
+    pub front_m: Vec<f64>,
+    /// Column height at the remaining wall.
+    pub wall_height_m: Vec<f64>,
+    pub kinetic_energy_per_mass: Vec<f64>,
+}
+
+impl FlowSeries {
+    /// Reads the rows of `stage` from `dir/timeseries.csv`; None when the file or its
+    /// columns are missing or the stage has no rows.
+    pub fn read(dir: &Path, stage: &str) -> Option<FlowSeries> {
+        let text = std::fs::read_to_string(dir.join("timeseries.csv")).ok()?;
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next()?.split(',').collect();
+        let col = |name: &str| header.iter().position(|h| *h == name);
+        let (t, st, x, h, ke) = (
+            col("time_s")?,
+            col("stage")?,
+            col("front_m")?,
+            col("wall_height_m")?,
+            col("kinetic_energy_per_mass_j_kg")?,
+        );
+        let mut out = FlowSeries::default();
+        let mut t0 = None;
+        for line in lines {
+            let f: Vec<&str> = line.split(',').collect();
+            if f.get(st) != Some(&stage) {
+                continue;
+            }
+            let num = |k: usize| f.get(k).and_then(|v| v.parse::<f64>().ok());
+            let (Some(time), Some(front), Some(height), Some(energy)) =
+                (num(t), num(x), num(h), num(ke))
+            else {
+                continue;
+            };
+            let start = *t0.get_or_insert(time);
+            out.time_s.push(time - start);
+            out.front_m.push(front);
+            out.wall_height_m.push(height);
+            out.kinetic_energy_per_mass.push(energy);
+        }
+        (!out.time_s.is_empty()).then_some(out)
+    }
+
+    pub fn duration(&self) -> f64 {
+        self.time_s.last().copied().unwrap_or(0.0)
+    }
+
+    /// Time for the front to advance half of its largest advance beyond its start (the
+    /// collapse's characteristic time); None if the front never moves.
+    pub fn t_half(&self) -> Option<f64> {
+        let start = *self.front_m.first()?;
+        let largest = self.front_m.iter().map(|x| x - start).fold(0.0, f64::max);
+        if largest <= 0.0 {
+            return None;
+        }
+        let k = self
+            .front_m
+            .iter()
+            .position(|x| x - start >= 0.5 * largest)?;
+        Some(self.time_s[k])
+    }
+
+    /// Linear interpolation of every column at `t`; past the end the last value holds (the
+    /// run stopped because the heap came to rest).
+    fn at(&self, t: f64) -> (f64, f64, f64) {
+        let n = self.time_s.len();
+        let k = self.time_s.partition_point(|&s| s <= t);
+        let pick = |v: &[f64]| -> f64 {
+            if k == 0 {
+                v[0]
+            } else if k >= n {
+                v[n - 1]
+            } else {
+                let (t0, t1) = (self.time_s[k - 1], self.time_s[k]);
+                let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+                v[k - 1] + w * (v[k] - v[k - 1])
+            }
+        };
+        (
+            pick(&self.front_m),
+            pick(&self.wall_height_m),
+            pick(&self.kinetic_energy_per_mass),
+        )
+    }
+
+    /// The mean of several runs on a common grid of spacing `step` up to the longest run.
+    pub fn mean(runs: &[FlowSeries], step: f64) -> Option<FlowSeries> {
+        let end = runs.iter().map(FlowSeries::duration).fold(0.0, f64::max);
+        if runs.is_empty() || step <= 0.0 {
+            return None;
+        }
+        let n = (end / step).round() as usize + 1;
+        let mut out = FlowSeries::default();
+        for i in 0..n {
+            let t = i as f64 * step;
+            let (mut x, mut h, mut e) = (0.0, 0.0, 0.0);
+            for r in runs {
+                let v = r.at(t);
+                x += v.0;
+                h += v.1;
+                e += v.2;
+            }
+            let k = runs.len() as f64;
+            out.time_s.push(t);
+            out.front_m.push(x / k);
+            out.wall_height_m.push(h / k);
+            out.kinetic_energy_per_mass.push(e / k);
+        }
+        Some(out)
+    }
+}
+
+/// Differences between two flows after normalising: the front by the box length, the wall
+/// height by the reference's initial height, the kinetic energy per mass by the reference's
+/// peak; largest and time-averaged over the longer of the two (the ended one holds its last
+/// value).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FlowDifference {
+    pub front_max: f64,
+    pub front_mean: f64,
+    pub wall_height_max: f64,
+    pub wall_height_mean: f64,
+    pub kinetic_energy_max: f64,
+    pub kinetic_energy_mean: f64,
+}
+
+pub fn flow_difference(
+    reference: &FlowSeries,
+    other: &FlowSeries,
+    box_length: f64,
+    step: f64,
+) -> Option<FlowDifference> {
+    let h0 = *reference.wall_height_m.first()?;
+    let e_peak = reference
+        .kinetic_energy_per_mass
+        .iter()
+        .copied()
+        .fold(0.0, f64::max);
+    if other.time_s.is_empty() || h0 <= 0.0 || e_peak <= 0.0 || box_length <= 0.0 || step <= 0.0 {
+        return None;
+    }
+    let end = reference.duration().max(other.duration());
+    let n = (end / step).round() as usize + 1;
+    let mut d = FlowDifference {
+        front_max: 0.0,
+        front_mean: 0.0,
+        wall_height_max: 0.0,
+        wall_height_mean: 0.0,
+        kinetic_energy_max: 0.0,
+        kinetic_energy_mean: 0.0,
+    };
+    for i in 0..n {
+        let t = i as f64 * step;
+        let (a, b) = (reference.at(t), other.at(t));
+        let dx = (a.0 - b.0).abs() / box_length;
+        let dh = (a.1 - b.1).abs() / h0;
+        let de = (a.2 - b.2).abs() / e_peak;
+        d.front_max = d.front_max.max(dx);
+        d.wall_height_max = d.wall_height_max.max(dh);
+        d.kinetic_energy_max = d.kinetic_energy_max.max(de);
+        d.front_mean += dx / n as f64;
+        d.wall_height_mean += dh / n as f64;
+        d.kinetic_energy_mean += de / n as f64;
+    }
+    Some(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series(f: impl Fn(f64) -> f64, end: f64) -> FlowSeries {
+        let time_s: Vec<f64> = (0..=(end * 100.0) as usize)
+            .map(|i| i as f64 * 0.01)
+            .collect();
+        FlowSeries {
+            front_m: time_s.iter().map(|&t| f(t)).collect(),
+            wall_height_m: time_s.iter().map(|&t| 0.2 - 0.1 * f(t)).collect(),
+            kinetic_energy_per_mass: time_s.iter().map(|&t| (t * (2.0 - t)).max(0.0)).collect(),
+            time_s,
+        }
+    }
+
+    #[test]
+    fn t_half_is_when_the_front_covers_half_its_largest_advance() {
+        // x_f = 0.1 + 0.2 (1 - exp(-t / 0.5)): half the advance at t = 0.5 ln 2.
+        let s = series(|t| 0.1 + 0.2 * (1.0 - (-t / 0.5).exp()), 5.0);
+        let t = s.t_half().unwrap();
+        assert!((t - 0.5 * 2f64.ln()).abs() <= 0.01, "{t}");
+        assert_eq!(series(|_| 0.1, 1.0).t_half(), None);
+    }
+
+    #[test]
+    fn a_flow_twice_as_slow_doubles_t_half_and_shows_in_the_front_difference() {
+        let fast = series(|t| 0.1 + 0.2 * (1.0 - (-t / 0.5).exp()), 6.0);
+        let slow = series(|t| 0.1 + 0.2 * (1.0 - (-t / 1.0).exp()), 6.0);
+        let ratio = slow.t_half().unwrap() / fast.t_half().unwrap();
+        assert!((ratio - 2.0).abs() < 0.05, "{ratio}");
+        let d = flow_difference(&fast, &slow, 0.5, 0.01).unwrap();
+        // Largest gap 0.2 (e^-x - e^-2x) at e^-x = 1/2: 0.05 m, 0.1 of a 0.5 m box.
+        assert!((d.front_max - 0.1).abs() < 0.002, "{d:?}");
+        assert!(d.front_mean > 0.0 && d.front_mean < d.front_max);
+        let same = flow_difference(&fast, &fast, 0.5, 0.01).unwrap();
+        assert_eq!(same.front_max, 0.0);
+    }
+
+    #[test]
+    fn the_mean_holds_a_finished_run_at_its_last_value() {
+        let a = series(|t| t, 1.0);
+        let b = series(|t| 2.0 * t, 2.0);
+        let m = FlowSeries::mean(&[a, b], 0.5).unwrap();
+        assert_eq!(m.time_s, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
+        assert!(
+            (m.front_m[4] - 0.5 * (1.0 + 4.0)).abs() < 1e-12,
+            "{:?}",
+            m.front_m
+        );
+    }
+}
