@@ -92,6 +92,23 @@ enum Command {
         #[arg(long)]
         reuse: bool,
     },
+    /// Add a nightly report (a `cgdem validate` output) to the history in DIR: appends its
+    /// metrics to DIR/history.json, rewrites DIR/index.html with the history table, trend
+    /// plots and flags, and prints the metrics that moved beyond tolerance since the
+    /// previous night (scripts/nightly.sh calls this).
+    History {
+        /// The history directory, e.g. reports/nightly.
+        dir: PathBuf,
+        /// The night's report directory.
+        #[arg(long)]
+        add: PathBuf,
+        /// The night's date (YYYY-MM-DD).
+        #[arg(long)]
+        date: String,
+        /// The cgdem commit the night ran.
+        #[arg(long)]
+        commit: String,
+    },
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).
     Reference {
@@ -367,6 +384,35 @@ fn main() -> ExitCode {
             }
         },
         Command::Geometry { command } => geometry(command),
+        Command::History {
+            dir,
+            add,
+            date,
+            commit,
+        } => match cgdem::harness::history::add_night(&dir, &add, &date, &commit) {
+            Ok(flags) => {
+                for f in &flags {
+                    println!(
+                        "flag: {} moved from {:.4e} to {:.4e} (tolerance {}{})",
+                        f.metric,
+                        f.previous,
+                        f.current,
+                        f.tolerance,
+                        if f.relative { " relative" } else { "" }
+                    );
+                }
+                println!(
+                    "history: {} ({} flags against the previous night)",
+                    dir.join("index.html").display(),
+                    flags.len()
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Run {
             case,
             lambda,

@@ -3,6 +3,7 @@
 //! The solver core never imports this module.
 
 pub mod dynamics;
+pub mod history;
 pub mod lammps;
 pub mod suite;
 pub mod validate;

@@ -94,9 +94,9 @@ pub struct ValidateOptions {
     /// Time limit of one reference-code run, seconds.
     pub reference_timeout_s: u64,
     /// Reuse a run directory that already holds this exact run (an interrupted suite resumes;
-    /// a report is rebuilt without re-running): cgdem's when its summary's scene digest
-    /// matches, a reference code's when its deck is the one the case writes now (its dumps are
-    /// post-processed again by the current code).
+    /// a report is rebuilt without re-running): when its summary's scene digest matches, or
+    /// for a reference run without one, when its deck is the one the case writes now (its
+    /// dumps are then post-processed again by the current code).
     pub reuse: bool,
 }
 
@@ -415,8 +415,12 @@ fn run_lammps(
         },
         ..ReferenceOptions::default()
     };
-    // A finished run whose deck is the one this case writes now is post-processed again,
-    // not repeated; anything else (no run, another deck, a failed post-processing) runs.
+    // A finished run of this very scene is reused; one whose deck is the one this case
+    // writes now (an older summary without a digest) is post-processed again; anything else
+    // (no run, another deck, dumps gone) runs.
+    if validate.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+        return Ok(true);
+    }
     if validate.reuse && dir.join("summary.json").exists() {
         options.postprocess_only = true;
         if let Ok(run) = run_reference(&coarse, dir, &options) {

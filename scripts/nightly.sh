@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The nightly validation: runs the nightly suite (cgdem and the reference codes) into
+# reports/nightly/<date>-<commit>/, then adds it to the history in reports/nightly/
+# (history.json, index.html with trends, and flags for metrics that moved beyond their
+# tolerance since the previous night).
+#
+# Re-running on the same day and commit resumes an interrupted night (`--reuse`: finished
+# runs are kept, the report is rebuilt). Exit status: 0, or 1 if a run failed or a metric
+# was flagged. Usage: bash scripts/nightly.sh [extra `cgdem validate` options]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    bash scripts/install-references.sh || echo "note: reference codes not installed; their runs will be marked skipped"
+fi
+cargo build --release --quiet
+cgdem=target/release/cgdem
+
+date=$(date +%F)
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git status --porcelain --untracked-files=no 2>/dev/null)" ]; then
+    commit="${commit}-dirty"
+fi
+night="reports/nightly/${date}-${commit}"
+mkdir -p "$night"
+
+started=$(date +%s)
+"$cgdem" validate --suite nightly --out "$night" --reuse "$@"
+echo "nightly suite: $(( $(date +%s) - started )) s wall time"
+
+# Keep the night small: run directories hold dumps and VTK files; the report needs only
+# its summaries, CSV and figures.
+find "$night/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete
+
+flags=$("$cgdem" history reports/nightly --add "$night" --date "$date" --commit "$commit")
+echo "$flags"
+failed=$(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print(sum(r['status']=='failed' for r in s['runs']))" "$night/summary.json")
+if [ "$failed" != 0 ] || grep -q '^flag:' <<<"$flags"; then
+    exit 1
+fi
