@@ -63,6 +63,11 @@ enum Command {
         /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Name the variant the overrides make: appended to the scene's name
+        /// (`aor_collapse-smooth-walls`), as a suite's `variant` does, so `validate --reuse`
+        /// recognises the run.
+        #[arg(long, requires = "set")]
+        variant: Option<String>,
         /// Screw-speed sweep, e.g. `rpm=20,40,60`: one run per speed of the `[conveying]`
         /// body into OUT/rpm<N>/, then OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7).
         #[arg(long)]
@@ -144,6 +149,11 @@ enum ReferenceCode {
         /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Name the variant the overrides make: appended to the scene's name
+        /// (`aor_collapse-smooth-walls`), as a suite's `variant` does, so `validate --reuse`
+        /// recognises the run.
+        #[arg(long, requires = "set")]
+        variant: Option<String>,
         /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp`); default: serial.
         #[arg(long)]
         np: Option<u32>,
@@ -173,8 +183,9 @@ fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
         force_dt,
         postprocess_only,
         set,
+        variant,
     } = args;
-    let scene = load_scene(&case, &set, seed)?;
+    let scene = load_scene(&case, &set, variant.as_deref(), seed)?;
     let scene = coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())?;
     let out = out.unwrap_or_else(|| {
         PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda))
@@ -247,14 +258,23 @@ fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
     }
 }
 
-/// Reads a scene with its `--set` overrides and, when given, an insertion seed.
-fn load_scene(case: &std::path::Path, set: &[String], seed: Option<u64>) -> Result<Scene, String> {
+/// Reads a scene with its `--set` overrides (named `variant`) and, when given, an insertion
+/// seed.
+fn load_scene(
+    case: &std::path::Path,
+    set: &[String],
+    variant: Option<&str>,
+    seed: Option<u64>,
+) -> Result<Scene, String> {
     let overrides = set
         .iter()
         .map(|o| Override::parse(o, std::path::Path::new("--set")))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;
-    let scene = Scene::load_with_overrides(case, &overrides).map_err(|e| e.to_string())?;
+    let mut scene = Scene::load_with_overrides(case, &overrides).map_err(|e| e.to_string())?;
+    if let Some(v) = variant {
+        scene.name = format!("{}-{v}", scene.name);
+    }
     Ok(match seed {
         Some(s) => scene.with_insertion_seed(s),
         None => scene,
@@ -425,6 +445,7 @@ fn main() -> ExitCode {
             strict,
             sweep,
             set,
+            variant,
         } => {
             let speeds: Option<Vec<f64>> = match sweep.as_deref().map(|s| s.strip_prefix("rpm=")) {
                 None => None,
@@ -451,7 +472,7 @@ fn main() -> ExitCode {
                 Err(code) => return code,
             };
             let result = pool.install(|| {
-                load_scene(&case, &set, seed)
+                load_scene(&case, &set, variant.as_deref(), seed)
                     .and_then(|scene| {
                         let warnings = coarse_grain_warnings(&scene, lambda);
                         if strict && !warnings.is_empty() {
