@@ -109,12 +109,21 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     let mut comparisons = Vec::new();
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
     let provenance = provenance(&suite, options);
+    // Cases of one scene (e.g. its two coarse-graining rules) are compared and reported
+    // together: one section, one set of figures, judged by the first case's tolerances.
+    let mut scenes: Vec<(Scene, &SuiteCase, Vec<RunRecord>)> = Vec::new();
     for case in &suite.cases {
         let scene = case.load_scene().map_err(|e| ValidateError::Case {
             file: case.file.clone(),
             message: e.to_string(),
         })?;
         let case_runs = run_case(&scene, case, options)?;
+        match scenes.iter_mut().find(|(s, _, _)| s.name == scene.name) {
+            Some((_, _, earlier)) => earlier.extend(case_runs),
+            None => scenes.push((scene, case, case_runs)),
+        }
+    }
+    for (scene, case, case_runs) in scenes {
         let case_comparisons = compare(&scene, case, &case_runs);
         write_case_section(
             &mut report,
