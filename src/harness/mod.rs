@@ -3,5 +3,6 @@
 //! The solver core never imports this module.
 
 pub mod lammps;
+pub mod liggghts;
 pub mod suite;
 pub mod validate;
