@@ -341,11 +341,12 @@ fn head_on_pair() {
     pair_case("pair head-on", 0.0, 0.0, &[]);
 }
 
-/// LAMMPS's rolling and tangential laws are not LIGGGHTS's (MAPPING.md): constant `k_roll`
-/// against epsd2's `k_t(delta) R^2`, contact-point velocity with the full radii against
-/// `r - delta/2`, Coulomb cap on spring + dashpot against the spring alone.
+/// LAMMPS's `mindlin` is not LIGGGHTS's `tangential history` (contact-point velocity with the
+/// full radii, Coulomb cap on spring + dashpot) and `rolling sds` has a constant stiffness;
+/// runs with rolling or friction switched off put the gap in the tangential law (MAPPING.md).
 const LAMMPS_SPIN: &str =
-    "LAMMPS rolling sds / mindlin are not epsd2 / tangential history (MAPPING.md)";
+    "LAMMPS mindlin / rolling sds are other laws than tangential history / epsd2 (MAPPING.md)";
+
 #[test]
 fn oblique_pair_with_spin() {
     pair_case(
