@@ -52,6 +52,9 @@ pub struct World<L: PairLaw, W: WallLaw> {
     neighbor: NeighborSettings,
     list: VerletList,
     history: Vec<L::History>,
+    /// Per particle, per planar wall (particle-major, `wall_slots()` each) contact history;
+    /// zero-sized for stateless wall laws.
+    wall_history: Vec<W::History>,
     pair_result: Vec<PairResult>,
     integrator: Integrator,
     /// PCVV's `F0`, `T0` (empty for velocity Verlet).
@@ -104,6 +107,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             neighbor,
             list: VerletList::new(neighbor.skin),
             history: Vec::new(),
+            wall_history: Vec::new(),
             pair_result: Vec::new(),
             bodies: Vec::new(),
             body_loads: Vec::new(),
@@ -315,6 +319,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     .collect(),
             );
             self.particles.retain(&keep);
+            let slots = self.wall_slots();
+            if self.wall_history.len() == keep.len() * slots {
+                let mut k = 0;
+                self.wall_history.retain(|_| {
+                    k += 1;
+                    keep[(k - 1) / slots]
+                });
+            }
             self.lost += (old_count - self.particles.len()) as u64;
             self.lost -= self.deleted - deleted_before;
         }
@@ -329,6 +341,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.list
                 .build(&mut self.particles, &self.domain, self.law.reach(), resort)
         {
+            // The wall history follows its particles.
+            let slots = self.wall_slots();
+            if self.wall_history.len() == order.len() * slots {
+                let old = std::mem::take(&mut self.wall_history);
+                self.wall_history = order
+                    .iter()
+                    .flat_map(|&o| {
+                        old[o as usize * slots..(o as usize + 1) * slots]
+                            .iter()
+                            .copied()
+                    })
+                    .collect();
+            }
             // Compose: old index -> (after removal) -> after re-sort.
             let mut sorted_index = vec![0u32; order.len()];
             for (new, &old) in order.iter().enumerate() {
@@ -437,8 +462,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
     }
 
+    /// History entries per particle: one per planar wall (at least one, so chunks exist).
+    fn wall_slots(&self) -> usize {
+        self.walls.walls.len().max(1)
+    }
+
     /// The gather for spinning particles: forces and torques of pairs, walls and gravity.
     fn gather_with_torques(&mut self) {
+        let slots = self.wall_slots();
+        let n = self.particles.len();
+        if self.wall_history.len() != n * slots {
+            self.wall_history.resize(n * slots, W::History::default());
+        }
+        let wall_history = &mut self.wall_history;
         let (list, results, dt) = (&self.list, &self.pair_result, self.dt);
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let Particles {
@@ -458,9 +494,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         force
             .par_iter_mut()
             .zip(a.torque.par_iter_mut())
+            .zip(wall_history.par_chunks_mut(slots))
             .enumerate()
             .with_min_len(CHUNK)
-            .for_each(|(i, (force, torque))| {
+            .for_each(|(i, ((force, torque), wall_history))| {
                 let mut f = mass[i] * gravity;
                 let particle = WallParticle {
                     species: species[i] as usize,
@@ -471,7 +508,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 };
                 let mut t = Vec3::ZERO;
                 if W::NEEDS_ROTATION {
-                    let (wf, wt) = walls.force_and_torque_on(wall_law, &particle, omega[i], dt);
+                    let (wf, wt) =
+                        walls.force_and_torque_on(wall_law, &particle, omega[i], wall_history, dt);
                     f += wf;
                     t += wt;
                 } else {

@@ -509,6 +509,7 @@ struct LinearWall {
 }
 
 impl WallLaw for LinearWall {
+    type History = ();
     fn reach(&self, _: usize, _: Real) -> Real {
         1.0
     }
@@ -606,4 +607,67 @@ fn coarse_graining_keeps_hertz_restitution_and_stretches_contact_time_by_lambda(
     );
     assert!((t2 / t1 / lambda - 1.0).abs() < 2e-3);
     assert!((e2 - e1).abs() < 1e-3);
+}
+
+/// The per-particle wall springs must follow their particle when particles are re-sorted:
+/// spheres sliding and spinning on a LIGGGHTS-style history floor end the same, by id,
+/// whether the list re-sorts them at every build or never.
+#[test]
+fn wall_history_follows_its_particle_through_re_sorting() {
+    let domain = open_box(0.02, false);
+    let run = |resort_every: u32| {
+        let wall = crate::walls::HertzHistoryWall::new(
+            &[(
+                Material::y_eff(MATERIAL, MATERIAL),
+                Material::g_eff(MATERIAL, MATERIAL),
+            )],
+            0.5,
+            0.5,
+            0.1,
+            1.0,
+        );
+        // Two spheres in one row of cells (y = -+1.1 mm, not touching) slide past each
+        // other along x, so the cell sort swaps them mid-run, while their wall springs load.
+        let z = domain.lo.z + RADIUS - 1e-6;
+        let bodies = [
+            (
+                Vec3::new(-0.004, -0.0011, z),
+                Vec3::new(1.0, 0.0, 0.0),
+                RADIUS,
+            ),
+            (
+                Vec3::new(0.004, 0.0011, z),
+                Vec3::new(-1.0, 0.0, 0.0),
+                RADIUS,
+            ),
+        ];
+        let mut w = world(
+            hertz_law(0.5, 0.5, NoCohesion),
+            wall,
+            floor(&domain),
+            domain.clone(),
+            &bodies,
+            Vec3::new(0.0, 0.0, -9.81),
+            1e-6,
+            resort_every,
+        );
+        let first = w.particles.id.clone();
+        for _ in 0..12000 {
+            w.step();
+        }
+        let p = &w.particles;
+        let swapped = p.id != first;
+        let mut by_id = vec![(Vec3::ZERO, Vec3::ZERO); p.len()];
+        for k in 0..p.len() {
+            by_id[p.id[k] as usize] = (p.velocity[k], p.angular.as_ref().unwrap().omega[k]);
+        }
+        (by_id, swapped)
+    };
+    let (sorted, swapped) = run(1);
+    let (unsorted, _) = run(0);
+    assert!(swapped, "the re-sort must have swapped the two spheres");
+    for (a, b) in sorted.iter().zip(&unsorted) {
+        assert!((a.0 - b.0).length() < 1e-12 && (a.1 - b.1).length() < 1e-9);
+        assert!(a.1.length() > 1.0, "the floor spun the sphere up");
+    }
 }

@@ -5,5 +5,6 @@
 pub mod dynamics;
 pub mod history;
 pub mod lammps;
+pub mod liggghts;
 pub mod suite;
 pub mod validate;

@@ -12,7 +12,7 @@ use crate::math::Real;
 use crate::scene::{
     CohesionKind, HertzDampingKind, HertzSettings, RollingKind, Scene, TangentialKind,
 };
-use crate::walls::HertzWall;
+use crate::walls::{HertzHistoryWall, HertzWall};
 
 /// A slot built from the scene (one material for all species, so every species-pair table
 /// holds the same value).
@@ -172,6 +172,34 @@ pub fn hertz_wall(scene: &Scene, h: &HertzSettings) -> HertzWall {
     )
 }
 
+/// LIGGGHTS's wall for `tangential = "history"`: the pair law's springs with `R_eff = r`
+/// (`walls::HertzHistoryWall`); epsd2 rolling when the particles have it.
+pub fn hertz_history_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall {
+    let w = &scene.wall_contact;
+    let wall = Material {
+        youngs_modulus: w.youngs_modulus.unwrap_or(h.youngs_modulus),
+        poisson_ratio: w.poisson_ratio.unwrap_or(h.poisson_ratio),
+    };
+    let moduli = vec![
+        (
+            Material::y_eff(material(h), wall),
+            Material::g_eff(material(h), wall)
+        );
+        scene.species.len()
+    ];
+    let rolling_friction = match h.rolling {
+        RollingKind::Epsd2 => w.rolling_friction,
+        _ => 0.0,
+    };
+    HertzHistoryWall::new(
+        &moduli,
+        w.restitution,
+        w.friction,
+        rolling_friction,
+        h.characteristic_velocity,
+    )
+}
+
 fn run_with<D, T, R, C>(
     scene: &Scene,
     h: &HertzSettings,
@@ -187,6 +215,25 @@ where
         scene,
         hertz_law::<D, T, R, C>(scene, h),
         hertz_wall(scene, h),
+        options,
+    )
+}
+
+/// `run_with` for the LIGGGHTS keywords (`tangential = "history"`, rolling none or epsd2):
+/// the walls are LIGGGHTS's, with the same springs (`hertz_history_wall`).
+fn run_liggghts<R, C>(
+    scene: &Scene,
+    h: &HertzSettings,
+    options: &RunOptions,
+) -> Result<RunSummary, RunError>
+where
+    R: RollingModel + FromScene,
+    C: CohesionModel + FromScene,
+{
+    execute(
+        scene,
+        hertz_law::<HertzDamping, Mindlin, R, C>(scene, h),
+        hertz_history_wall(scene, h),
         options,
     )
 }
@@ -213,7 +260,7 @@ pub fn run_hertz(
     type K = TangentialKind;
     match (h.damping, h.tangential, h.rolling, h.cohesion) {
         (Restitution, K::History, RollingKind::None, NoVdw) => {
-            run_with::<HertzDamping, Mindlin, NoRolling, NoCohesion>(scene, h, options)
+            run_liggghts::<NoRolling, NoCohesion>(scene, h, options)
         }
         (Restitution, K::History, RollingKind::ConstantTorque, NoVdw) => {
             run_with::<HertzDamping, Mindlin, ConstantTorque, NoCohesion>(scene, h, options)
@@ -222,10 +269,10 @@ pub fn run_hertz(
             run_with::<HertzDamping, Mindlin, ConstantTorque, VanDerWaals>(scene, h, options)
         }
         (Restitution, K::History, RollingKind::Epsd2, NoVdw) => {
-            run_with::<HertzDamping, Mindlin, Epsd2, NoCohesion>(scene, h, options)
+            run_liggghts::<Epsd2, NoCohesion>(scene, h, options)
         }
         (Restitution, K::History, RollingKind::Epsd2, Vdw { .. }) => {
-            run_with::<HertzDamping, Mindlin, Epsd2, VanDerWaals>(scene, h, options)
+            run_liggghts::<Epsd2, VanDerWaals>(scene, h, options)
         }
         (Yang { .. }, K::Yang, RollingKind::None, NoVdw) => {
             run_with::<YangDamping, YangTangential, NoRolling, NoCohesion>(scene, h, options)

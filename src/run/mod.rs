@@ -3,7 +3,7 @@
 
 mod hertz;
 
-pub use hertz::{hertz_law, hertz_wall, run_hertz, FromScene, SUPPORTED};
+pub use hertz::{hertz_history_wall, hertz_law, hertz_wall, run_hertz, FromScene, SUPPORTED};
 
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};

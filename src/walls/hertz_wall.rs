@@ -4,8 +4,11 @@
 //! **Normal.** `F_n = (4/3) Y_eff sqrt(r delta) delta`, `delta = r - h` (h the centre-to-plane
 //! distance), with the LIGGGHTS restitution dashpot `-2 sqrt(5/6) |beta(e_w)| sqrt(S_n m) v_n`.
 //!
-//! **Friction.** Not the history spring: a wall would need per-particle-per-wall history.
-//! It is the regularized kinetic Coulomb law of the seed's wall (`wca_wall`):
+//! Used with paper B's laws (`rolling = "constant_torque"`, `yang`); scenes with LIGGGHTS's
+//! keywords (`tangential = "history"`, rolling none or epsd2) get `HertzHistoryWall`, whose
+//! springs are LIGGGHTS's.
+//!
+//! **Friction.** Not the history spring: the regularized kinetic Coulomb law of the seed's wall (`wca_wall`):
 //! `-mu N v_t/|v_t|`, `N = max(F_n, 0)`, its magnitude capped at `m_c |v_t| / (2 dt)` so it can
 //! at most halve the contact-point slip per step; `m_c = (2/7) m` is the effective mass of the
 //! contact point of a solid sphere (`1/m_c = 1/m + r^2/I`). The contact-point velocity
@@ -61,6 +64,7 @@ impl HertzWall {
 
 impl WallLaw for HertzWall {
     const NEEDS_ROTATION: bool = true;
+    type History = ();
 
     fn reach(&self, _: usize, radius: Real) -> Real {
         radius

@@ -1,13 +1,16 @@
 //! Walls: finite planes that can be removed during a run, and the particle-wall laws.
 
+mod hertz_history_wall;
 mod hertz_wall;
 mod wca_wall;
 
+pub use hertz_history_wall::{HertzHistoryWall, HertzHistoryWallSpecies};
 pub use hertz_wall::{HertzWall, HertzWallSpecies};
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
 use crate::geometry::FinitePlane;
 use crate::math::{Real, Vec3};
+use crate::neighbor::PairHistory;
 
 /// One particle touching one wall, seen from the particle.
 #[derive(Clone, Copy, Debug)]
@@ -28,6 +31,9 @@ pub trait WallLaw: Send + Sync {
     /// Whether the law uses the particle spin and exerts torques (then the world calls
     /// `force_and_torque` instead of `force`).
     const NEEDS_ROTATION: bool = false;
+    /// State of one particle-wall contact (e.g. tangential and rolling springs), kept per
+    /// particle per planar wall and reset when they part; `()` for stateless laws.
+    type History: PairHistory;
     /// Largest centre-to-plane distance at which the wall acts on `species`.
     fn reach(&self, species: usize, radius: Real) -> Real;
     /// Force on the particle; only called when `distance < reach`.
@@ -35,6 +41,16 @@ pub trait WallLaw: Send + Sync {
     /// Force and torque on a spinning particle; `contact.relative_velocity` is the centre's.
     fn force_and_torque(&self, contact: &WallContact, _omega: Vec3, dt: Real) -> (Vec3, Vec3) {
         (self.force(contact, dt), Vec3::ZERO)
+    }
+    /// `force_and_torque` with the contact's history (planar walls; bodies use `force`).
+    fn force_and_torque_with_history(
+        &self,
+        contact: &WallContact,
+        omega: Vec3,
+        _history: &mut Self::History,
+        dt: Real,
+    ) -> (Vec3, Vec3) {
+        self.force_and_torque(contact, omega, dt)
     }
     /// (stiffness, damping coefficient) of the linearized contact, for the time step.
     fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real);
@@ -108,19 +124,41 @@ impl WallSet {
             .sum()
     }
 
-    /// Total force and torque of the active walls on one spinning particle.
+    /// Total force and torque of the active walls on one spinning particle; `history` holds
+    /// one entry per wall (index order), reset for walls the particle does not touch.
     #[inline(always)]
     pub fn force_and_torque_on<W: WallLaw>(
         &self,
         law: &W,
         particle: &WallParticle,
         omega: Vec3,
+        history: &mut [W::History],
         dt: Real,
     ) -> (Vec3, Vec3) {
-        self.contacts(law, particle)
-            .fold((Vec3::ZERO, Vec3::ZERO), |(force, torque), c| {
-                let (f, t) = law.force_and_torque(&c, omega, dt);
-                (force + f, torque + t)
-            })
+        let reach = law.reach(particle.species, particle.radius);
+        let mut total = (Vec3::ZERO, Vec3::ZERO);
+        for (wall, state) in self.walls.iter().zip(history.iter_mut()) {
+            let touching = wall
+                .active
+                .then(|| wall.plane.distance(particle.position))
+                .flatten()
+                .filter(|&d| d > 0.0 && d < reach);
+            let Some(distance) = touching else {
+                *state = W::History::default();
+                continue;
+            };
+            let contact = WallContact {
+                species: particle.species,
+                normal: wall.plane.normal,
+                distance,
+                relative_velocity: particle.velocity,
+                radius: particle.radius,
+                mass: particle.mass,
+            };
+            let (f, t) = law.force_and_torque_with_history(&contact, omega, state, dt);
+            total.0 += f;
+            total.1 += t;
+        }
+        total
     }
 }

@@ -60,6 +60,7 @@ impl WcaWall {
 }
 
 impl WallLaw for WcaWall {
+    type History = ();
     fn reach(&self, species: usize, _: Real) -> Real {
         0.5 * self.species[species].wca.cutoff()
     }

@@ -5,9 +5,10 @@
 //! the spring force exceeds `mu |F_n|` it is truncated to the cap, `u_t` is reset so the spring
 //! gives exactly the cap, and (as in LIGGGHTS) the dashpot is left out in that step.
 //!
-//! `u_t` (the history, seen from `i`) is rotated onto the current tangent plane each step,
-//! keeping its length, before `v_t dt` is added. It is zero when a contact starts; seen from
-//! `j` it is `-u_t`.
+//! Each step `v_t dt` is added to `u_t` (the history, seen from `i`) and the sum is projected
+//! onto the current tangent plane, without rescaling: LIGGGHTS's order
+//! (`tangential_model_history.h`; LAMMPS instead rotates keeping the length, then adds). It is
+//! zero when a contact starts; seen from `j` it is `-u_t`.
 
 use super::super::{Contact, TangentialModel};
 use crate::math::{Real, Vec3};
@@ -28,13 +29,8 @@ impl TangentialModel for Mindlin {
     fn force(&self, contact: &Contact, normal_force: Real, history: &mut Vec3, dt: Real) -> Vec3 {
         let sp = contact.species_pair;
         let n = contact.normal;
-        let length = history.length();
-        let mut u = *history - history.dot(n) * n;
-        let projected = u.length();
-        if projected > 0.0 {
-            u *= length / projected;
-        }
-        u += contact.tangential_velocity * dt;
+        let mut u = *history + contact.tangential_velocity * dt;
+        u -= u.dot(n) * n;
         let k_t = 8.0 * self.g_eff[sp] * (contact.r_eff * contact.overlap.max(0.0)).sqrt();
         let spring = -k_t * u;
         let cap = self.friction[sp] * normal_force.abs();
@@ -87,7 +83,7 @@ mod tests {
     }
 
     #[test]
-    fn history_is_rotated_onto_the_new_tangent_plane_keeping_its_length() {
+    fn history_is_projected_onto_the_new_tangent_plane_as_in_liggghts() {
         let mut c = contact_at(1e-5, 5e-4);
         c.tangential_velocity = Vec3::ZERO;
         let tilt = 0.1_f64;
@@ -95,6 +91,7 @@ mod tests {
         let mut u = Vec3::new(0.0, 1e-7, 0.0);
         model().force(&c, 100.0, &mut u, 1e-3);
         assert!(u.dot(c.normal).abs() < 1e-20);
-        assert!((u.length() - 1e-7).abs() < 1e-20);
+        // Projection, no rescaling: the length shrinks by cos(tilt).
+        assert!((u.length() - 1e-7 * tilt.cos()).abs() < 1e-20);
     }
 }

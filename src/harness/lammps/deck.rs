@@ -66,8 +66,69 @@ impl Deck {
     }
 }
 
-fn g(x: Real) -> String {
+pub(crate) fn g(x: Real) -> String {
     format!("{x:.17e}")
+}
+
+/// A `read_data` file for `atom_style sphere` (LAMMPS) or `granular` (LIGGGHTS, same columns):
+/// `n_types` atom types (at least one per species; LIGGGHTS walls take one more), per
+/// species the diameter and density given, the particles' positions, velocities and
+/// spins (zero without angular state). Ids are `id + 1`, types `species + 1`.
+pub fn data_file(
+    scene: &Scene,
+    particles: &Particles,
+    diameters: &[Real],
+    densities: &[Real],
+    n_types: usize,
+) -> String {
+    let (lo, hi) = (scene.domain.lo, scene.domain.hi);
+    let mut data = format!(
+        "LAMMPS data file written by cgdem {} for scene {} (lambda = {})\n\n{} atoms\n{} atom types\n\n",
+        env!("CARGO_PKG_VERSION"),
+        scene.name,
+        scene.lambda,
+        particles.len(),
+        n_types
+    );
+    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+        let _ = writeln!(data, "{} {} {name}lo {name}hi", g(lo[axis]), g(hi[axis]));
+    }
+    data += "\nAtoms # sphere\n\n";
+    for k in 0..particles.len() {
+        let species = particles.species[k] as usize;
+        let p = particles.position[k];
+        let _ = writeln!(
+            data,
+            "{} {} {} {} {} {} {}",
+            particles.id[k] + 1,
+            species + 1,
+            g(diameters[species]),
+            g(densities[species]),
+            g(p.x),
+            g(p.y),
+            g(p.z)
+        );
+    }
+    data += "\nVelocities\n\n";
+    for k in 0..particles.len() {
+        let v = particles.velocity[k];
+        let w = particles
+            .angular
+            .as_ref()
+            .map_or(crate::math::Vec3::ZERO, |a| a.omega[k]);
+        let _ = writeln!(
+            data,
+            "{} {} {} {} {} {} {}",
+            particles.id[k] + 1,
+            g(v.x),
+            g(v.y),
+            g(v.z),
+            g(w.x),
+            g(w.y),
+            g(w.z)
+        );
+    }
+    data
 }
 
 /// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`.
@@ -109,49 +170,18 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         ));
     }
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
-    let (lo, hi) = (scene.domain.lo, scene.domain.hi);
 
     // Data file: cgdem's own particles, so both codes start from the same packing.
-    let mut data = format!(
-        "LAMMPS data file written by cgdem {} for scene {} (lambda = {})\n\n{} atoms\n{} atom types\n\n",
-        env!("CARGO_PKG_VERSION"),
-        scene.name,
-        scene.lambda,
-        particles.len(),
-        scene.species.len()
-    );
-    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
-        let _ = writeln!(data, "{} {} {name}lo {name}hi", g(lo[axis]), g(hi[axis]));
-    }
-    data += "\nAtoms # sphere\n\n";
+    let diameters = vec![rc; scene.species.len()];
     let volume = std::f64::consts::PI / 6.0 * rc.powi(3);
-    for k in 0..particles.len() {
-        let species = particles.species[k] as usize;
-        let p = particles.position[k];
-        let _ = writeln!(
-            data,
-            "{} {} {} {} {} {} {}",
-            particles.id[k] + 1,
-            species + 1,
-            g(rc),
-            g(masses[species] / volume),
-            g(p.x),
-            g(p.y),
-            g(p.z)
-        );
-    }
-    data += "\nVelocities\n\n";
-    for k in 0..particles.len() {
-        let v = particles.velocity[k];
-        let _ = writeln!(
-            data,
-            "{} {} {} {} 0 0 0",
-            particles.id[k] + 1,
-            g(v.x),
-            g(v.y),
-            g(v.z)
-        );
-    }
+    let densities: Vec<Real> = masses.iter().map(|m| m / volume).collect();
+    let data = data_file(
+        scene,
+        particles,
+        &diameters,
+        &densities,
+        scene.species.len(),
+    );
 
     let mut d = String::new();
     let _ = writeln!(

@@ -50,24 +50,34 @@ pub enum RunStatus {
 
 /// The `lmp` binary: `$CGDEM_LMP`, else `lmp` on `PATH`.
 pub fn find_lmp() -> Result<PathBuf, String> {
-    if let Some(explicit) = std::env::var_os("CGDEM_LMP") {
+    find_program("lmp", "CGDEM_LMP")
+}
+
+/// A reference binary: the file named by `$env_var` if set, else `name` on `PATH`.
+pub fn find_program(name: &str, env_var: &str) -> Result<PathBuf, String> {
+    if let Some(explicit) = std::env::var_os(env_var) {
         let path = PathBuf::from(explicit);
         return if path.is_file() {
             Ok(path)
         } else {
-            Err(format!("CGDEM_LMP = {} is not a file", path.display()))
+            Err(format!("{env_var} = {} is not a file", path.display()))
         };
     }
     let path_var = std::env::var_os("PATH").unwrap_or_default();
     std::env::split_paths(&path_var)
-        .map(|dir| dir.join("lmp"))
+        .map(|dir| dir.join(name))
         .find(|p| p.is_file())
-        .ok_or_else(|| "lmp not found on PATH (set CGDEM_LMP to its path)".to_string())
+        .ok_or_else(|| format!("{name} not found on PATH (set {env_var} to its path)"))
 }
 
 /// Last `lines` lines of the run's log (or of stdout if there is no log).
 pub fn log_tail(dir: &Path, lines: usize) -> String {
-    let text = std::fs::read_to_string(dir.join(LOG_FILE))
+    log_tail_of(dir, LOG_FILE, lines)
+}
+
+/// Last `lines` lines of `dir/log_file` (or of stdout if there is no log).
+pub fn log_tail_of(dir: &Path, log_file: &str, lines: usize) -> String {
+    let text = std::fs::read_to_string(dir.join(log_file))
         .or_else(|_| std::fs::read_to_string(dir.join("stdout.txt")))
         .unwrap_or_default();
     let all: Vec<&str> = text.lines().collect();
@@ -76,15 +86,24 @@ pub fn log_tail(dir: &Path, lines: usize) -> String {
 
 /// Runs the deck in `dir` (which must hold it) and waits, killing LAMMPS at the time limit.
 pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
-    let lmp = match find_lmp() {
-        Ok(path) => path,
-        Err(reason) => {
-            return RunStatus::Skipped {
-                reason,
-                install_hint: INSTALL_HINT.into(),
-            }
-        }
-    };
+    match find_lmp() {
+        Ok(lmp) => run_program(&lmp, dir, DECK_FILE, LOG_FILE, options),
+        Err(reason) => RunStatus::Skipped {
+            reason,
+            install_hint: INSTALL_HINT.into(),
+        },
+    }
+}
+
+/// Runs `program -in deck_file -log log_file` in `dir` (LAMMPS and LIGGGHTS take the same
+/// arguments) and waits, killing it at the time limit.
+pub fn run_program(
+    program: &Path,
+    dir: &Path,
+    deck_file: &str,
+    log_file: &str,
+    options: &RunnerOptions,
+) -> RunStatus {
     let mut argv: Vec<String> = Vec::new();
     if let Some(np) = options.np {
         argv.extend([
@@ -95,11 +114,11 @@ pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
         ]);
     }
     argv.extend([
-        lmp.display().to_string(),
+        program.display().to_string(),
         "-in".into(),
-        DECK_FILE.into(),
+        deck_file.into(),
         "-log".into(),
-        LOG_FILE.into(),
+        log_file.into(),
     ]);
     let failed = |message: String| RunStatus::Failed {
         exit_code: None,
@@ -154,7 +173,7 @@ pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
                 } else {
                     RunStatus::Failed {
                         exit_code: status.code(),
-                        log_tail: log_tail(dir, 20),
+                        log_tail: log_tail_of(dir, log_file, 20),
                     }
                 };
             }
@@ -167,11 +186,11 @@ pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
                 let _ = child.wait();
                 return RunStatus::TimedOut {
                     after_s: started.elapsed().as_secs_f64(),
-                    log_tail: log_tail(dir, 20),
+                    log_tail: log_tail_of(dir, log_file, 20),
                 };
             }
             Ok(None) => std::thread::sleep(Duration::from_millis(50)),
-            Err(e) => return failed(format!("waiting for LAMMPS: {e}")),
+            Err(e) => return failed(format!("waiting for {}: {e}", program.display())),
         }
     }
 }

@@ -1,0 +1,182 @@
+//! The LIGGGHTS input for a Hertz scene, written from the scene alone: `pair_style gran model
+//! hertz tangential history [rolling_friction epsd2]`, the keywords cgdem's Hertz slots are
+//! named after, so no mapping is needed; walls are `fix wall/gran` primitives (axis-aligned
+//! planes) of their own atom type (`n_species + 1`), whose material and pair coefficients
+//! with every species come from `[wall_contact]`.
+//!
+//! LIGGGHTS needs `newton off`, `communicate single vel yes`, Young's modulus >= 5e6 Pa in SI
+//! units (it refuses softer materials), and an explicit dump format (default: 6 digits).
+//! Supported: what `lammps::hertz` supports (one duration stage, no wall removal).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::harness::lammps::deck::{data_file, g, Deck, DeckError, DeckPlan, DATA_FILE};
+use crate::harness::lammps::hertz::{hertz_settings, material, wall_axis, wall_material};
+use crate::math::Real;
+use crate::particles::Particles;
+use crate::scene::{RollingKind, Scene, StageEnd};
+
+pub const DECK_FILE: &str = "deck.in";
+pub const LOG_FILE: &str = "log.liggghts";
+pub const TRAJECTORY_FILE: &str = "traj.dump";
+
+/// LIGGGHTS 3.8 rejects a Young's modulus below this in SI units.
+pub const MIN_YOUNGS_MODULUS: Real = 5e6;
+
+/// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
+/// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
+pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
+    let h = hertz_settings(scene, "LIGGGHTS")?;
+    let n = scene.species.len();
+    let has_walls = !scene.walls.is_empty();
+    let n_types = n + usize::from(has_walls);
+    let (m, wm) = (material(h), wall_material(scene, h));
+    for (what, e) in [
+        ("contact.youngs_modulus", m.youngs_modulus),
+        ("wall_contact.youngs_modulus", wm.youngs_modulus),
+    ] {
+        if e < MIN_YOUNGS_MODULUS {
+            return Err(DeckError::Unsupported {
+                file: scene.source.display().to_string(),
+                reason: format!("{what} = {e} Pa: LIGGGHTS refuses E < 5e6 Pa in SI units"),
+            });
+        }
+    }
+    let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
+    let StageEnd::Duration(duration) = scene.stages[0].end else {
+        unreachable!("checked by hertz_settings")
+    };
+    let steps = (duration / dt).round() as u64;
+
+    let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
+    let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
+    let data = data_file(scene, particles, &diameters, &densities, n_types);
+
+    // Per-type and per-type-pair tables; the wall type pairs with particles only.
+    let w = &scene.wall_contact;
+    let per_type = |particle: Real, wall: Real| {
+        let mut v = vec![g(particle); n];
+        if has_walls {
+            v.push(g(wall));
+        }
+        v.join(" ")
+    };
+    let per_pair = |particle: Real, wall: Real| {
+        let mut v = Vec::new();
+        for a in 0..n_types {
+            for b in 0..n_types {
+                v.push(g(if a == n || b == n { wall } else { particle }));
+            }
+        }
+        format!("{n_types} {}", v.join(" "))
+    };
+
+    let mut d = String::new();
+    let _ = writeln!(
+        d,
+        "# LIGGGHTS input written by cgdem {} from {} (scene `{}`).",
+        env!("CARGO_PKG_VERSION"),
+        scene.source.display(),
+        scene.name
+    );
+    d += "units           si\natom_style      granular\natom_modify     map array\n";
+    let flag = |axis: usize| {
+        if scene.domain.periodic[axis] {
+            "p"
+        } else {
+            "f"
+        }
+    };
+    let _ = writeln!(d, "boundary        {} {} {}", flag(0), flag(1), flag(2));
+    d += "newton          off\ncommunicate     single vel yes\n";
+    let _ = writeln!(d, "read_data       {DATA_FILE}");
+    let _ = writeln!(
+        d,
+        "neighbor        {} bin",
+        g(scene.skin_fraction * scene.max_diameter())
+    );
+    d += "neigh_modify    delay 0\n";
+    let _ = writeln!(
+        d,
+        "fix             m1 all property/global youngsModulus peratomtype {}",
+        per_type(m.youngs_modulus, wm.youngs_modulus)
+    );
+    let _ = writeln!(
+        d,
+        "fix             m2 all property/global poissonsRatio peratomtype {}",
+        per_type(m.poisson_ratio, wm.poisson_ratio)
+    );
+    let _ = writeln!(
+        d,
+        "fix             m3 all property/global coefficientRestitution peratomtypepair {}",
+        per_pair(h.restitution, w.restitution)
+    );
+    let _ = writeln!(
+        d,
+        "fix             m4 all property/global coefficientFriction peratomtypepair {}",
+        per_pair(h.friction, w.friction)
+    );
+    let rolling = if h.rolling == RollingKind::Epsd2 {
+        let _ = writeln!(
+            d,
+            "fix             m5 all property/global coefficientRollingFriction peratomtypepair {}",
+            per_pair(h.rolling_friction, w.rolling_friction)
+        );
+        " rolling_friction epsd2"
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        d,
+        "pair_style      gran model hertz tangential history{rolling}"
+    );
+    d += "pair_coeff      * *\n";
+    let _ = writeln!(d, "timestep        {}", g(dt));
+    d += "fix             integ all nve/sphere\n";
+    if scene.gravity.length() > 0.0 {
+        let dir = scene.gravity / scene.gravity.length();
+        let _ = writeln!(
+            d,
+            "fix             grav all gravity {} vector {} {} {}",
+            g(scene.gravity.length()),
+            g(dir.x),
+            g(dir.y),
+            g(dir.z)
+        );
+    }
+    for wall in &scene.walls {
+        let (axis, _) = wall_axis(scene, wall)?;
+        let at = [wall.point.x, wall.point.y, wall.point.z][axis];
+        let _ = writeln!(
+            d,
+            "fix             w_{} all wall/gran model hertz tangential history{rolling} primitive type {} {}plane {}",
+            wall.name,
+            n + 1,
+            ["x", "y", "z"][axis],
+            g(at)
+        );
+    }
+    d += "thermo          1000\nthermo_modify   lost ignore norm no\n";
+    let _ = writeln!(d, "dump            traj all custom {dump_every} {TRAJECTORY_FILE} id type x y z vx vy vz omegax omegay omegaz radius");
+    let _ = writeln!(
+        d,
+        "dump_modify     traj sort id format \"%d %d{}\"",
+        " %.17g".repeat(10)
+    );
+    let _ = writeln!(d, "run             {steps}");
+    Ok(Deck {
+        input: d,
+        data,
+        plan: DeckPlan {
+            dt,
+            dump_every,
+            repose_dumps: Vec::new(),
+        },
+    })
+}
+
+/// The trajectory file of a run directory.
+pub fn trajectory(dir: &Path) -> std::path::PathBuf {
+    dir.join(TRAJECTORY_FILE)
+}

@@ -1,0 +1,177 @@
+//! LIGGGHTS's particle-wall contact for `model hertz tangential history [rolling_friction
+//! epsd2]` (`fix wall/gran ... primitive`): the pair law with the wall's radius and mass taken
+//! as infinite (`R_eff = r`, `m_eff = m`), with a tangential and a rolling spring per particle
+//! per wall (the contact's history, zeroed when they part).
+//!
+//! With `delta = r - h` (h the centre-to-plane distance), `a = sqrt(r delta)` and the contact
+//! point at `c = r - delta/2` from the centre (LIGGGHTS `cri`):
+//! - normal: `(4/3) Y_eff a delta - 2 sqrt(5/6) |beta(e_w)| sqrt(2 Y_eff a m) v_n`;
+//! - tangential (LIGGGHTS `tangential_model_history.h`): the slip `v_t + c n x omega` is added
+//!   to the shear displacement, which is then projected onto the tangent plane (no
+//!   rescaling); `F_t = -k_t u`, `k_t = 8 G_eff a`; if `|F_t| > mu |F_n|` it is truncated and
+//!   `u = -F_t/k_t` (no dashpot that step), else the dashpot `-2 sqrt(5/6)|beta| sqrt(k_t m) v_slip`
+//!   is added; torque `(-c n) x F_t`;
+//! - rolling (epsd2, `rolling_model_epsd2.h`): `M += k_t r^2 w_t dt`, capped at `mu_r r |F_n|`,
+//!   torque `-M`; `F_n` is the total normal force (elastic + dashpot). For walls LIGGGHTS feeds
+//!   `w = omega c/h` (its `cdata.wr`, the spin scaled by contact radius over distance), not
+//!   `omega`: kept here, since the keyword promises LIGGGHTS's model.
+//!
+//! Bodies (SDF) call the stateless `force`, which has no history: the normal force and the
+//! kinetic Coulomb friction of `HertzWall`.
+
+use super::{HertzWall, WallContact, WallLaw};
+use crate::contact::damping::liggghts_damping_factor;
+use crate::math::{Real, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct HertzHistoryWallSpecies {
+    pub y_eff: Real,
+    pub g_eff: Real,
+    /// `2 sqrt(5/6) |beta(e_w)|`.
+    pub damping_factor: Real,
+    pub friction: Real,
+    /// epsd2's `mu_r`; 0 = no rolling spring.
+    pub rolling_friction: Real,
+}
+
+#[derive(Clone, Debug)]
+pub struct HertzHistoryWall {
+    pub species: Vec<HertzHistoryWallSpecies>,
+    /// The stateless law for bodies and the time step.
+    pub stateless: HertzWall,
+}
+
+impl HertzHistoryWall {
+    /// Per species `(Y_eff, G_eff)` of the particle-wall pair.
+    pub fn new(
+        moduli: &[(Real, Real)],
+        restitution: Real,
+        friction: Real,
+        rolling_friction: Real,
+        characteristic_velocity: Real,
+    ) -> Self {
+        let y_eff: Vec<Real> = moduli.iter().map(|m| m.0).collect();
+        HertzHistoryWall {
+            species: moduli
+                .iter()
+                .map(|&(y_eff, g_eff)| HertzHistoryWallSpecies {
+                    y_eff,
+                    g_eff,
+                    damping_factor: liggghts_damping_factor(restitution),
+                    friction,
+                    rolling_friction,
+                })
+                .collect(),
+            stateless: HertzWall::new(&y_eff, restitution, friction, 0.0, characteristic_velocity),
+        }
+    }
+}
+
+impl WallLaw for HertzHistoryWall {
+    const NEEDS_ROTATION: bool = true;
+    /// (shear displacement, stored rolling torque).
+    type History = (Vec3, Vec3);
+
+    fn reach(&self, _: usize, radius: Real) -> Real {
+        radius
+    }
+
+    fn force(&self, contact: &WallContact, dt: Real) -> Vec3 {
+        self.stateless.force(contact, dt)
+    }
+
+    #[inline(always)]
+    fn force_and_torque_with_history(
+        &self,
+        c: &WallContact,
+        omega: Vec3,
+        (shear, rolling): &mut (Vec3, Vec3),
+        dt: Real,
+    ) -> (Vec3, Vec3) {
+        let s = &self.species[c.species];
+        let n = c.normal;
+        let delta = c.radius - c.distance;
+        let a = (c.radius * delta).sqrt();
+        let normal_speed = c.relative_velocity.dot(n);
+        let normal_force = 4.0 / 3.0 * s.y_eff * a * delta
+            - s.damping_factor * (2.0 * s.y_eff * a * c.mass).sqrt() * normal_speed;
+        let load = normal_force.abs();
+
+        let arm = c.radius - 0.5 * delta;
+        let slip = c.relative_velocity - normal_speed * n + arm * n.cross(omega);
+        *shear += slip * dt;
+        *shear -= shear.dot(n) * n;
+        let k_t = 8.0 * s.g_eff * a;
+        let mut tangential = -k_t * *shear;
+        let cap = s.friction * load;
+        let size = tangential.length();
+        if size > cap {
+            if size > 0.0 {
+                tangential *= cap / size;
+                *shear = -tangential / k_t;
+            }
+        } else {
+            tangential -= s.damping_factor * (k_t * c.mass).sqrt() * slip;
+        }
+        let mut torque = (-arm * n).cross(tangential);
+
+        if s.rolling_friction > 0.0 {
+            let w = omega * (arm / c.distance);
+            let w_t = w - w.dot(n) * n;
+            *rolling += k_t * c.radius * c.radius * dt * w_t;
+            let limit = s.rolling_friction * c.radius * load;
+            let size = rolling.length();
+            if size > limit {
+                *rolling *= limit / size;
+            }
+            torque -= *rolling;
+        }
+        (normal_force * n + tangential, torque)
+    }
+
+    fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real) {
+        self.stateless.linearized(species, radius, mass)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contact(delta: Real, v: Vec3) -> WallContact {
+        WallContact {
+            species: 0,
+            normal: Vec3::Z,
+            distance: 1e-3 - delta,
+            relative_velocity: v,
+            radius: 1e-3,
+            mass: 1e-5,
+        }
+    }
+
+    fn law(rolling_friction: Real) -> HertzHistoryWall {
+        HertzHistoryWall::new(&[(2.7e6, 1.0e6)], 0.5, 0.5, rolling_friction, 1.0)
+    }
+
+    #[test]
+    fn sliding_is_capped_at_mu_fn_and_the_spring_truncated() {
+        let c = contact(1e-5, Vec3::new(10.0, 0.0, 0.0));
+        let mut h = (Vec3::ZERO, Vec3::ZERO);
+        let (f, _) = law(0.0).force_and_torque_with_history(&c, Vec3::ZERO, &mut h, 1e-4);
+        assert!((f.x.abs() - 0.5 * f.z).abs() < 1e-12 * f.z && f.x < 0.0);
+        let k_t = 8.0 * 1.0e6 * (1e-3_f64 * 1e-5).sqrt();
+        assert!((k_t * h.0.x - 0.5 * f.z).abs() < 1e-12 * f.z);
+    }
+
+    #[test]
+    fn rolling_torque_opposes_the_spin_and_saturates_at_mu_r_r_fn() {
+        let c = contact(1e-5, Vec3::ZERO);
+        let mut h = (Vec3::ZERO, Vec3::ZERO);
+        let (f, t) =
+            law(0.1).force_and_torque_with_history(&c, Vec3::new(0.0, 1e6, 0.0), &mut h, 1e-3);
+        // Spin about y makes the contact point slip along -x... the friction torque and the
+        // rolling torque both oppose the spin; the rolling part is at its cap.
+        assert!(t.y < 0.0);
+        assert!((h.1.length() - 0.1 * 1e-3 * f.z).abs() < 1e-12 * f.z * 1e-3);
+    }
+}
