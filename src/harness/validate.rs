@@ -40,6 +40,9 @@ pub struct RunRecord {
     pub runout_m: Option<f64>,
     /// The run was not repeated: its directory already held it (`--reuse`).
     pub reused: bool,
+    /// The run stopped before its last stage ended (time limit, killed, stopped by a
+    /// guard): its fixed-time samples and histories count, its final state does not.
+    pub partial: bool,
 }
 
 /// One judged comparison.
@@ -176,6 +179,7 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     .caption("Runs");
     for r in &summary.runs {
         let status = match r.status.as_str() {
+            "ok" if r.partial => Cell::skipped(r.reason.clone().unwrap_or_default()),
             "ok" if r.reused => Cell::pass("ok (reused)"),
             "ok" => Cell::pass("ok"),
             "skipped" => {
@@ -330,6 +334,7 @@ fn run_case(
                         repose_fit_r2: None,
                         runout_m: None,
                         reused: false,
+                        partial: false,
                     };
                     let outcome = match code {
                         Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options)
@@ -481,6 +486,21 @@ fn fill_from_summary(record: &mut RunRecord) {
     record.repose_angle_deg = f("repose_angle_deg");
     record.repose_fit_r2 = f("repose_fit_r2");
     record.runout_m = f("runout_m");
+    let unfinished = value["stages"].as_array().and_then(|stages| {
+        stages.iter().find(|st| {
+            let how = st["ended_by"].as_str().unwrap_or("");
+            how == "did not finish" || how.starts_with("stopped")
+        })
+    });
+    if let Some(stage) = unfinished {
+        record.partial = true;
+        record.reason = Some(format!(
+            "partial: stage `{}` {} after {:.2} s",
+            stage["name"].as_str().unwrap_or("?"),
+            stage["ended_by"].as_str().unwrap_or("?"),
+            stage["end_s"].as_f64().unwrap_or(0.0) - stage["start_s"].as_f64().unwrap_or(0.0),
+        ));
+    }
 }
 
 /// Mean and sample standard deviation.
@@ -504,7 +524,7 @@ type GroupKey = (u8, u32, Code);
 
 fn angles_by_group(runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<f64>> {
     let mut groups: BTreeMap<GroupKey, Vec<f64>> = BTreeMap::new();
-    for r in runs {
+    for r in runs.iter().filter(|r| !r.partial) {
         if let Some(a) = r.repose_angle_deg {
             groups
                 .entry((r.cg_rule as u8, r.lambda, r.code))

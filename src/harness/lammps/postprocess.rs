@@ -279,6 +279,13 @@ pub fn postprocess(
                 .end
                 .clone()
                 .unwrap_or((last_step.max(m.start), "did not finish".into()));
+            if how == "did not finish" {
+                warnings.push(format!(
+                    "partial run: LAMMPS stopped during stage `{}`, {:.3} s after it began",
+                    m.name,
+                    (end - m.start) as Real * dt
+                ));
+            }
             if how == "max_duration" {
                 warnings.push(format!(
                     "stage `{}` did not settle within max_duration",
