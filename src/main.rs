@@ -57,6 +57,10 @@ enum Command {
         /// Run even if the time step exceeds the stable limit (prints a warning).
         #[arg(long)]
         force_dt: bool,
+        /// Do not stop when a guard fires (non-finite state, overlap beyond a quarter of the
+        /// radius, energy growing without work): warn once per guard and go on.
+        #[arg(long)]
+        keep_going: bool,
         /// Refuse to coarse-grain where the scaling rule is inconsistent for the scene's
         /// model (gravity, cohesion, rolling with Hertz), instead of warning.
         #[arg(long)]
@@ -84,6 +88,9 @@ enum Command {
         /// No per-run progress lines.
         #[arg(long)]
         quiet: bool,
+        /// cgdem runs warn instead of stopping when a guard fires.
+        #[arg(long)]
+        keep_going: bool,
     },
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).
@@ -322,6 +329,7 @@ fn main() -> ExitCode {
             threads,
             reference_timeout,
             quiet,
+            keep_going,
         } => {
             let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
                 PathBuf::from(&suite)
@@ -337,6 +345,7 @@ fn main() -> ExitCode {
                 out: out.clone(),
                 quiet,
                 reference_timeout_s: reference_timeout,
+                keep_going,
             };
             match pool.install(|| cgdem::harness::validate::validate(&options)) {
                 Ok(summary) => {
@@ -398,6 +407,7 @@ fn main() -> ExitCode {
             threads,
             quiet,
             force_dt,
+            keep_going,
             strict,
             sweep,
         } => {
@@ -449,7 +459,7 @@ fn main() -> ExitCode {
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
                         if let Some(speeds) = &speeds {
-                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt)?;
+                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going)?;
                             for (rpm, s) in &results {
                                 if let Some(c) = &s.conveying {
                                     println!("{rpm} rpm: {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (a = {:.3}), wall {:.1} s", c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.fill_ratio, s.wall_s);
@@ -462,6 +472,7 @@ fn main() -> ExitCode {
                             out_dir: out_dir.clone(),
                             quiet,
                             force_dt,
+                            keep_going,
                         };
                         run(&scene, &options)
                             .map(|summary| (summary, out_dir))

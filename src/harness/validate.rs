@@ -84,6 +84,8 @@ pub struct ValidateOptions {
     pub quiet: bool,
     /// Time limit of one reference-code run, seconds.
     pub reference_timeout_s: u64,
+    /// cgdem's guards only warn instead of stopping a run (`--keep-going`).
+    pub keep_going: bool,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -305,7 +307,7 @@ fn run_case(
                         runout_m: None,
                     };
                     let outcome = match code {
-                        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options.quiet),
+                        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options),
                         Code::Lammps => run_lammps(scene, lambda, rule, seed, &dir, options.reference_timeout_s),
                         Code::Liggghts => Err(RunOutcome::Skipped("LIGGGHTS cannot express the seed's WCA model; Hertz decks for LIGGGHTS are not written yet".into())),
                     };
@@ -352,14 +354,15 @@ fn run_cgdem(
     rule: CoarseGrainRule,
     seed: u64,
     dir: &Path,
-    quiet: bool,
+    validate: &ValidateOptions,
 ) -> Result<(), RunOutcome> {
     let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
     let options = RunOptions {
         out_dir: dir.to_path_buf(),
-        quiet,
+        quiet: validate.quiet,
         force_dt: false,
+        keep_going: validate.keep_going,
     };
     run(&coarse, &options)
         .map(|_| ())

@@ -7,6 +7,7 @@ pub use hertz_wall::{HertzWall, HertzWallSpecies};
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
 use crate::geometry::FinitePlane;
+use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
 
 /// One particle touching one wall, seen from the particle.
@@ -75,40 +76,17 @@ impl WallSet {
         }
     }
 
-    /// The contacts of the active walls with one particle.
+    /// Total force of the active walls on one particle, and its deepest overlap with one of
+    /// them as a fraction of its radius (for the overlap guard, from the same distances).
     #[inline(always)]
-    fn contacts<'a, W: WallLaw>(
-        &'a self,
-        law: &W,
-        particle: &'a WallParticle,
-    ) -> impl Iterator<Item = WallContact> + 'a {
-        let reach = law.reach(particle.species, particle.radius);
-        self.walls
-            .iter()
-            .filter(|w| w.active)
-            .filter_map(move |wall| {
-                let distance = wall.plane.distance(particle.position)?;
-                // Only the front side repels: a particle behind a wall has left through it.
-                (distance > 0.0 && distance < reach).then_some(WallContact {
-                    species: particle.species,
-                    normal: wall.plane.normal,
-                    distance,
-                    relative_velocity: particle.velocity,
-                    radius: particle.radius,
-                    mass: particle.mass,
-                })
-            })
+    pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> (Vec3, Real) {
+        let (mut force, mut overlap) = (Vec3::ZERO, 0.0);
+        self.each_contact(law, particle, &mut overlap, |c| force += law.force(&c, dt));
+        (force, overlap)
     }
 
-    /// Total force of the active walls on one particle.
-    #[inline(always)]
-    pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> Vec3 {
-        self.contacts(law, particle)
-            .map(|c| law.force(&c, dt))
-            .sum()
-    }
-
-    /// Total force and torque of the active walls on one spinning particle.
+    /// Total force and torque of the active walls on one spinning particle, and its deepest
+    /// overlap fraction.
     #[inline(always)]
     pub fn force_and_torque_on<W: WallLaw>(
         &self,
@@ -116,11 +94,45 @@ impl WallSet {
         particle: &WallParticle,
         omega: Vec3,
         dt: Real,
-    ) -> (Vec3, Vec3) {
-        self.contacts(law, particle)
-            .fold((Vec3::ZERO, Vec3::ZERO), |(force, torque), c| {
-                let (f, t) = law.force_and_torque(&c, omega, dt);
-                (force + f, torque + t)
-            })
+    ) -> (Vec3, Vec3, Real) {
+        let (mut force, mut torque, mut overlap) = (Vec3::ZERO, Vec3::ZERO, 0.0);
+        self.each_contact(law, particle, &mut overlap, |c| {
+            let (f, t) = law.force_and_torque(&c, omega, dt);
+            force += f;
+            torque += t;
+        });
+        (force, torque, overlap)
+    }
+
+    /// Calls `act` for each active wall the particle touches and keeps the deepest overlap.
+    #[inline(always)]
+    fn each_contact<W: WallLaw>(
+        &self,
+        law: &W,
+        particle: &WallParticle,
+        overlap: &mut Real,
+        mut act: impl FnMut(WallContact),
+    ) {
+        let reach = law.reach(particle.species, particle.radius);
+        for wall in self.walls.iter().filter(|w| w.active) {
+            let Some(distance) = wall.plane.distance(particle.position) else {
+                continue;
+            };
+            if distance >= reach {
+                continue; // the common case: one comparison
+            }
+            *overlap = overlap.max(overlap_fraction(distance, particle.radius));
+            // Only the front side repels: a particle behind a wall has left through it.
+            if distance > 0.0 {
+                act(WallContact {
+                    species: particle.species,
+                    normal: wall.plane.normal,
+                    distance,
+                    relative_velocity: particle.velocity,
+                    radius: particle.radius,
+                    mass: particle.mass,
+                });
+            }
+        }
     }
 }
