@@ -307,6 +307,7 @@ pub fn initial_particles(
                 .iter()
                 .all(|b| b.query(p, radius).is_none_or(|(d, _)| d > radius))
         };
+        let first = particles.len();
         insert_random_where(
             &mut particles,
             ins.species as u16,
@@ -316,6 +317,7 @@ pub fn initial_particles(
             ins.hi,
             count,
             ins.seed,
+            ins.overlap,
             accept,
         )
         .map_err(|source| RunError::Insertion {
@@ -323,6 +325,9 @@ pub fn initial_particles(
             index,
             source,
         })?;
+        for v in &mut particles.velocity[first..] {
+            *v = ins.velocity;
+        }
     }
     Ok(particles)
 }
