@@ -12,7 +12,7 @@
 //! - **Energy growth without work**: every [`GuardSettings::energy_every`] steps the
 //!   kinetic plus gravitational energy `E = KE + sum m g_abs h` (height `h` above the box's
 //!   lowest corner along gravity) is compared with its value at the last reference point (the
-//!   run's start, each stage start, any change in the particle count). Contacts that only
+//!   run's start, each stage start; particles removed take their energy with them). Contacts that only
 //!   repel and dissipate can store energy but not create it, so `E` may not exceed the
 //!   reference by more than [`GuardSettings::energy_growth`] of `max(E_ref, M e_floor)`.
 //!   The check is off while a moving body does work and for cohesive laws (binding energy
@@ -136,8 +136,12 @@ pub(crate) struct GuardState {
     pub finite: bool,
     /// Overlap at the first force evaluation (particles placed overlapping).
     pub initial_overlap: Option<Real>,
-    /// Energy reference and the particle count it was taken with.
-    pub energy_reference: Option<(Real, usize)>,
+    /// Energy reference, and the energy of particles removed since the last check (it
+    /// leaves the reference with them).
+    pub energy_reference: Option<Real>,
+    pub removed_energy: Real,
+    /// Ids of particles that the list rebuild found at a non-finite position.
+    pub removed_non_finite: Vec<u32>,
     pub trip: Option<GuardTrip>,
     pub peaks: GuardPeaks,
 }

@@ -126,6 +126,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         world.rebuild();
         world.compute_forces();
         world.guard.initial_overlap = Some(world.max_overlap_fraction());
+        world.reset_energy_reference();
         world
     }
 
@@ -314,6 +315,16 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             }
         }
         if keep.iter().any(|&k| !k) {
+            // The energy guard's reference loses what the removed particles carried; a
+            // non-finite position is the non-finite guard's business, not a lost particle.
+            for (k, _) in keep.iter().enumerate().filter(|(_, &kept)| !kept) {
+                let e = self.particle_energy(k);
+                if e.is_finite() {
+                    self.guard.removed_energy += e;
+                } else {
+                    self.guard.removed_non_finite.push(self.particles.id[k]);
+                }
+            }
             let mut next = 0u32;
             remap = Some(
                 keep.iter()
@@ -545,10 +556,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.guard.trip.take()
     }
 
-    /// The energy guard takes its next reference from the state at its next check (call
-    /// when walls are removed or bodies start: both change what is stored or supplied).
+    /// The energy guard takes the present state as its reference (call when walls are
+    /// removed or bodies start: both change what is stored or supplied).
     pub fn reset_energy_reference(&mut self) {
-        self.guard.energy_reference = None;
+        self.guard.energy_reference = Some(self.mechanical_energy());
+        self.guard.removed_energy = 0.0;
     }
 
     /// The largest overlap of the last force evaluation, as a fraction of the smaller radius
@@ -559,12 +571,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// Kinetic energy plus gravitational energy above the box's lowest corner along gravity.
     pub fn mechanical_energy(&self) -> Real {
-        let (g, lo, hi) = (self.gravity, self.domain.lo, self.domain.hi);
-        let corner = Vec3::new(
-            if g.x < 0.0 { lo.x } else { hi.x },
-            if g.y < 0.0 { lo.y } else { hi.y },
-            if g.z < 0.0 { lo.z } else { hi.z },
-        );
+        let (g, corner) = (self.gravity, self.potential_origin());
         let p = &self.particles;
         let potential: Real = p
             .position
@@ -573,6 +580,26 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .map(|(&x, &m)| -m * g.dot(x - corner))
             .sum();
         self.kinetic_energy() + potential
+    }
+
+    /// Kinetic plus gravitational energy of particle `k` (as in `mechanical_energy`).
+    fn particle_energy(&self, k: usize) -> Real {
+        let p = &self.particles;
+        let spin = p.angular.as_ref().map_or(0.0, |a| {
+            0.5 * a.omega[k].length_squared() / a.inv_inertia[k]
+        });
+        0.5 * p.mass[k] * p.velocity[k].length_squared() + spin
+            - p.mass[k] * self.gravity.dot(p.position[k] - self.potential_origin())
+    }
+
+    /// The box corner lowest along gravity: gravitational energy is counted from it.
+    fn potential_origin(&self) -> Vec3 {
+        let (g, lo, hi) = (self.gravity, self.domain.lo, self.domain.hi);
+        Vec3::new(
+            if g.x < 0.0 { lo.x } else { hi.x },
+            if g.y < 0.0 { lo.y } else { hi.y },
+            if g.z < 0.0 { lo.z } else { hi.z },
+        )
     }
 
     /// Whether the energy guard applies: no attraction, no moving body doing work, and no
@@ -593,7 +620,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let overlap = self.max_overlap_fraction();
         let peaks = &mut self.guard.peaks;
         peaks.overlap_fraction = peaks.overlap_fraction.max(overlap);
-        self.guard.trip = if !self.guard.finite {
+        self.guard.trip = if !self.guard.finite || !self.guard.removed_non_finite.is_empty() {
             Some(self.diagnose_non_finite())
         } else if self.max_overlap_fraction() > s.max_overlap_fraction {
             Some(self.diagnose_overlap())
@@ -610,16 +637,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     fn check_energy(&mut self) -> Option<GuardTrip> {
         let s = self.guard.settings;
         let energy = self.mechanical_energy();
-        let n = self.particles.len();
+        let removed = std::mem::take(&mut self.guard.removed_energy);
+        if let Some(reference) = &mut self.guard.energy_reference {
+            *reference -= removed;
+        }
         match self.guard.energy_reference {
-            Some((reference, count)) if count == n => {
+            Some(reference) => {
                 let scale = reference.max(self.particles.total_mass() * s.energy_floor_per_mass);
                 let rise = (energy - reference) / scale;
                 self.guard.peaks.energy_rise = self.guard.peaks.energy_rise.max(rise);
                 (rise > s.energy_growth).then(|| self.diagnose_energy(energy, reference))
             }
-            _ => {
-                self.guard.energy_reference = Some((energy, n));
+            None => {
+                self.guard.energy_reference = Some(energy);
                 None
             }
         }
@@ -644,8 +674,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
     }
 
-    fn diagnose_non_finite(&self) -> GuardTrip {
+    fn diagnose_non_finite(&mut self) -> GuardTrip {
         let p = &self.particles;
+        let mut ids = std::mem::take(&mut self.guard.removed_non_finite);
         let bad: Vec<usize> = (0..p.len())
             .filter(|&k| {
                 let spin_ok = p
@@ -661,13 +692,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let cause = forced_step_cause(self.dt, self.guard.settings.stable_dt).unwrap_or_else(|| {
             "a force too large for the step: a contact far stiffer than the step was chosen for (an impact faster than the scene's contact time scale, or particles placed overlapping)".into()
         });
+        let count = ids.len() + bad.len();
+        ids.extend(bad.iter().map(|&k| p.id[k]));
+        ids.truncate(5);
         self.trip(
             GuardKind::NonFinite,
-            bad.iter().take(5).map(|&k| p.id[k]).collect(),
-            format!(
-                "{} particle(s) with a non-finite position, velocity, force or spin",
-                bad.len()
-            ),
+            ids,
+            format!("{count} particle(s) with a non-finite position, velocity, force or spin"),
             cause,
         )
     }
@@ -790,8 +821,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             forced
         } else if fraction > 1.0 {
             format!("the particle passed through the surface: at {speed:.3} m/s it moved {:.0}% of its radius per step", 100.0 * speed.abs() * self.dt / p.radius.iter().cloned().fold(Real::INFINITY, Real::min))
+        } else if self.dt > local_limit {
+            format!("an impact at {speed:.3} m/s (normal approach speed) made the contact stiffer than the step resolves (Hertz scenes: contact.characteristic_velocity below the impact speed)")
         } else {
-            format!("an impact at {speed:.3} m/s (normal approach speed) compresses the contact further than the step was chosen for (Hertz scenes: contact.characteristic_velocity below the impact speed)")
+            format!("an impact at {speed:.3} m/s (normal approach speed) is more than the contact law absorbs within this overlap; the step is inside the stable limit, so the material is too soft for the impact (raise youngs_modulus or epsilon) or the impact too fast")
         };
         let mut trip = self.trip(
             GuardKind::Overlap,
@@ -821,9 +854,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .map(|k| (p.mass[k] * p.velocity[k].length_squared(), p.id[k]))
             .collect();
         by_energy.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let cause = forced_step_cause(self.dt, s.stable_dt).unwrap_or_else(|| {
-            "energy created at contacts the step does not resolve (a contact stiffer or an impact faster than the step was chosen for), or particles placed overlapping".into()
-        });
+        let initial = self.guard.initial_overlap.unwrap_or(0.0);
+        let cause = if let Some(forced) = forced_step_cause(self.dt, s.stable_dt) {
+            forced
+        } else if initial > 0.01 {
+            format!("the particles were placed overlapping (largest overlap {:.0}% of the radius before the first step) and their elastic energy was released", 100.0 * initial)
+        } else {
+            "energy created at contacts the step does not resolve (a contact stiffer or an impact faster than the step was chosen for)".into()
+        };
         self.trip(
             GuardKind::EnergyGrowth,
             by_energy.iter().take(3).map(|e| e.1).collect(),
