@@ -830,7 +830,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             GuardKind::Overlap,
             ids,
             format!(
-                "{what} overlap {:.0}% of the radius exceeds the limit of {:.0}%{}",
+                "{what} overlap {:.1}% of the radius exceeds the limit of {:.1}%{}",
                 100.0 * fraction,
                 100.0 * s.max_overlap_fraction,
                 if local_limit.is_finite() {
