@@ -25,7 +25,7 @@ use crate::math::Real;
 pub struct GuardSettings {
     /// Largest overlap, as a fraction of the smaller radius, before the run is stopped.
     /// Default 0.25: four times the deepest overlap of the shipped Hertz case (hertz_settle,
-    /// 6%), hundreds of times that of the seed's WCA cases (aor_smoke, 0.07%); Hertz theory
+    /// 6%), hundreds of times that of the seed's WCA cases (aor_smoke, 0.06%); Hertz theory
     /// itself assumes overlaps of a few percent.
     pub max_overlap_fraction: Real,
     /// Allowed rise of kinetic plus gravitational energy over its reference, as a fraction
