@@ -40,12 +40,13 @@ pub fn insert_random(
         hi,
         count,
         seed,
+        0.0,
         |_| true,
     )
 }
 
 /// As [`insert_random`], keeping only positions that `accept` (e.g. inside a mesh region and
-/// clear of bodies).
+/// clear of bodies), and allowing centres as close as `(1 - overlap)` times the sum of radii.
 #[allow(clippy::too_many_arguments)]
 pub fn insert_random_where(
     particles: &mut Particles,
@@ -56,6 +57,7 @@ pub fn insert_random_where(
     hi: Vec3,
     count: u64,
     seed: u64,
+    overlap: Real,
     accept: impl Fn(Vec3) -> bool,
 ) -> Result<(), InsertionFailed> {
     let mut rng = Pcg64::seed_from_u64(seed);
@@ -98,7 +100,8 @@ pub fn insert_random_where(
                     grid.get(&[cx + dx, cy + dy, cz + dz])
                         .is_some_and(|members| {
                             members.iter().any(|&k| {
-                                let reach = radius + particles.radius[k as usize];
+                                let reach =
+                                    (radius + particles.radius[k as usize]) * (1.0 - overlap);
                                 (particles.position[k as usize] - p).length_squared()
                                     < reach * reach
                             })

@@ -9,6 +9,7 @@ pub mod coarse_graining;
 pub mod contact;
 pub mod domain;
 pub mod geometry;
+pub mod guard;
 pub mod harness;
 pub mod insertion;
 pub mod integrate;

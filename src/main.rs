@@ -55,6 +55,10 @@ enum Command {
         /// Run even if the time step exceeds the stable limit (prints a warning).
         #[arg(long)]
         force_dt: bool,
+        /// Do not stop when a guard fires (non-finite state, overlap beyond a quarter of the
+        /// radius, energy growing without work): warn once per guard and go on.
+        #[arg(long)]
+        keep_going: bool,
         /// Refuse to coarse-grain where the scaling rule is inconsistent for the scene's
         /// model (gravity, cohesion, rolling with Hertz), instead of warning.
         #[arg(long)]
@@ -96,6 +100,9 @@ enum Command {
         /// rebuilds the report without re-running.
         #[arg(long)]
         reuse: bool,
+        /// cgdem runs warn instead of stopping when a guard fires.
+        #[arg(long)]
+        keep_going: bool,
     },
     /// Add a nightly report (a `cgdem validate` output) to the history in DIR: appends its
     /// metrics to DIR/history.json, rewrites DIR/index.html with the history table, trend
@@ -357,6 +364,7 @@ fn main() -> ExitCode {
             reference_timeout,
             quiet,
             reuse,
+            keep_going,
         } => {
             let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
                 PathBuf::from(&suite)
@@ -373,6 +381,7 @@ fn main() -> ExitCode {
                 quiet,
                 reference_timeout_s: reference_timeout,
                 reuse,
+                keep_going,
             };
             match pool.install(|| cgdem::harness::validate::validate(&options)) {
                 Ok(summary) => {
@@ -442,6 +451,7 @@ fn main() -> ExitCode {
             threads,
             quiet,
             force_dt,
+            keep_going,
             strict,
             sweep,
             set,
@@ -490,7 +500,7 @@ fn main() -> ExitCode {
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
                         if let Some(speeds) = &speeds {
-                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt)?;
+                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going)?;
                             for (rpm, s) in &results {
                                 if let Some(c) = &s.conveying {
                                     println!("{rpm} rpm: {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (a = {:.3}), wall {:.1} s", c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.fill_ratio, s.wall_s);
@@ -503,6 +513,7 @@ fn main() -> ExitCode {
                             out_dir: out_dir.clone(),
                             quiet,
                             force_dt,
+                            keep_going,
                         };
                         run(&scene, &options)
                             .map(|summary| (summary, out_dir))

@@ -10,6 +10,10 @@ use crate::bodies::{Body, BodyLoad};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
+use crate::guard::{
+    forced_step_cause, overlap_fraction, undamped_limit, GuardKind, GuardPeaks, GuardSettings,
+    GuardState, GuardTrip,
+};
 use crate::integrate::{drift_kick, kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{Pair, VerletList};
@@ -60,6 +64,7 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// PCVV's `F0`, `T0` (empty for velocity Verlet).
     old_force: Vec<Vec3>,
     old_torque: Vec<Vec3>,
+    guard: GuardState,
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
@@ -117,9 +122,15 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             integrator: Integrator::VelocityVerlet,
             old_force: Vec::new(),
             old_torque: Vec::new(),
+            guard: GuardState {
+                finite: true,
+                ..Default::default()
+            },
         };
         world.rebuild();
         world.compute_forces();
+        world.guard.initial_overlap = Some(world.max_overlap_fraction());
+        world.reset_energy_reference();
         world
     }
 
@@ -212,6 +223,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         self.time += self.dt;
         self.steps += 1;
+        self.check_guards();
     }
 
     /// One predictor-corrector velocity-Verlet step, paper B Eq. (11)-(15).
@@ -237,10 +249,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         self.compute_forces();
         let p = &mut self.particles;
-        pcvv::correct(&mut p.velocity, &p.force, &self.old_force, &p.inv_mass, dt);
+        let mut finite = pcvv::correct(&mut p.velocity, &p.force, &self.old_force, &p.inv_mass, dt);
         if Self::ROTATES {
             if let Some(a) = &mut p.angular {
-                pcvv::correct(
+                finite &= pcvv::correct(
                     &mut a.omega,
                     &a.torque,
                     &self.old_torque,
@@ -249,6 +261,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 );
             }
         }
+        self.guard.finite = finite;
     }
 
     /// One velocity-Verlet step.
@@ -267,12 +280,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.pose_bodies_at(self.time + dt);
         self.compute_forces();
         let p = &mut self.particles;
-        kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
+        let mut finite = kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
         if Self::ROTATES {
             if let Some(a) = &mut p.angular {
-                kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
+                finite &= kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
+        self.guard.finite = finite;
     }
 
     /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list
@@ -305,6 +319,16 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             }
         }
         if keep.iter().any(|&k| !k) {
+            // The energy guard's reference loses what the removed particles carried; a
+            // non-finite position is the non-finite guard's business, not a lost particle.
+            for (k, _) in keep.iter().enumerate().filter(|(_, &kept)| !kept) {
+                let e = self.particle_energy(k);
+                if e.is_finite() {
+                    self.guard.removed_energy += e;
+                } else {
+                    self.guard.removed_non_finite.push(self.particles.id[k]);
+                }
+            }
             let mut next = 0u32;
             remap = Some(
                 keep.iter()
@@ -389,15 +413,21 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let law = &self.law;
         let n_species = self.n_species;
         let dt = self.dt;
-        self.list
+        // The largest overlap fraction, for the overlap guard (max is exact in any order).
+        self.guard.pair_overlap = self
+            .list
             .pairs
             .par_iter()
             .zip(self.history.par_iter_mut())
             .zip(self.pair_result.par_iter_mut())
             .with_min_len(CHUNK)
-            .for_each(|((pair, history), result)| {
-                *result = pair_force(law, p, omega, &images, n_species, *pair, history, dt);
-            });
+            .map(|((pair, history), result)| {
+                let (r, overlap) =
+                    pair_force(law, p, omega, &images, n_species, *pair, history, dt);
+                *result = r;
+                overlap
+            })
+            .reduce(|| 0.0, larger);
 
         if Self::ROTATES {
             self.gather_with_torques();
@@ -408,7 +438,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let (position, velocity, radius, mass, species) =
             (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
-        let gather = |i: usize| -> (Vec3, WallParticle) {
+        let gather = |i: usize| -> (Vec3, WallParticle, Real) {
             let mut f = mass[i] * gravity;
             let particle = WallParticle {
                 species: species[i] as usize,
@@ -417,41 +447,52 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 radius: radius[i],
                 mass: mass[i],
             };
-            f += walls.force_on(wall_law, &particle, dt);
+            let (wall_force, overlap) = walls.force_on(wall_law, &particle, dt);
+            f += wall_force;
             for k in list.out_start[i]..list.out_start[i + 1] {
                 f += results[k as usize].force_on_i;
             }
             for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
                 f -= results[k as usize].force_on_i;
             }
-            (f, particle)
+            (f, particle, overlap)
         };
         if self.bodies.is_empty() {
-            p.force
+            self.guard.wall_overlap = p
+                .force
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(CHUNK)
-                .for_each(|(i, force)| *force = gather(i).0);
+                .map(|(i, force)| {
+                    let (f, _, overlap) = gather(i);
+                    *force = f;
+                    overlap
+                })
+                .reduce(|| 0.0, larger);
             return;
         }
         let bodies = &self.bodies;
         let n_bodies = bodies.len();
         self.body_loads
             .resize(p.force.len() * n_bodies, BodyLoad::default());
-        p.force
+        self.guard.wall_overlap = p
+            .force
             .par_iter_mut()
             .zip(self.body_loads.par_chunks_mut(n_bodies))
             .enumerate()
             .with_min_len(CHUNK)
-            .for_each(|(i, (force, loads))| {
-                let (mut f, particle) = gather(i);
+            .map(|(i, (force, loads))| {
+                let (mut f, particle, mut overlap) = gather(i);
                 for (body, load) in bodies.iter().zip(loads.iter_mut()) {
-                    let (f_body, l) = body_force(body, wall_law, &particle, dt);
+                    let (f_body, l, o) = body_force(body, wall_law, &particle, dt);
                     f += f_body;
                     *load = l;
+                    overlap = overlap.max(o);
                 }
                 *force = f;
-            });
+                overlap
+            })
+            .reduce(|| 0.0, larger);
         // Fixed-order reduction: bitwise identical for any thread count.
         for (b, body) in self.bodies.iter_mut().enumerate() {
             let mut total = BodyLoad::default();
@@ -491,13 +532,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             return;
         };
         let omega = &a.omega;
-        force
+        self.guard.wall_overlap = force
             .par_iter_mut()
             .zip(a.torque.par_iter_mut())
             .zip(wall_history.par_chunks_mut(slots))
             .enumerate()
             .with_min_len(CHUNK)
-            .for_each(|(i, ((force, torque), wall_history))| {
+            .map(|(i, ((force, torque), wall_history))| {
                 let mut f = mass[i] * gravity;
                 let particle = WallParticle {
                     species: species[i] as usize,
@@ -507,14 +548,17 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     mass: mass[i],
                 };
                 let mut t = Vec3::ZERO;
-                if W::NEEDS_ROTATION {
-                    let (wf, wt) =
+                let overlap = if W::NEEDS_ROTATION {
+                    let (wf, wt, overlap) =
                         walls.force_and_torque_on(wall_law, &particle, omega[i], wall_history, dt);
                     f += wf;
                     t += wt;
+                    overlap
                 } else {
-                    f += walls.force_on(wall_law, &particle, dt);
-                }
+                    let (wf, overlap) = walls.force_on(wall_law, &particle, dt);
+                    f += wf;
+                    overlap
+                };
                 for k in list.out_start[i]..list.out_start[i + 1] {
                     f += results[k as usize].force_on_i;
                     t += results[k as usize].torque_on_i;
@@ -525,11 +569,345 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 }
                 *force = f;
                 *torque = t;
-            });
+                overlap
+            })
+            .reduce(|| 0.0, larger);
     }
 
     pub fn kinetic_energy(&self) -> Real {
         self.particles.kinetic_energy()
+    }
+
+    /// Sets the guard thresholds (and the scene's stable step, for messages).
+    pub fn set_guard_settings(&mut self, settings: GuardSettings) {
+        self.guard.settings = settings;
+    }
+
+    /// How close the run came to the guards' thresholds so far.
+    pub fn guard_peaks(&self) -> GuardPeaks {
+        self.guard.peaks
+    }
+
+    /// The guard that fired in the last step, if any. Until it is taken no other fires.
+    pub fn take_guard_trip(&mut self) -> Option<GuardTrip> {
+        self.guard.trip.take()
+    }
+
+    /// The energy guard takes the present state as its reference (call when walls are
+    /// removed or bodies start: both change what is stored or supplied).
+    pub fn reset_energy_reference(&mut self) {
+        self.guard.energy_reference = Some(self.mechanical_energy());
+        self.guard.removed_energy = 0.0;
+    }
+
+    /// The largest overlap of the last force evaluation, as a fraction of the smaller radius
+    /// (pairs) or of the radius (walls, bodies).
+    pub fn max_overlap_fraction(&self) -> Real {
+        self.guard.pair_overlap.max(self.guard.wall_overlap)
+    }
+
+    /// Kinetic energy plus gravitational energy above the box's lowest corner along gravity.
+    pub fn mechanical_energy(&self) -> Real {
+        let (g, corner) = (self.gravity, self.potential_origin());
+        let p = &self.particles;
+        let potential: Real = p
+            .position
+            .iter()
+            .zip(&p.mass)
+            .map(|(&x, &m)| -m * g.dot(x - corner))
+            .sum();
+        self.kinetic_energy() + potential
+    }
+
+    /// Kinetic plus gravitational energy of particle `k` (as in `mechanical_energy`).
+    fn particle_energy(&self, k: usize) -> Real {
+        let p = &self.particles;
+        let spin = p.angular.as_ref().map_or(0.0, |a| {
+            0.5 * a.omega[k].length_squared() / a.inv_inertia[k]
+        });
+        0.5 * p.mass[k] * p.velocity[k].length_squared() + spin
+            - p.mass[k] * self.gravity.dot(p.position[k] - self.potential_origin())
+    }
+
+    /// The box corner lowest along gravity: gravitational energy is counted from it.
+    fn potential_origin(&self) -> Vec3 {
+        let (g, lo, hi) = (self.gravity, self.domain.lo, self.domain.hi);
+        Vec3::new(
+            if g.x < 0.0 { lo.x } else { hi.x },
+            if g.y < 0.0 { lo.y } else { hi.y },
+            if g.z < 0.0 { lo.z } else { hi.z },
+        )
+    }
+
+    /// Whether the energy guard applies: no attraction, no moving body doing work, and no
+    /// gravity along a periodic axis (which does work without end).
+    fn energy_guard_applies(&self) -> bool {
+        let g = self.gravity.to_array();
+        !L::ATTRACTS
+            && !self.bodies.iter().any(|b| b.is_moving())
+            && (0..3).all(|k| !self.domain.periodic[k] || g[k] == 0.0)
+    }
+
+    /// The per-step checks; the costly part (naming the particles) only runs when one fires.
+    fn check_guards(&mut self) {
+        if self.guard.trip.is_some() {
+            return;
+        }
+        let s = self.guard.settings;
+        let overlap = self.max_overlap_fraction();
+        let peaks = &mut self.guard.peaks;
+        peaks.overlap_fraction = peaks.overlap_fraction.max(overlap);
+        self.guard.trip = if !self.guard.finite || !self.guard.removed_non_finite.is_empty() {
+            Some(self.diagnose_non_finite())
+        } else if self.max_overlap_fraction() > s.max_overlap_fraction {
+            Some(self.diagnose_overlap())
+        } else if s.energy_every > 0
+            && self.steps.is_multiple_of(s.energy_every)
+            && self.energy_guard_applies()
+        {
+            self.check_energy()
+        } else {
+            None
+        };
+    }
+
+    fn check_energy(&mut self) -> Option<GuardTrip> {
+        let s = self.guard.settings;
+        let energy = self.mechanical_energy();
+        let removed = std::mem::take(&mut self.guard.removed_energy);
+        if let Some(reference) = &mut self.guard.energy_reference {
+            *reference -= removed;
+        }
+        match self.guard.energy_reference {
+            Some(reference) => {
+                let scale = reference.max(self.particles.total_mass() * s.energy_floor_per_mass);
+                let rise = (energy - reference) / scale;
+                self.guard.peaks.energy_rise = self.guard.peaks.energy_rise.max(rise);
+                (rise > s.energy_growth).then(|| self.diagnose_energy(energy, reference))
+            }
+            None => {
+                self.guard.energy_reference = Some(energy);
+                None
+            }
+        }
+    }
+
+    fn trip(
+        &self,
+        kind: GuardKind,
+        particles: Vec<u32>,
+        detail: String,
+        cause: String,
+    ) -> GuardTrip {
+        GuardTrip {
+            kind,
+            step: self.steps,
+            time: self.time,
+            particles,
+            detail,
+            cause,
+            dt: self.dt,
+            stable_dt: self.guard.settings.stable_dt,
+        }
+    }
+
+    fn diagnose_non_finite(&mut self) -> GuardTrip {
+        let p = &self.particles;
+        let mut ids = std::mem::take(&mut self.guard.removed_non_finite);
+        let bad: Vec<usize> = (0..p.len())
+            .filter(|&k| {
+                let spin_ok = p
+                    .angular
+                    .as_ref()
+                    .is_none_or(|a| a.omega[k].is_finite() && a.torque[k].is_finite());
+                !(p.position[k].is_finite()
+                    && p.velocity[k].is_finite()
+                    && p.force[k].is_finite()
+                    && spin_ok)
+            })
+            .collect();
+        let cause = forced_step_cause(self.dt, self.guard.settings.stable_dt).unwrap_or_else(|| {
+            "a force too large for the step: a contact far stiffer than the step was chosen for (an impact faster than the scene's contact time scale, or particles placed overlapping)".into()
+        });
+        let count = ids.len() + bad.len();
+        ids.extend(bad.iter().map(|&k| p.id[k]));
+        ids.truncate(5);
+        self.trip(
+            GuardKind::NonFinite,
+            ids,
+            format!("{count} particle(s) with a non-finite position, velocity, force or spin"),
+            cause,
+        )
+    }
+
+    /// Names the deepest contact (pair, wall or body) and the step its stiffness at that
+    /// overlap allows.
+    fn diagnose_overlap(&self) -> GuardTrip {
+        let p = &self.particles;
+        let s = self.guard.settings;
+        let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
+        // (fraction, ids, relative normal speed, local stable step, what)
+        let mut worst: (Real, Vec<u32>, Real, Real, String) =
+            (0.0, Vec::new(), 0.0, Real::NAN, String::new());
+        for pair in &self.list.pairs {
+            let (i, j) = (pair.i as usize, pair.j as usize);
+            let d = p.position[i] - (p.position[j] + images[pair.image as usize]);
+            let distance = d.length();
+            let (r_i, r_j) = (p.radius[i], p.radius[j]);
+            let fraction = (r_i + r_j - distance) / r_i.min(r_j);
+            if fraction > worst.0 {
+                let normal = d / distance;
+                let speed = (p.velocity[i] - p.velocity[j]).dot(normal);
+                let m_eff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+                let species_pair = p.species[i] as usize * self.n_species + p.species[j] as usize;
+                let force_at = |distance: Real| {
+                    let contact = Contact {
+                        species_pair,
+                        normal: Vec3::Z,
+                        distance,
+                        overlap: r_i + r_j - distance,
+                        radius_i: r_i,
+                        radius_j: r_j,
+                        r_eff: r_i * r_j / (r_i + r_j),
+                        mass_i: p.mass[i],
+                        mass_j: p.mass[j],
+                        m_eff,
+                        relative_velocity: Vec3::ZERO,
+                        normal_speed: 0.0,
+                        tangential_velocity: Vec3::ZERO,
+                    };
+                    let mut history = L::History::default();
+                    self.law
+                        .evaluate(&contact, &mut history, (Vec3::ZERO, Vec3::ZERO), self.dt)
+                        .force_on_i
+                        .z
+                };
+                let h = 1e-6 * (r_i + r_j);
+                let stiffness = (force_at(distance - h) - force_at(distance)) / h;
+                worst = (
+                    fraction,
+                    vec![p.id[i], p.id[j]],
+                    -speed,
+                    undamped_limit(stiffness, m_eff),
+                    "pair".into(),
+                );
+            }
+        }
+        for k in 0..p.len() {
+            let particle = WallParticle {
+                species: p.species[k] as usize,
+                position: p.position[k],
+                velocity: p.velocity[k],
+                radius: p.radius[k],
+                mass: p.mass[k],
+            };
+            for wall in self.walls.walls.iter().filter(|w| w.active) {
+                let Some(distance) = wall.plane.distance(particle.position) else {
+                    continue;
+                };
+                let fraction = overlap_fraction(distance, particle.radius);
+                if fraction > worst.0 {
+                    let force_at = |distance: Real| {
+                        let contact = WallContact {
+                            species: particle.species,
+                            normal: Vec3::Z,
+                            distance,
+                            relative_velocity: Vec3::ZERO,
+                            radius: particle.radius,
+                            mass: particle.mass,
+                        };
+                        self.wall_law.force(&contact, self.dt).z
+                    };
+                    let h = 1e-6 * particle.radius;
+                    let stiffness = if distance > h {
+                        (force_at(distance - h) - force_at(distance)) / h
+                    } else {
+                        Real::NAN // the centre has passed the wall
+                    };
+                    worst = (
+                        fraction,
+                        vec![p.id[k]],
+                        -particle.velocity.dot(wall.plane.normal),
+                        undamped_limit(stiffness, particle.mass),
+                        format!("wall `{}`", wall.name),
+                    );
+                }
+            }
+            for body in &self.bodies {
+                let reach = self.wall_law.reach(particle.species, particle.radius);
+                if let Some((distance, normal)) = body.query(particle.position, reach) {
+                    let fraction = overlap_fraction(distance, particle.radius);
+                    if fraction > worst.0 {
+                        let surface = body.surface_velocity(particle.position - distance * normal);
+                        worst = (
+                            fraction,
+                            vec![p.id[k]],
+                            -(particle.velocity - surface).dot(normal),
+                            Real::NAN,
+                            format!("body `{}`", body.name),
+                        );
+                    }
+                }
+            }
+        }
+        let (fraction, ids, speed, local_limit, what) = worst;
+        let initial = self.guard.initial_overlap.unwrap_or(0.0);
+        let cause = if initial > s.max_overlap_fraction {
+            format!("the particles were placed overlapping (largest overlap {:.0}% of the radius before the first step)", 100.0 * initial)
+        } else if let Some(forced) = forced_step_cause(self.dt, s.stable_dt) {
+            forced
+        } else if fraction > 1.0 {
+            format!("the particle passed through the surface: at {speed:.3} m/s it moved {:.0}% of its radius per step", 100.0 * speed.abs() * self.dt / p.radius.iter().cloned().fold(Real::INFINITY, Real::min))
+        } else if self.dt > local_limit {
+            format!("an impact at {speed:.3} m/s (normal approach speed) made the contact stiffer than the step resolves (Hertz scenes: contact.characteristic_velocity below the impact speed)")
+        } else {
+            format!("an impact at {speed:.3} m/s (normal approach speed) is more than the contact law absorbs within this overlap; the step is inside the stable limit, so the material is too soft for the impact (raise youngs_modulus or epsilon) or the impact too fast")
+        };
+        let mut trip = self.trip(
+            GuardKind::Overlap,
+            ids,
+            format!(
+                "{what} overlap {:.1}% of the radius exceeds the limit of {:.1}%{}",
+                100.0 * fraction,
+                100.0 * s.max_overlap_fraction,
+                if local_limit.is_finite() {
+                    format!("; at this overlap the contact allows dt <= {local_limit:.3e} s (undamped 2/omega)")
+                } else {
+                    String::new()
+                }
+            ),
+            cause,
+        );
+        if local_limit.is_finite() {
+            trip.stable_dt = trip.stable_dt.min(local_limit);
+        }
+        trip
+    }
+
+    fn diagnose_energy(&self, energy: Real, reference: Real) -> GuardTrip {
+        let p = &self.particles;
+        let s = self.guard.settings;
+        let mut by_energy: Vec<(Real, u32)> = (0..p.len())
+            .map(|k| (p.mass[k] * p.velocity[k].length_squared(), p.id[k]))
+            .collect();
+        by_energy.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let initial = self.guard.initial_overlap.unwrap_or(0.0);
+        let cause = if let Some(forced) = forced_step_cause(self.dt, s.stable_dt) {
+            forced
+        } else if initial > 0.01 {
+            format!("the particles were placed overlapping (largest overlap {:.0}% of the radius before the first step) and their elastic energy was released", 100.0 * initial)
+        } else {
+            "energy created at contacts the step does not resolve (a contact stiffer or an impact faster than the step was chosen for)".into()
+        };
+        self.trip(
+            GuardKind::EnergyGrowth,
+            by_energy.iter().take(3).map(|e| e.1).collect(),
+            format!(
+                "kinetic plus gravitational energy rose to {energy:.4e} J from {reference:.4e} J at the start of the run or stage (allowed: +{:.0}%) with no work done on the particles; the particles named move fastest",
+                100.0 * s.energy_growth
+            ),
+            cause,
+        )
     }
 }
 
@@ -545,7 +923,7 @@ fn pair_force<L: PairLaw>(
     pair: Pair,
     history: &mut L::History,
     dt: Real,
-) -> PairResult {
+) -> (PairResult, Real) {
     let (i, j) = (pair.i as usize, pair.j as usize);
     let d = p.position[i] - (p.position[j] + images[pair.image as usize]);
     let distance_sq = d.length_squared();
@@ -554,7 +932,7 @@ fn pair_force<L: PairLaw>(
     let cutoff = law.cutoff(species_pair, radius_i, radius_j);
     if distance_sq >= cutoff * cutoff {
         *history = L::History::default();
-        return PairResult::default();
+        return (PairResult::default(), 0.0);
     }
     let distance = distance_sq.sqrt();
     let normal = d / distance;
@@ -587,25 +965,28 @@ fn pair_force<L: PairLaw>(
         normal_speed,
         tangential_velocity: relative_velocity - normal_speed * normal,
     };
-    law.evaluate(&contact, history, spins, dt)
+    let overlap_fraction = overlap / radius_i.min(radius_j);
+    (law.evaluate(&contact, history, spins, dt), overlap_fraction)
 }
 
 /// Force of one body on one particle (the wall law with the SDF distance and normal and the
-/// velocity relative to the body's surface), and the particle's load on the body.
+/// velocity relative to the body's surface), the particle's load on the body and its overlap
+/// with the body as a fraction of the radius.
 #[inline(always)]
 fn body_force<W: WallLaw>(
     body: &Body,
     law: &W,
     particle: &WallParticle,
     dt: Real,
-) -> (Vec3, BodyLoad) {
+) -> (Vec3, BodyLoad, Real) {
     let reach = law.reach(particle.species, particle.radius);
     let Some((distance, normal)) = body.query(particle.position, reach) else {
-        return (Vec3::ZERO, BodyLoad::default());
+        return (Vec3::ZERO, BodyLoad::default(), 0.0);
     };
+    let overlap = overlap_fraction(distance, particle.radius);
     // A centre inside the body has passed through it: no force (as for planar walls).
     if distance <= 0.0 || distance >= reach {
-        return (Vec3::ZERO, BodyLoad::default());
+        return (Vec3::ZERO, BodyLoad::default(), overlap);
     }
     let contact_point = particle.position - distance * normal;
     let contact = WallContact {
@@ -621,5 +1002,16 @@ fn body_force<W: WallLaw>(
         force: -force,
         torque: (contact_point - body.center()).cross(-force),
     };
-    (force, load)
+    (force, load, overlap)
+}
+
+/// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN
+/// handling, and a NaN state is the non-finite guard's business).
+#[inline(always)]
+fn larger(a: Real, b: Real) -> Real {
+    if b > a {
+        b
+    } else {
+        a
+    }
 }

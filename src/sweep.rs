@@ -18,6 +18,7 @@ pub fn rpm_sweep(
     out: &Path,
     quiet: bool,
     force_dt: bool,
+    keep_going: bool,
 ) -> Result<Vec<(Real, RunSummary)>, String> {
     let body = scene
         .conveying
@@ -40,6 +41,7 @@ pub fn rpm_sweep(
             out_dir: out.join(format!("rpm{rpm}")),
             quiet,
             force_dt,
+            keep_going,
         };
         let started = Instant::now();
         let summary = run(&s, &options).map_err(|e| e.to_string())?;

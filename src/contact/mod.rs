@@ -109,6 +109,9 @@ pub trait RollingModel: Send + Sync {
 }
 
 pub trait CohesionModel: Send + Sync {
+    /// Whether the slot attracts: then kinetic plus gravitational energy may rise by the
+    /// binding energy, and the energy guard does not apply.
+    const ATTRACTS: bool = true;
     /// How far beyond touching (`r_i + r_j`) the attraction reaches; the neighbour search
     /// adds it to its cut-off.
     fn reach(&self) -> Real;
@@ -120,6 +123,8 @@ pub trait CohesionModel: Send + Sync {
 pub trait PairLaw: Send + Sync {
     type History: PairHistory;
     const NEEDS_ROTATION: bool;
+    /// Whether any part of the law attracts (cohesion).
+    const ATTRACTS: bool = false;
     /// Largest distance beyond `r_i + r_j` at which any pair still interacts.
     fn reach(&self) -> Real;
     fn cutoff(&self, species_pair: usize, radius_i: Real, radius_j: Real) -> Real;
@@ -163,6 +168,7 @@ where
     /// Tangential and rolling history side by side; `((), ())` (no storage) for the seed.
     type History = (T::History, R::History);
     const NEEDS_ROTATION: bool = T::NEEDS_ROTATION || R::NEEDS_ROTATION;
+    const ATTRACTS: bool = C::ATTRACTS;
 
     fn reach(&self) -> Real {
         self.normal_reach.max(self.cohesion.reach())

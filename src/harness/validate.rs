@@ -101,6 +101,8 @@ pub struct ValidateOptions {
     /// for a reference run without one, when its deck is the one the case writes now (its
     /// dumps are then post-processed again by the current code).
     pub reuse: bool,
+    /// cgdem's guards only warn instead of stopping a run (`--keep-going`).
+    pub keep_going: bool,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -398,6 +400,7 @@ fn run_cgdem(
         out_dir: dir.to_path_buf(),
         quiet: options.quiet,
         force_dt: false,
+        keep_going: options.keep_going,
     };
     run(&coarse, &run_options)
         .map(|_| false)

@@ -41,19 +41,23 @@ pub fn predict_rate(rate: &mut [Vec3], torque: &[Vec3], inv_inertia: &[Real], dt
         .for_each(|(w, (t, inv_i))| *w += dt * *inv_i * *t);
 }
 
-/// The corrector: `v += dt/(2m) (F1 - F0)`.
+/// The corrector: `v += dt/(2m) (F1 - F0)`. Returns whether every updated value is finite.
 pub fn correct(
     velocity: &mut [Vec3],
     force: &[Vec3],
     old_force: &[Vec3],
     inv_mass: &[Real],
     dt: Real,
-) {
+) -> bool {
     let half = 0.5 * dt;
     velocity
         .par_iter_mut()
         .zip(force.par_iter().zip(old_force.par_iter()))
         .zip(inv_mass.par_iter())
         .with_min_len(CHUNK)
-        .for_each(|((v, (f1, f0)), inv_m)| *v += half * *inv_m * (*f1 - *f0));
+        .map(|((v, (f1, f0)), inv_m)| {
+            *v += half * *inv_m * (*f1 - *f0);
+            v.is_finite()
+        })
+        .reduce(|| true, |a, b| a && b)
 }

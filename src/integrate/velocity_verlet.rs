@@ -30,11 +30,16 @@ pub fn drift_kick(
 }
 
 /// Half kick: `v += dt/2 F/m` (also used for spins with torque and inverse inertia).
-pub fn kick(velocity: &mut [Vec3], force: &[Vec3], inv_mass: &[Real], dt: Real) {
+/// Returns whether every updated value is finite (the non-finite guard, at no extra pass).
+pub fn kick(velocity: &mut [Vec3], force: &[Vec3], inv_mass: &[Real], dt: Real) -> bool {
     let half = 0.5 * dt;
     velocity
         .par_iter_mut()
         .zip(force.par_iter().zip(inv_mass.par_iter()))
         .with_min_len(CHUNK)
-        .for_each(|(v, (f, inv_m))| *v += half * *inv_m * *f);
+        .map(|(v, (f, inv_m))| {
+            *v += half * *inv_m * *f;
+            v.is_finite()
+        })
+        .reduce(|| true, |a, b| a && b)
 }

@@ -306,6 +306,7 @@ mod tests {
             out_dir: std::env::temp_dir().join("cgdem-unsupported"),
             quiet: true,
             force_dt: false,
+            keep_going: false,
         };
         let message = run_hertz(&scene, &h, &options).unwrap_err().to_string();
         assert!(

@@ -18,6 +18,7 @@ use crate::bodies::{Body, BodyShape, Motion};
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
 use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, SdfGrid};
+use crate::guard::{GuardKind, GuardPeaks, GuardSettings, GuardTrip};
 use crate::insertion::{insert_random_where, InsertionFailed};
 use crate::io::{vtk::VtkSeries, write_atomic};
 use crate::math::{Real, Vec3};
@@ -32,6 +33,8 @@ pub struct RunOptions {
     pub out_dir: PathBuf,
     pub quiet: bool,
     pub force_dt: bool,
+    /// A guard that fires only warns (once per guard) instead of stopping the run.
+    pub keep_going: bool,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -63,6 +66,12 @@ pub enum RunError {
     },
     #[error("cannot write {path}: {message}")]
     Output { path: PathBuf, message: String },
+    #[error("{file}: run stopped: {trip}; the outputs written so far are kept in {}; pass --keep-going to only warn", out_dir.display())]
+    Stopped {
+        file: String,
+        trip: Box<GuardTrip>,
+        out_dir: PathBuf,
+    },
 }
 
 fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
@@ -149,6 +158,10 @@ pub struct RunSummary {
     pub deleted_mass_kg: Real,
     pub conveying: Option<ConveyingSummary>,
     pub warnings: Vec<String>,
+    /// The guard that stopped the run early, if one did.
+    pub stopped_by: Option<GuardTrip>,
+    /// How close the run came to the guards' thresholds (none for reference codes).
+    pub guard_peaks: Option<GuardPeaks>,
     pub scene_file: String,
     /// `Scene::digest` of the (coarse-grained) scene this run simulated.
     pub scene_digest: String,
@@ -296,6 +309,7 @@ pub fn initial_particles(
                 .iter()
                 .all(|b| b.query(p, radius).is_none_or(|(d, _)| d > radius))
         };
+        let first = particles.len();
         insert_random_where(
             &mut particles,
             ins.species as u16,
@@ -305,6 +319,7 @@ pub fn initial_particles(
             ins.hi,
             count,
             ins.seed,
+            ins.overlap,
             accept,
         )
         .map_err(|source| RunError::Insertion {
@@ -312,6 +327,9 @@ pub fn initial_particles(
             index,
             source,
         })?;
+        for v in &mut particles.velocity[first..] {
+            *v = ins.velocity;
+        }
     }
     Ok(particles)
 }
@@ -400,6 +418,12 @@ fn execute<L: PairLaw, W: WallLaw>(
         neighbor,
     )
     .with_integrator(scene.integrator);
+    world.set_guard_settings(GuardSettings {
+        stable_dt: scales.stable_limit,
+        ..GuardSettings::default()
+    });
+    let mut guard_counts: Vec<(GuardKind, u64)> = Vec::new();
+    let mut stopped_by: Option<GuardTrip> = None;
     if !bodies.is_empty() {
         world.set_bodies(bodies);
     }
@@ -494,7 +518,8 @@ fn execute<L: PairLaw, W: WallLaw>(
     let mut next_row = 0.0;
     let mut next_frame = 0.0;
     let mut final_profile = None;
-    for stage in &scene.stages {
+    'stages: for stage in &scene.stages {
+        world.reset_energy_reference();
         for name in &stage.remove_walls {
             world.walls.remove(name);
         }
@@ -525,6 +550,31 @@ fn execute<L: PairLaw, W: WallLaw>(
         for k in 1..=stage_steps {
             world.step();
             particle_steps += world.particles.len() as u64;
+            if let Some(trip) = world.take_guard_trip() {
+                if !options.keep_going {
+                    stages.push(StageRecord {
+                        name: stage.name.clone(),
+                        start_s: start,
+                        end_s: world.time,
+                        steps: world.steps - start_steps,
+                        ended_by: format!("stopped by the {} guard", trip.kind.name()),
+                    });
+                    stopped_by = Some(trip);
+                    break 'stages;
+                }
+                // Warn once per guard; count the rest. A new energy reference, so the
+                // energy guard judges what follows.
+                world.reset_energy_reference();
+                match guard_counts.iter_mut().find(|(kind, _)| *kind == trip.kind) {
+                    Some((_, count)) => *count += 1,
+                    None => {
+                        let w = format!("--keep-going: {trip}");
+                        eprintln!("warning: {w}");
+                        warnings.push(w);
+                        guard_counts.push((trip.kind, 1));
+                    }
+                }
+            }
             if let Some((c, k)) = measuring {
                 if world.time - start >= c.discard - 0.5 * dt {
                     let body = &world.bodies()[k];
@@ -643,6 +693,14 @@ fn execute<L: PairLaw, W: WallLaw>(
         });
     }
     progress.finish_and_clear();
+    for (kind, count) in guard_counts.iter().filter(|(_, count)| *count > 1) {
+        let w = format!(
+            "--keep-going: the {} guard fired in {count} steps",
+            kind.name()
+        );
+        eprintln!("warning: {w}");
+        warnings.push(w);
+    }
     let wall_s = started.elapsed().as_secs_f64();
     if world.lost > 0 {
         let w = format!(
@@ -675,7 +733,7 @@ fn execute<L: PairLaw, W: WallLaw>(
         }
         _ => None,
     };
-    if final_profile.is_none() {
+    if final_profile.is_none() && stopped_by.is_none() {
         if let Some(profile) = heap_profile(&world) {
             write_measurements(out, &samples, &profile)?;
         }
@@ -721,14 +779,23 @@ fn execute<L: PairLaw, W: WallLaw>(
         deleted_mass_kg: world.deleted_mass,
         conveying: conveying_summary,
         warnings,
-        scene_file: file,
+        stopped_by: stopped_by.clone(),
+        guard_peaks: Some(world.guard_peaks()),
+        scene_file: file.clone(),
         scene_digest: scene.digest(),
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
     };
     let path = out.join("summary.json");
     let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&path, e))?;
     write_atomic(&path, json.as_bytes()).map_err(|e| output_error(&path, e))?;
-    Ok(summary)
+    match stopped_by {
+        Some(trip) => Err(RunError::Stopped {
+            file,
+            trip: Box::new(trip),
+            out_dir: out.clone(),
+        }),
+        None => Ok(summary),
+    }
 }
 
 /// How a stage ends, in words for the summary.

@@ -133,6 +133,11 @@ pub struct Insertion {
     pub mesh: Option<MeshSource>,
     pub amount: InsertAmount,
     pub seed: u64,
+    /// Initial velocity of every particle inserted, m/s.
+    pub velocity: Vec3,
+    /// Overlap allowed between inserted particles, as a fraction of the sum of their radii
+    /// (0: none; stability tests use it to start from a compressed packing).
+    pub overlap: Real,
 }
 
 /// Where a triangle mesh comes from: an STL file (path relative to the scene file) or, with

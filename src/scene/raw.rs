@@ -161,6 +161,8 @@ pub struct RawInsertion {
     #[serde(default)]
     pub seed: u64,
     pub mesh: Option<String>,
+    pub velocity: Option<[f64; 3]>,
+    pub overlap: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -341,6 +341,21 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
             mesh: ins.mesh.as_deref().map(|m| mesh_source(m, file)),
             amount,
             seed: ins.seed,
+            velocity: c.vector(
+                &format!("insert[{k}].velocity"),
+                ins.velocity.unwrap_or([0.0; 3]),
+            )?,
+            overlap: match ins.overlap {
+                None => 0.0,
+                Some(f) if (0.0..=0.9).contains(&f) => f,
+                Some(f) => {
+                    return Err(c.invalid(
+                        format!("insert[{k}].overlap"),
+                        f,
+                        "a fraction of the sum of the radii from 0 (default) to 0.9",
+                    ))
+                }
+            },
         });
     }
 

@@ -9,6 +9,7 @@ pub use hertz_wall::{HertzWall, HertzWallSpecies};
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
 use crate::geometry::FinitePlane;
+use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
 use crate::neighbor::PairHistory;
 
@@ -91,41 +92,18 @@ impl WallSet {
         }
     }
 
-    /// The contacts of the active walls with one particle.
+    /// Total force of the active walls on one particle, and its deepest overlap with one of
+    /// them as a fraction of its radius (for the overlap guard, from the same distances).
     #[inline(always)]
-    fn contacts<'a, W: WallLaw>(
-        &'a self,
-        law: &W,
-        particle: &'a WallParticle,
-    ) -> impl Iterator<Item = WallContact> + 'a {
-        let reach = law.reach(particle.species, particle.radius);
-        self.walls
-            .iter()
-            .filter(|w| w.active)
-            .filter_map(move |wall| {
-                let distance = wall.plane.distance(particle.position)?;
-                // Only the front side repels: a particle behind a wall has left through it.
-                (distance > 0.0 && distance < reach).then_some(WallContact {
-                    species: particle.species,
-                    normal: wall.plane.normal,
-                    distance,
-                    relative_velocity: particle.velocity,
-                    radius: particle.radius,
-                    mass: particle.mass,
-                })
-            })
+    pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> (Vec3, Real) {
+        let (mut force, mut overlap) = (Vec3::ZERO, 0.0);
+        self.each_contact(law, particle, &mut overlap, |c| force += law.force(&c, dt));
+        (force, overlap)
     }
 
-    /// Total force of the active walls on one particle.
-    #[inline(always)]
-    pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> Vec3 {
-        self.contacts(law, particle)
-            .map(|c| law.force(&c, dt))
-            .sum()
-    }
-
-    /// Total force and torque of the active walls on one spinning particle; `history` holds
-    /// one entry per wall (index order), reset for walls the particle does not touch.
+    /// Total force and torque of the active walls on one spinning particle, and its deepest
+    /// overlap fraction; `history` holds one entry per wall (index order), reset for walls
+    /// the particle does not touch.
     #[inline(always)]
     pub fn force_and_torque_on<W: WallLaw>(
         &self,
@@ -134,19 +112,25 @@ impl WallSet {
         omega: Vec3,
         history: &mut [W::History],
         dt: Real,
-    ) -> (Vec3, Vec3) {
+    ) -> (Vec3, Vec3, Real) {
         let reach = law.reach(particle.species, particle.radius);
-        let mut total = (Vec3::ZERO, Vec3::ZERO);
+        let (mut force, mut torque, mut overlap) = (Vec3::ZERO, Vec3::ZERO, 0.0 as Real);
         for (wall, state) in self.walls.iter().zip(history.iter_mut()) {
-            let touching = wall
+            let within = wall
                 .active
                 .then(|| wall.plane.distance(particle.position))
                 .flatten()
-                .filter(|&d| d > 0.0 && d < reach);
-            let Some(distance) = touching else {
+                .filter(|&d| d < reach);
+            let Some(distance) = within else {
                 *state = W::History::default();
                 continue;
             };
+            overlap = overlap.max(overlap_fraction(distance, particle.radius));
+            // Only the front side repels: a particle behind a wall has left through it.
+            if distance <= 0.0 {
+                *state = W::History::default();
+                continue;
+            }
             let contact = WallContact {
                 species: particle.species,
                 normal: wall.plane.normal,
@@ -156,9 +140,41 @@ impl WallSet {
                 mass: particle.mass,
             };
             let (f, t) = law.force_and_torque_with_history(&contact, omega, state, dt);
-            total.0 += f;
-            total.1 += t;
+            force += f;
+            torque += t;
         }
-        total
+        (force, torque, overlap)
+    }
+
+    /// Calls `act` for each active wall the particle touches and keeps the deepest overlap.
+    #[inline(always)]
+    fn each_contact<W: WallLaw>(
+        &self,
+        law: &W,
+        particle: &WallParticle,
+        overlap: &mut Real,
+        mut act: impl FnMut(WallContact),
+    ) {
+        let reach = law.reach(particle.species, particle.radius);
+        for wall in self.walls.iter().filter(|w| w.active) {
+            let Some(distance) = wall.plane.distance(particle.position) else {
+                continue;
+            };
+            if distance >= reach {
+                continue; // the common case: one comparison
+            }
+            *overlap = overlap.max(overlap_fraction(distance, particle.radius));
+            // Only the front side repels: a particle behind a wall has left through it.
+            if distance > 0.0 {
+                act(WallContact {
+                    species: particle.species,
+                    normal: wall.plane.normal,
+                    distance,
+                    relative_velocity: particle.velocity,
+                    radius: particle.radius,
+                    mass: particle.mass,
+                });
+            }
+        }
     }
 }

@@ -12,6 +12,8 @@ use crate::math::Real;
 pub struct NoCohesion;
 
 impl CohesionModel for NoCohesion {
+    const ATTRACTS: bool = false;
+
     #[inline(always)]
     fn reach(&self) -> Real {
         0.0

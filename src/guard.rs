@@ -1,0 +1,168 @@
+//! Guards that stop an unstable run instead of letting it write garbage.
+//!
+//! Three cheap checks, folded into loops that run anyway or done every few steps:
+//!
+//! - **Non-finite state**: the last velocity (and spin) update of each step reports whether
+//!   every value it wrote is finite. A NaN or infinite force, velocity or position shows up
+//!   there in the step it appears.
+//! - **Overlap**: the pair loop reduces the largest `overlap / min(r_i, r_j)`, and the
+//!   particle gather the largest wall and body overlap `(r - h) / r` (`h` the centre-to-
+//!   surface distance; a centre up to one radius behind a wall counts, as it has tunnelled).
+//!   Above [`GuardSettings::max_overlap_fraction`] the contact is no longer resolved.
+//! - **Energy growth without work**: every [`GuardSettings::energy_every`] steps the
+//!   kinetic plus gravitational energy `E = KE + sum m g_abs h` (height `h` above the box's
+//!   lowest corner along gravity) is compared with its value at the last reference point (the
+//!   run's start, each stage start; particles removed take their energy with them). Contacts that only
+//!   repel and dissipate can store energy but not create it, so `E` may not exceed the
+//!   reference by more than [`GuardSettings::energy_growth`] of `max(E_ref, M e_floor)`.
+//!   The check is off while a moving body does work and for cohesive laws (binding energy
+//!   turns into kinetic energy legitimately).
+
+use crate::math::Real;
+
+/// Thresholds of the guards. The defaults are what `cgdem run` uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuardSettings {
+    /// Largest overlap, as a fraction of the smaller radius, before the run is stopped.
+    /// Default 0.25: four times the deepest overlap of the shipped Hertz case (hertz_settle,
+    /// 6%), hundreds of times that of the seed's WCA cases (aor_smoke, 0.06%); Hertz theory
+    /// itself assumes overlaps of a few percent.
+    pub max_overlap_fraction: Real,
+    /// Allowed rise of kinetic plus gravitational energy over its reference, as a fraction
+    /// of `max(E_ref, total mass * energy_floor_per_mass)`.
+    pub energy_growth: Real,
+    /// Energy scale per unit mass below which `energy_growth` is taken of this instead,
+    /// J/kg (per mass, so it is the same at every coarse-graining level).
+    pub energy_floor_per_mass: Real,
+    /// Steps between energy checks (16: an instability grows by orders of magnitude per
+    /// contact period, which is 20 steps at the default dt_fraction 0.05).
+    pub energy_every: u64,
+    /// The scene's stable time-step limit, s (for messages; NaN when unknown).
+    pub stable_dt: Real,
+}
+
+impl Default for GuardSettings {
+    fn default() -> Self {
+        GuardSettings {
+            max_overlap_fraction: 0.25,
+            energy_growth: 0.05,
+            energy_floor_per_mass: 1e-3,
+            energy_every: 16,
+            stable_dt: Real::NAN,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GuardKind {
+    NonFinite,
+    Overlap,
+    EnergyGrowth,
+}
+
+impl GuardKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            GuardKind::NonFinite => "non-finite state",
+            GuardKind::Overlap => "overlap",
+            GuardKind::EnergyGrowth => "energy growth",
+        }
+    }
+}
+
+/// A guard that fired: when, what was measured, which particles, why, and a step that would
+/// be stable.
+#[derive(Clone, Debug, PartialEq, thiserror::Error, serde::Serialize)]
+#[error("guard `{}` fired at step {step} (t = {time:.6e} s): {detail}; particles (id) {}; likely cause: {cause}; a stable time step: {}", kind.name(), format_ids(particles), format_stable(*stable_dt, *dt))]
+pub struct GuardTrip {
+    pub kind: GuardKind,
+    pub step: u64,
+    pub time: Real,
+    /// Stable ids of the particles involved (at most a few).
+    pub particles: Vec<u32>,
+    pub detail: String,
+    pub cause: String,
+    /// The run's step and the step that would be stable here, s.
+    pub dt: Real,
+    pub stable_dt: Real,
+}
+
+fn format_ids(ids: &[u32]) -> String {
+    if ids.is_empty() {
+        return "none identified".into();
+    }
+    ids.iter()
+        .map(|id| id.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn format_stable(stable_dt: Real, dt: Real) -> String {
+    if stable_dt.is_finite() {
+        format!("dt <= {stable_dt:.3e} s (this run: {dt:.3e} s)")
+    } else {
+        format!("unknown (this run: {dt:.3e} s)")
+    }
+}
+
+/// The cause when the step itself was forced past the limit, if it was.
+pub(crate) fn forced_step_cause(dt: Real, stable_dt: Real) -> Option<String> {
+    (dt > stable_dt).then(|| {
+        format!(
+            "the time step is {:.2} times the stable limit (forced with --force-dt)",
+            dt / stable_dt
+        )
+    })
+}
+
+/// Undamped stable step `2 / omega` of a contact of local stiffness `k` on mass `m`.
+pub(crate) fn undamped_limit(stiffness: Real, mass: Real) -> Real {
+    if stiffness > 0.0 && mass > 0.0 {
+        2.0 / (stiffness / mass).sqrt()
+    } else {
+        Real::NAN
+    }
+}
+
+/// Guard state the world carries between steps.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct GuardState {
+    pub settings: GuardSettings,
+    /// Largest pair and wall/body overlap fractions of the last force evaluation.
+    pub pair_overlap: Real,
+    pub wall_overlap: Real,
+    /// Whether the last velocity update wrote only finite values.
+    pub finite: bool,
+    /// Overlap at the first force evaluation (particles placed overlapping).
+    pub initial_overlap: Option<Real>,
+    /// Energy reference, and the energy of particles removed since the last check (it
+    /// leaves the reference with them).
+    pub energy_reference: Option<Real>,
+    pub removed_energy: Real,
+    /// Ids of particles that the list rebuild found at a non-finite position.
+    pub removed_non_finite: Vec<u32>,
+    pub trip: Option<GuardTrip>,
+    pub peaks: GuardPeaks,
+}
+
+/// How close a run came to each guard's threshold: the largest overlap fraction seen and
+/// the largest energy rise as a fraction of the scale it is judged against (the guard fires
+/// above `energy_growth`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct GuardPeaks {
+    pub overlap_fraction: Real,
+    pub energy_rise: Real,
+}
+
+/// Overlap of a particle of radius `r` whose centre is `distance` in front of a surface, as a
+/// fraction of `r`; a centre up to one radius behind the surface has tunnelled (fraction
+/// between 1 and 2); further behind, or not touching, 0.
+#[inline(always)]
+pub fn overlap_fraction(distance: Real, radius: Real) -> Real {
+    if distance < radius && distance > -radius {
+        1.0 - distance / radius
+    } else {
+        0.0
+    }
+}

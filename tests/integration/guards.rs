@@ -1,0 +1,134 @@
+//! The solver guards: a deliberately unstable run is stopped with an error naming the guard,
+//! the step, the particles, the likely cause and a stable step; what it wrote survives; and
+//! `--keep-going` turns the stop into a warning. One regression test per guard.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use cgdem::guard::GuardKind;
+use cgdem::math::Real;
+
+use crate::common::{binary_collision, collide, Coke};
+
+fn cgdem_run(case: &str, dir: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cgdem"))
+        .args(["run", case, "--quiet", "--threads", "1", "--out"])
+        .arg(dir)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cgdem-guard-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// The run failed with the named guard's full message, kept at least `rows` time-series rows
+/// and wrote a summary that records the stop; returns stderr.
+fn assert_stopped(out: &Output, dir: &Path, guard: &str, kind: &str, rows: usize) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!out.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in [
+        format!("guard `{guard}` fired at step"),
+        "particles (id)".into(),
+        "likely cause:".into(),
+        "a stable time step: dt <=".into(),
+        "outputs written so far are kept".into(),
+    ] {
+        assert!(stderr.contains(&needle), "no `{needle}` in: {stderr}");
+    }
+    let series = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
+    assert!(series.lines().count() > rows, "{series}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["stopped_by"]["kind"], kind, "{summary}");
+    assert!(summary["stages"][0]["ended_by"]
+        .as_str()
+        .unwrap()
+        .contains("stopped by"));
+    stderr
+}
+
+#[test]
+fn energy_guard_stops_a_forced_5x_time_step_and_keep_going_only_warns() {
+    let dir = scratch("energy");
+    let out = cgdem_run("validation/stability/dt_5x.toml", &dir, &["--force-dt"]);
+    let stderr = assert_stopped(&out, &dir, "energy growth", "energy_growth", 2);
+    assert!(
+        stderr.contains("5.00 times the stable limit") && stderr.contains("dt <= 4.446e-6 s"),
+        "{stderr}"
+    );
+
+    let dir_on = scratch("energy-keep-going");
+    let out = cgdem_run(
+        "validation/stability/dt_5x.toml",
+        &dir_on,
+        &["--force-dt", "--keep-going"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning: --keep-going: guard `energy growth`"),
+        "{stderr}"
+    );
+    let summary = std::fs::read_to_string(dir_on.join("summary.json")).unwrap();
+    assert!(summary.contains("\"stopped_by\": null"), "{summary}");
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&dir_on);
+}
+
+#[test]
+fn overlap_guard_stops_a_50_m_s_impact_on_soft_hertz_beads() {
+    let dir = scratch("overlap");
+    let out = cgdem_run("validation/stability/impact_50ms_hertz.toml", &dir, &[]);
+    let stderr = assert_stopped(&out, &dir, "overlap", "overlap", 1);
+    assert!(
+        stderr.contains("wall `floor` overlap") && stderr.contains("an impact at"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn overlap_guard_names_particles_placed_overlapping() {
+    let dir = scratch("overlap-placed");
+    let out = cgdem_run("validation/stability/dense_overlap.toml", &dir, &[]);
+    let stderr = assert_stopped(&out, &dir, "overlap", "overlap", 0);
+    assert!(stderr.contains("placed overlapping"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn non_finite_guard_stops_an_overflowing_contact_force() {
+    let dir = scratch("non-finite");
+    let out = cgdem_run("tests/data/guard_non_finite.toml", &dir, &["--force-dt"]);
+    assert_stopped(&out, &dir, "non-finite state", "non_finite", 2);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn non_finite_velocity_trips_the_guard_in_the_step_it_appears_naming_the_particle() {
+    let coke = Coke::at(8.0);
+    let mut world = binary_collision(&coke, 0.1, 0.0, 0.02 * coke.pair_period());
+    world.step();
+    assert!(world.take_guard_trip().is_none());
+    world.particles.velocity[1].x = Real::NAN;
+    let id = world.particles.id[1];
+    world.step();
+    let trip = world.take_guard_trip().expect("the non-finite guard fires");
+    assert_eq!(trip.kind, GuardKind::NonFinite);
+    assert_eq!(trip.step, 2);
+    assert!(trip.particles.contains(&id), "{trip}");
+}
+
+#[test]
+fn a_resolved_binary_collision_trips_no_guard() {
+    let coke = Coke::at(8.0);
+    let mut world = binary_collision(&coke, 1.0, 0.3, 0.02 * coke.pair_period());
+    collide(&mut world, coke.diameter());
+    assert!(world.take_guard_trip().is_none());
+    assert!(world.guard_peaks().overlap_fraction > 0.0);
+}
