@@ -311,6 +311,7 @@ pub fn postprocess(
         deleted_particles: 0,
         deleted_mass_kg: 0.0,
         conveying: None,
+        packing: None,
         n_particles: n_final,
         n_particles_inserted: n_inserted,
         lost_particles: (n_inserted - n_final.min(n_inserted)) as u64,
