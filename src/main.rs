@@ -12,6 +12,7 @@ use cgdem::geometry::screw_feeder::{self, ScrewFeederSpec};
 use cgdem::report::sdf_study::write_sdf_accuracy_study;
 use cgdem::run::{run, RunOptions};
 use cgdem::scene::{Override, Scene};
+use cgdem::sweep::Sweep;
 
 #[derive(Parser)]
 #[command(
@@ -72,8 +73,11 @@ enum Command {
         /// recognises the run.
         #[arg(long, requires = "set")]
         variant: Option<String>,
-        /// Screw-speed sweep, e.g. `rpm=20,40,60`: one run per speed of the `[conveying]`
-        /// body into OUT/rpm<N>/, then OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7).
+        /// A sweep, one run per value: `rpm=20,40,60` (screw speed of the `[conveying]` body;
+        /// OUT/rpm<N>/, OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7)) or
+        /// `diameter=1e-6,1e-5,1e-4` (m; a `[packing]` scene rescaled to each diameter with the
+        /// material held; OUT/d<um>um/, OUT/porosity_vs_diameter.csv, pore_size_vs_diameter.csv
+        /// and plots with the published points).
         #[arg(long)]
         sweep: Option<String>,
     },
@@ -457,23 +461,10 @@ fn main() -> ExitCode {
             set,
             variant,
         } => {
-            let speeds: Option<Vec<f64>> = match sweep.as_deref().map(|s| s.strip_prefix("rpm=")) {
-                None => None,
-                Some(Some(list)) => match list
-                    .split(',')
-                    .map(|v| v.trim().parse::<f64>())
-                    .collect::<Result<Vec<_>, _>>()
-                {
-                    Ok(v) if !v.is_empty() && v.iter().all(|x| x.is_finite() && *x > 0.0) => {
-                        Some(v)
-                    }
-                    _ => {
-                        eprintln!("error: --sweep expects rpm=<positive numbers separated by commas>, got `{list}`");
-                        return ExitCode::from(2);
-                    }
-                },
-                Some(None) => {
-                    eprintln!("error: --sweep expects rpm=<list>, e.g. rpm=20,40,60");
+            let sweep = match sweep.as_deref().map(Sweep::parse).transpose() {
+                Ok(s) => s,
+                Err(e) => {
+                    eprintln!("error: {e}");
                     return ExitCode::from(2);
                 }
             };
@@ -499,7 +490,17 @@ fn main() -> ExitCode {
                     })
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
-                        if let Some(speeds) = &speeds {
+                        if let Some(Sweep::Diameter(diameters)) = &sweep {
+                            let results = cgdem::sweep::diameter_sweep(&scene, diameters, &out_dir, quiet, force_dt, keep_going)?;
+                            for (d, s) in &results {
+                                let porosity = s.packing.as_ref().map_or("not measured".into(), |p| format!("{:.4}", p.porosity));
+                                println!("d = {:.3e} m: {} particles, {} steps of {:.3e} s, porosity {porosity}, wall {:.1} s", d, s.n_particles, s.steps, s.dt_s, s.wall_s);
+                            }
+                            println!("porosity_vs_diameter.csv, pore_size_vs_diameter.csv and plots in {}", out_dir.display());
+                            let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
+                            return Ok((last, out_dir));
+                        }
+                        if let Some(Sweep::Rpm(speeds)) = &sweep {
                             let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going)?;
                             for (rpm, s) in &results {
                                 if let Some(c) = &s.conveying {
@@ -532,6 +533,12 @@ fn main() -> ExitCode {
                         if let Some(rule) = &summary.repose_rule {
                             println!("  rule: {rule}");
                         }
+                    }
+                    if let Some(p) = &summary.packing {
+                        println!(
+                            "porosity {:.4} between z = {:.4e} and {:.4e} m ({:.1} d; bed height {:.1} d); mean pore diameter {:.3e} m",
+                            p.porosity, p.region_z_m[0], p.region_z_m[1], p.region_height_diameters, p.bed_height_diameters, p.mean_pore_diameter_m
+                        );
                     }
                     if let Some(c) = &summary.conveying {
                         println!(

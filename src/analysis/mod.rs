@@ -5,10 +5,12 @@
 pub mod conveying;
 pub mod distance_transform;
 pub mod heap;
+pub mod packing;
 pub mod pore_size;
 pub mod porosity;
 
 pub use distance_transform::squared_distance_transform;
+pub use packing::{measure_packing, PackingMeasurement, PackingSummary};
 pub use pore_size::{
     pore_size_field, pore_size_field_of_spheres, rasterize_spheres, Boundary, PoreSizeDistribution,
     PoreSizeError, PoreSizeField, VoxelGrid,

@@ -14,6 +14,7 @@ use serde::Serialize;
 
 use crate::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
 use crate::analysis::heap::{self, HeapProfile};
+use crate::analysis::{measure_packing, PackingSummary};
 use crate::bodies::{Body, BodyShape, Motion};
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
@@ -157,6 +158,8 @@ pub struct RunSummary {
     pub deleted_particles: u64,
     pub deleted_mass_kg: Real,
     pub conveying: Option<ConveyingSummary>,
+    /// Porosity and pore sizes of the bed (`[packing]`), measured when its stage ends.
+    pub packing: Option<PackingSummary>,
     pub warnings: Vec<String>,
     /// The guard that stopped the run early, if one did.
     pub stopped_by: Option<GuardTrip>,
@@ -518,6 +521,7 @@ fn execute<L: PairLaw, W: WallLaw>(
     let mut next_row = 0.0;
     let mut next_frame = 0.0;
     let mut final_profile = None;
+    let mut packing = None;
     'stages: for stage in &scene.stages {
         world.reset_energy_reference();
         for name in &stage.remove_walls {
@@ -684,6 +688,37 @@ fn execute<L: PairLaw, W: WallLaw>(
         if let Some((c, _)) = measuring {
             conveying_window = Some((start + c.discard, world.time));
         }
+        if let Some(pk) = scene.packing.as_ref().filter(|p| p.stage == stage.name) {
+            let (lo, hi) = (scene.domain.lo, scene.domain.hi);
+            match measure_packing(
+                &world.particles.position,
+                &world.particles.radius,
+                [lo.x, lo.y],
+                [hi.x, hi.y],
+                floor_z,
+                &pk.rule,
+                pk.voxels_per_diameter,
+                pk.bin_width_diameters,
+            ) {
+                Ok(m) => {
+                    let path = out.join("pore_size.csv");
+                    let mut csv = Vec::new();
+                    m.pore_sizes
+                        .write_csv(&mut csv)
+                        .map_err(|e| output_error(&path, e))?;
+                    write_atomic(&path, &csv).map_err(|e| output_error(&path, e))?;
+                    packing = Some(m.summary);
+                }
+                Err(e) => {
+                    let w = format!(
+                        "packing: not measured at the end of stage `{}`: {e}",
+                        stage.name
+                    );
+                    eprintln!("warning: {w}");
+                    warnings.push(w);
+                }
+            }
+        }
         stages.push(StageRecord {
             name: stage.name.clone(),
             start_s: start,
@@ -778,6 +813,7 @@ fn execute<L: PairLaw, W: WallLaw>(
         deleted_particles: world.deleted,
         deleted_mass_kg: world.deleted_mass,
         conveying: conveying_summary,
+        packing,
         warnings,
         stopped_by: stopped_by.clone(),
         guard_peaks: Some(world.guard_peaks()),

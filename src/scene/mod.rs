@@ -209,6 +209,18 @@ pub struct ConveyingSettings {
     pub bulk_hi: Vec3,
 }
 
+/// Porosity and pore sizes of a poured bed (paper B sec. 3), measured when `stage` ends.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackingSettings {
+    pub stage: String,
+    /// The measurement region, in diameters (see `analysis::porosity::BedRegionRule`).
+    pub rule: crate::analysis::BedRegionRule,
+    /// Pore-size voxels per particle diameter (the lateral period must hold a whole number).
+    pub voxels_per_diameter: u32,
+    /// Width of the pore-size histogram bins, in diameters.
+    pub bin_width_diameters: Real,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum StageEnd {
     /// Run for this long.
@@ -282,6 +294,7 @@ pub struct Scene {
     /// Particles whose centre enters one of these boxes (lo, hi) are deleted.
     pub deletions: Vec<(Vec3, Vec3)>,
     pub conveying: Option<ConveyingSettings>,
+    pub packing: Option<PackingSettings>,
 }
 
 impl Scene {

@@ -34,6 +34,19 @@ pub struct RawScene {
     pub deletions: Vec<RawDelete>,
     #[serde(default)]
     pub conveying: Option<RawConveying>,
+    #[serde(default)]
+    pub packing: Option<RawPacking>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPacking {
+    pub stage: String,
+    pub floor_margin: Option<f64>,
+    pub top_quantile: Option<f64>,
+    pub top_margin: Option<f64>,
+    pub voxels_per_diameter: Option<u32>,
+    pub bin_width_diameters: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

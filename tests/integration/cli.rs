@@ -159,3 +159,91 @@ fn geometry_commands_write_the_screw_feeder_meshes_and_the_sdf_study() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn bad_sweeps_are_errors_naming_the_key_and_value_not_panics() {
+    let cases: [(&str, &str, &[&str]); 4] = [
+        (
+            "validation/cases/packing_vdw.toml",
+            "size=1e-6",
+            &["--sweep", "unknown key `size`", "diameter"],
+        ),
+        (
+            "validation/cases/packing_vdw.toml",
+            "diameter=1e-6,-1e-5",
+            &["--sweep diameter", "`-1e-5`", "> 0"],
+        ),
+        (
+            "validation/cases/aor_collapse.toml",
+            "diameter=1e-4",
+            &["aor_collapse.toml", "[packing]"],
+        ),
+        (
+            "validation/cases/packing_vdw.toml",
+            "rpm=20",
+            &["packing_vdw.toml", "[conveying]"],
+        ),
+    ];
+    for (case, sweep, expected) in cases {
+        let out = cgdem()
+            .args(["run", case, "--quiet", "--sweep", sweep, "--out"])
+            .arg(std::env::temp_dir().join(format!("cgdem-cli-sweep-{}", std::process::id())))
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        for e in expected {
+            assert!(stderr.contains(e), "{sweep}: {stderr}");
+        }
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
+
+/// A small bed (300 spheres of 1 mm in a 5 d period, where gravity beats van der Waals) poured
+/// by the diameter sweep: a coarse random packing, porosity 0.35 .. 0.45, with its pore sizes
+/// and the sweep's table and plots written.
+#[test]
+fn a_small_diameter_sweep_packs_a_coarse_bed_and_writes_its_tables() {
+    let dir = std::env::temp_dir().join(format!("cgdem-cli-packing-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = std::fs::read_to_string("validation/cases/packing_vdw.toml")
+        .unwrap()
+        .replace(
+            "hi = [1.0e-3, 1.0e-3, 9.0e-3]",
+            "hi = [5.0e-4, 5.0e-4, 1.1e-2]",
+        )
+        .replace(
+            "hi = [1.0e-3, 1.0e-3, 8.72665e-3]",
+            "hi = [5.0e-4, 5.0e-4, 1.0472e-2]", // start porosity 0.94 again
+        )
+        .replace("count = 1000", "count = 300")
+        .replace("min_duration = 0.045", "min_duration = 0.05");
+    let case = dir.join("small_packing.toml");
+    std::fs::write(&case, scene).unwrap();
+    let out = cgdem()
+        .args(["run", case.to_str().unwrap(), "--quiet", "--threads", "1"])
+        .args(["--sweep", "diameter=1e-3", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let table = std::fs::read_to_string(dir.join("out/porosity_vs_diameter.csv")).unwrap();
+    let row: Vec<&str> = table.lines().nth(1).unwrap().split(',').collect();
+    let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+    let porosity: f64 = column("porosity").parse().unwrap();
+    assert!((0.35..0.45).contains(&porosity), "porosity {porosity}");
+    assert_eq!(column("settled"), "true");
+    assert_eq!(column("published_porosity"), "0.36");
+    for file in [
+        "d1000um/summary.json",
+        "d1000um/pore_size.csv",
+        "pore_size_vs_diameter.csv",
+        "porosity_vs_diameter_plot.png",
+        "porosity_vs_diameter_plot.svg",
+        "pore_size_distribution_plot.png",
+    ] {
+        assert!(dir.join("out").join(file).exists(), "{file} missing");
+    }
+}

@@ -6,11 +6,13 @@
 //! LIGGGHTS `epsd2` (see `Epsd2`) is a rolling spring capped at the same `mu_r R_eff |F_n|`;
 //! the two agree once the cap binds (steady rolling), not in elastic rolling oscillations.
 //!
-//! `w/|w|` flips with `w`; as for the seed's wall friction the torque is capped so it can at
-//! most halve `|w|` in one step: `|T| <= |w| / (2 dt (1/I_i + 1/I_j))`, solid spheres
-//! `I = (2/5) m R^2`.
+//! `w/|w|` flips with `w`; the torque is capped so it can remove at most `1/MAX_CONTACTS` of
+//! `|w|` in one step: `|T| <= |w| / (MAX_CONTACTS dt (1/I_i + 1/I_j))`, solid spheres
+//! `I = (2/5) m R^2`, so that all the contacts of a sphere together cannot reverse its spin
+//! (see `tangential::yang`).
 
 use super::super::{Contact, RollingModel};
+use crate::contact::tangential::MAX_CONTACTS;
 use crate::math::{Real, Vec3};
 
 /// `mu_r` per species pair (dimensionless).
@@ -44,7 +46,7 @@ impl RollingModel for ConstantTorque {
             self.rolling_friction[contact.species_pair] * contact.r_eff * normal_force.abs();
         let inv_inertia = 2.5 / (contact.mass_i * contact.radius_i * contact.radius_i)
             + 2.5 / (contact.mass_j * contact.radius_j * contact.radius_j);
-        let no_reversal = spin / (2.0 * dt * inv_inertia);
+        let no_reversal = spin / (MAX_CONTACTS * dt * inv_inertia);
         -(torque.min(no_reversal) / spin) * w
     }
 }

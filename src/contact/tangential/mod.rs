@@ -6,4 +6,4 @@ mod yang;
 
 pub use mindlin::Mindlin;
 pub use viscous::ViscousTangential;
-pub use yang::YangTangential;
+pub use yang::{YangTangential, MAX_CONTACTS};

@@ -3,13 +3,22 @@
 //! `xi_max = mu (2 - nu) / (2 (1 - nu)) xi_n`, `xi_s = integral of |v_t| dt` since the contact
 //! began (the history, a scalar, the same seen from either particle).
 //!
-//! `v_t/|v_t|` flips with `v_t` and would chatter around `v_t = 0` in an explicit scheme; as for
-//! the seed's wall friction the magnitude is capped at `m_t |v_t| / (2 dt)`, the force that
-//! halves the contact-point slip in one step, with `m_t = (2/7) m_eff` the effective mass of
-//! the contact point of two solid spheres (`1/m_t = 1/m_i + 1/m_j + R_i^2/I_i + R_j^2/I_j`).
+//! `v_t/|v_t|` flips with `v_t` and would chatter around `v_t = 0` in an explicit scheme; the
+//! magnitude is capped at `m_t |v_t| / (MAX_CONTACTS dt)`, the force that removes
+//! `1/MAX_CONTACTS` of the contact-point slip in one step, with `m_t = (2/7) m_eff` the
+//! effective mass of the contact point of two solid spheres
+//! (`1/m_t = 1/m_i + 1/m_j + R_i^2/I_i + R_j^2/I_j`). A sphere among equal spheres has at most
+//! 12 contacts, so all of them together cannot reverse its slip. (A cap that halves the slip
+//! per contact overshoots once a sphere has five or more contacts: the slip then chatters with
+//! speeds of order `mu F_n dt / m_t`, which for 1 um spheres held by van der Waals is about
+//! 0.1 m/s, a kinetic energy that never decays.)
 
 use super::super::{Contact, TangentialModel};
 use crate::math::{Real, Vec3};
+
+/// The most contacts one sphere has among equal spheres; each contact's regularized friction
+/// may remove at most this fraction of the slip per step.
+pub const MAX_CONTACTS: Real = 12.0;
 
 /// Per species pair: `mu` and `mu (2 - nu) / (2 (1 - nu))`.
 #[derive(Clone, Debug)]
@@ -39,7 +48,7 @@ impl TangentialModel for YangTangential {
         }
         let mobilized = 1.0 - (1.0 - slip.min(xi_max) / xi_max).powf(1.5);
         let magnitude = self.friction[sp] * normal_force.abs() * mobilized;
-        let no_reversal = (2.0 / 7.0) * contact.m_eff * speed / (2.0 * dt);
+        let no_reversal = (2.0 / 7.0) * contact.m_eff * speed / (MAX_CONTACTS * dt);
         -(magnitude.min(no_reversal) / speed) * contact.tangential_velocity
     }
 }

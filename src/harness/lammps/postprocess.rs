@@ -320,6 +320,7 @@ pub fn postprocess(
         conveying: None,
         stopped_by: None,
         guard_peaks: None,
+        packing: None,
         n_particles: n_final,
         n_particles_inserted: n_inserted,
         lost_particles: (n_inserted - n_final.min(n_inserted)) as u64,

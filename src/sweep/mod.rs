@@ -1,0 +1,220 @@
+//! Sweeps: one run per value of a scene parameter, then a table and a plot.
+//!
+//! * `rpm=...`: a conveying scene at several screw speeds, mass flow against speed with
+//!   Eq. (7) (paper A Fig. 8).
+//! * `diameter=...`: a packing scene at several particle diameters, porosity against diameter
+//!   beside the published values and pore-size distributions (paper B Fig. 2).
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::io::write_atomic;
+use crate::math::Real;
+use crate::report::{write_figure, Figure, Series, SeriesStyle};
+use crate::run::{run, RunOptions, RunSummary};
+use crate::scene::Scene;
+
+mod diameter;
+pub use diameter::{
+    diameter_sweep, published_porosity, scale_to_diameter, PublishedPorosity, PAPER_PSD_DIAMETERS,
+};
+
+/// A parsed `--sweep KEY=V1,V2,...`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Sweep {
+    /// Screw speeds, rev/min.
+    Rpm(Vec<Real>),
+    /// Particle diameters, m.
+    Diameter(Vec<Real>),
+}
+
+/// The keys `--sweep` knows, with what their values mean.
+pub const SWEEP_KEYS: &str =
+    "rpm (screw speeds, rev/min, > 0) or diameter (particle diameters, m, > 0)";
+
+/// A bad `--sweep` argument; the message names the option, the key and the value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SweepError {
+    #[error("--sweep: expected KEY=V1,V2,... with KEY {SWEEP_KEYS}; got `{0}`")]
+    Syntax(String),
+    #[error("--sweep: unknown key `{0}`; allowed: {SWEEP_KEYS}")]
+    UnknownKey(String),
+    #[error("--sweep {key}: value `{value}` is not allowed: {allowed}")]
+    BadValue {
+        key: String,
+        value: String,
+        allowed: String,
+    },
+}
+
+impl Sweep {
+    /// Parses `rpm=20,40` or `diameter=1e-6,3e-6`: every value a finite number > 0, no
+    /// value twice.
+    pub fn parse(text: &str) -> Result<Sweep, SweepError> {
+        let (key, list) = text
+            .split_once('=')
+            .ok_or_else(|| SweepError::Syntax(text.to_string()))?;
+        let key = key.trim();
+        let unit = match key {
+            "rpm" => "rev/min",
+            "diameter" => "m",
+            _ => return Err(SweepError::UnknownKey(key.to_string())),
+        };
+        let bad = |value: &str, allowed: String| SweepError::BadValue {
+            key: key.to_string(),
+            value: value.to_string(),
+            allowed,
+        };
+        let mut values: Vec<Real> = Vec::new();
+        for item in list.split(',') {
+            let item = item.trim();
+            let v: Real = item
+                .parse()
+                .map_err(|_| bad(item, format!("a number ({unit})")))?;
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(item, format!("a finite number > 0 ({unit})")));
+            }
+            if values.contains(&v) {
+                return Err(bad(item, "each value once".into()));
+            }
+            values.push(v);
+        }
+        Ok(match key {
+            "rpm" => Sweep::Rpm(values),
+            _ => Sweep::Diameter(values),
+        })
+    }
+}
+
+/// Runs `scene` once per speed (|rpm|; the scene's sense of rotation is kept) into
+/// `out/rpm<N>/`, then writes `out/mass_flow_vs_rpm.csv` and the plot `out/mass_flow_vs_rpm_plot.png|svg|csv`.
+pub fn rpm_sweep(
+    scene: &Scene,
+    speeds: &[Real],
+    out: &Path,
+    quiet: bool,
+    force_dt: bool,
+    keep_going: bool,
+) -> Result<Vec<(Real, RunSummary)>, String> {
+    let body = scene
+        .conveying
+        .as_ref()
+        .map(|c| c.body.clone())
+        .ok_or_else(|| {
+            format!(
+                "{}: --sweep needs a [conveying] section",
+                scene.source.display()
+            )
+        })?;
+    let mut results = Vec::new();
+    let mut csv = String::from("rpm,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,drive_torque_nm,drive_power_w,wall_s\n");
+    for &rpm in speeds {
+        let mut s = scene.clone();
+        for b in s.bodies.iter_mut().filter(|b| b.name == body) {
+            b.rpm = if b.rpm < 0.0 { -rpm.abs() } else { rpm.abs() };
+        }
+        let options = RunOptions {
+            out_dir: out.join(format!("rpm{rpm}")),
+            quiet,
+            force_dt,
+            keep_going,
+        };
+        let started = Instant::now();
+        let summary = run(&s, &options).map_err(|e| e.to_string())?;
+        let wall = started.elapsed().as_secs_f64();
+        let c = summary.conveying.as_ref();
+        let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+        csv += &format!(
+            "{rpm},{},{},{},{},{},{},{},{},{wall:.1}\n",
+            f(c.map(|c| c.mass_flow_kg_s)),
+            f(c.map(|c| c.mass_flow_std_error_kg_s)),
+            f(c.map(|c| c.fill_ratio)),
+            f(c.map(|c| c.bulk_density_kg_m3)),
+            f(c.map(|c| c.eq7_mass_flow_kg_s)),
+            f(c.map(|c| c.eq7_full_mass_flow_kg_s)),
+            f(c.map(|c| c.drive_torque_nm)),
+            f(c.map(|c| c.drive_power_w)),
+        );
+        write_atomic(&out.join("mass_flow_vs_rpm.csv"), csv.as_bytes()).map_err(|e| {
+            format!(
+                "cannot write {}: {e}",
+                out.join("mass_flow_vs_rpm.csv").display()
+            )
+        })?;
+        results.push((rpm, summary));
+    }
+    let points = |v: &dyn Fn(&crate::analysis::conveying::ConveyingSummary) -> Real| {
+        results
+            .iter()
+            .filter_map(|(rpm, s)| s.conveying.as_ref().map(|c| (*rpm, v(c))))
+            .collect::<Vec<_>>()
+    };
+    let measured = points(&|c| c.mass_flow_kg_s);
+    let errors: Vec<Real> = points(&|c| c.mass_flow_std_error_kg_s)
+        .iter()
+        .map(|p| p.1)
+        .collect();
+    let fig = Figure::new(
+        "Screw feeder: mass flow vs speed",
+        "screw speed (rpm)",
+        "mass flow (kg/s)",
+    )
+    .with_series(
+        Series::new("DEM (SDF screw)", measured)
+            .style(SeriesStyle::Markers)
+            .y_err(errors),
+    )
+    .with_series(
+        Series::new(
+            "Eq. (7), measured a and bulk density",
+            points(&|c| c.eq7_mass_flow_kg_s),
+        )
+        .style(SeriesStyle::Line),
+    )
+    .with_series(
+        Series::new("Eq. (7), a = 1", points(&|c| c.eq7_full_mass_flow_kg_s))
+            .style(SeriesStyle::Dashed),
+    );
+    write_figure(out, "mass_flow_vs_rpm_plot", &fig).map_err(|e| e.to_string())?;
+    Ok(results)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweep_lists_parse_with_their_key() {
+        assert_eq!(
+            Sweep::parse("diameter=1e-6, 3e-6,1e-3").unwrap(),
+            Sweep::Diameter(vec![1e-6, 3e-6, 1e-3])
+        );
+        assert_eq!(
+            Sweep::parse("rpm=20,40").unwrap(),
+            Sweep::Rpm(vec![20.0, 40.0])
+        );
+    }
+
+    #[test]
+    fn bad_sweeps_name_the_key_the_value_and_what_is_allowed() {
+        let cases = [
+            ("size=1e-6", "unknown key `size`", "diameter"),
+            ("diameter 1e-6", "expected KEY=V1,V2", "rpm"),
+            ("diameter=1e-6,-3e-6", "value `-3e-6`", "> 0 (m)"),
+            ("diameter=0", "value `0`", "> 0 (m)"),
+            ("diameter=1e-6,abc", "value `abc`", "a number (m)"),
+            ("diameter=", "value ``", "a number"),
+            ("diameter=1e-6,1e-6", "value `1e-6`", "each value once"),
+            ("rpm=20,inf", "value `inf`", "rev/min"),
+        ];
+        for (text, what, allowed) in cases {
+            let message = Sweep::parse(text).unwrap_err().to_string();
+            assert!(
+                message.starts_with("--sweep")
+                    && message.contains(what)
+                    && message.contains(allowed),
+                "{text}: {message}"
+            );
+        }
+    }
+}
