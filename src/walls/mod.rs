@@ -97,7 +97,11 @@ impl WallSet {
     #[inline(always)]
     pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> (Vec3, Real) {
         let (mut force, mut overlap) = (Vec3::ZERO, 0.0);
-        self.each_contact(law, particle, &mut overlap, |c| force += law.force(&c, dt));
+        self.each_wall(law, particle, &mut overlap, |_, contact| {
+            if let Some(c) = contact {
+                force += law.force(&c, dt);
+            }
+        });
         (force, overlap)
     }
 
@@ -113,68 +117,49 @@ impl WallSet {
         history: &mut [W::History],
         dt: Real,
     ) -> (Vec3, Vec3, Real) {
-        let reach = law.reach(particle.species, particle.radius);
-        let (mut force, mut torque, mut overlap) = (Vec3::ZERO, Vec3::ZERO, 0.0 as Real);
-        for (wall, state) in self.walls.iter().zip(history.iter_mut()) {
-            let within = wall
-                .active
-                .then(|| wall.plane.distance(particle.position))
-                .flatten()
-                .filter(|&d| d < reach);
-            let Some(distance) = within else {
-                *state = W::History::default();
-                continue;
-            };
-            overlap = overlap.max(overlap_fraction(distance, particle.radius));
-            // Only the front side repels: a particle behind a wall has left through it.
-            if distance <= 0.0 {
-                *state = W::History::default();
-                continue;
+        let (mut force, mut torque, mut overlap) = (Vec3::ZERO, Vec3::ZERO, 0.0);
+        self.each_wall(law, particle, &mut overlap, |k, contact| match contact {
+            Some(c) => {
+                let (f, t) = law.force_and_torque_with_history(&c, omega, &mut history[k], dt);
+                force += f;
+                torque += t;
             }
-            let contact = WallContact {
-                species: particle.species,
-                normal: wall.plane.normal,
-                distance,
-                relative_velocity: particle.velocity,
-                radius: particle.radius,
-                mass: particle.mass,
-            };
-            let (f, t) = law.force_and_torque_with_history(&contact, omega, state, dt);
-            force += f;
-            torque += t;
-        }
+            None => history[k] = W::History::default(),
+        });
         (force, torque, overlap)
     }
 
-    /// Calls `act` for each active wall the particle touches and keeps the deepest overlap.
+    /// Calls `act(k, contact)` for every wall k: the contact when the particle touches it
+    /// (an active wall, within reach, on its front side), None otherwise; keeps the deepest
+    /// overlap (a centre behind a wall counts, for the guard).
     #[inline(always)]
-    fn each_contact<W: WallLaw>(
+    fn each_wall<W: WallLaw>(
         &self,
         law: &W,
         particle: &WallParticle,
         overlap: &mut Real,
-        mut act: impl FnMut(WallContact),
+        mut act: impl FnMut(usize, Option<WallContact>),
     ) {
         let reach = law.reach(particle.species, particle.radius);
-        for wall in self.walls.iter().filter(|w| w.active) {
-            let Some(distance) = wall.plane.distance(particle.position) else {
-                continue;
-            };
-            if distance >= reach {
-                continue; // the common case: one comparison
-            }
-            *overlap = overlap.max(overlap_fraction(distance, particle.radius));
-            // Only the front side repels: a particle behind a wall has left through it.
-            if distance > 0.0 {
-                act(WallContact {
+        for (k, wall) in self.walls.iter().enumerate() {
+            let distance = wall
+                .active
+                .then(|| wall.plane.distance(particle.position))
+                .flatten()
+                .filter(|&d| d < reach);
+            let contact = distance.and_then(|distance| {
+                *overlap = overlap.max(overlap_fraction(distance, particle.radius));
+                // Only the front side repels: a particle behind a wall has left through it.
+                (distance > 0.0).then_some(WallContact {
                     species: particle.species,
                     normal: wall.plane.normal,
                     distance,
                     relative_velocity: particle.velocity,
                     radius: particle.radius,
                     mass: particle.mass,
-                });
-            }
+                })
+            });
+            act(k, contact);
         }
     }
 }

@@ -66,6 +66,18 @@ impl Deck {
     }
 }
 
+/// The `boundary` line (LAMMPS and LIGGGHTS alike): `p` on periodic axes, `f` elsewhere.
+pub(crate) fn boundary_line(scene: &Scene) -> String {
+    let flag = |axis: usize| {
+        if scene.domain.periodic[axis] {
+            "p"
+        } else {
+            "f"
+        }
+    };
+    format!("boundary        {} {} {}\n", flag(0), flag(1), flag(2))
+}
+
 pub(crate) fn g(x: Real) -> String {
     format!("{x:.17e}")
 }
@@ -194,14 +206,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     );
     let _ = writeln!(d, "# Model lines: reference/lammps/SEED_MODEL.md. Do not edit: rewrite with `cgdem reference lammps`.");
     d += "units           si\natom_style      sphere\natom_modify     map array\n";
-    let flag = |axis: usize| {
-        if scene.domain.periodic[axis] {
-            "p"
-        } else {
-            "f"
-        }
-    };
-    let _ = writeln!(d, "boundary        {} {} {}", flag(0), flag(1), flag(2));
+    d += &boundary_line(scene);
     d += "newton          off\ncomm_modify     vel yes\n";
     let _ = writeln!(d, "read_data       {DATA_FILE}");
     // Diameter rc for the granular contact range; mass from the species' own diameter.

@@ -16,7 +16,9 @@
 
 use std::fmt::Write as _;
 
-use super::deck::{data_file, g, Deck, DeckError, DeckPlan, DATA_FILE, TRAJECTORY_FILE};
+use super::deck::{
+    boundary_line, data_file, g, Deck, DeckError, DeckPlan, DATA_FILE, TRAJECTORY_FILE,
+};
 use crate::contact::damping::restitution_beta;
 use crate::contact::normal::{Hertz, Material};
 use crate::math::Real;
@@ -188,14 +190,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         scene.name
     );
     d += "units           si\natom_style      sphere\natom_modify     map array\n";
-    let flag = |axis: usize| {
-        if scene.domain.periodic[axis] {
-            "p"
-        } else {
-            "f"
-        }
-    };
-    let _ = writeln!(d, "boundary        {} {} {}", flag(0), flag(1), flag(2));
+    d += &boundary_line(scene);
     d += "newton          off\ncomm_modify     vel yes\n";
     let _ = writeln!(d, "read_data       {DATA_FILE}");
     d += "pair_style      granular\n";

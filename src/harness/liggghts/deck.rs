@@ -11,7 +11,9 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::harness::lammps::deck::{data_file, g, Deck, DeckError, DeckPlan, DATA_FILE};
+use crate::harness::lammps::deck::{
+    boundary_line, data_file, g, Deck, DeckError, DeckPlan, DATA_FILE,
+};
 use crate::harness::lammps::hertz::{hertz_settings, material, wall_axis, wall_material};
 use crate::math::Real;
 use crate::particles::Particles;
@@ -81,14 +83,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         scene.name
     );
     d += "units           si\natom_style      granular\natom_modify     map array\n";
-    let flag = |axis: usize| {
-        if scene.domain.periodic[axis] {
-            "p"
-        } else {
-            "f"
-        }
-    };
-    let _ = writeln!(d, "boundary        {} {} {}", flag(0), flag(1), flag(2));
+    d += &boundary_line(scene);
     d += "newton          off\ncommunicate     single vel yes\n";
     let _ = writeln!(d, "read_data       {DATA_FILE}");
     let _ = writeln!(
