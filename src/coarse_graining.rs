@@ -160,6 +160,10 @@ pub fn coarse_grain_by(
         out.time_step = TimeStepRequest::Explicit(dt * l.powi(time));
     }
     for ins in &mut out.insertions {
+        if let InsertAmount::Lattice(lattice) = &mut ins.amount {
+            // Sites one coarse diameter apart where there were sites one diameter apart.
+            lattice.spacing *= l;
+        }
         if let InsertAmount::Count(n) = ins.amount {
             ins.amount = InsertAmount::Count(((n as f64 / l.powi(3)).round() as u64).max(1));
         }

@@ -64,6 +64,42 @@ impl Particles {
         }
     }
 
+    /// Fixes particle `k` in place (LIGGGHTS/LAMMPS `fix freeze`): zero inverse mass and
+    /// inertia, so the integrator never moves it and its contacts see an infinite mass.
+    pub fn freeze(&mut self, k: usize) {
+        self.velocity[k] = Vec3::ZERO;
+        self.inv_mass[k] = 0.0;
+        if let Some(angular) = &mut self.angular {
+            angular.omega[k] = Vec3::ZERO;
+            angular.inv_inertia[k] = 0.0;
+        }
+    }
+
+    /// Whether particle `k` is frozen (see [`Particles::freeze`]).
+    #[inline(always)]
+    pub fn is_frozen(&self, k: usize) -> bool {
+        self.inv_mass[k] == 0.0
+    }
+
+    /// The same particles with spin state (at rest); frozen particles stay frozen.
+    pub fn with_rotation(&self) -> Particles {
+        let mut rotating = Particles::new(true);
+        for k in 0..self.len() {
+            rotating.push(
+                self.species[k],
+                self.position[k],
+                self.radius[k],
+                self.mass[k],
+            );
+            rotating.velocity[k] = self.velocity[k];
+            rotating.id[k] = self.id[k];
+            if self.is_frozen(k) {
+                rotating.freeze(k);
+            }
+        }
+        rotating
+    }
+
     /// Reorders every per-particle array: new index `k` holds old particle `order[k]`.
     pub fn permute(&mut self, order: &[u32]) {
         fn apply<T: Copy>(values: &mut Vec<T>, order: &[u32]) {
@@ -101,17 +137,34 @@ impl Particles {
             .zip(&self.mass)
             .map(|(v, m)| 0.5 * m * v.length_squared())
             .sum();
-        let rotational: Real = self.angular.as_ref().map_or(0.0, |a| {
-            a.omega
-                .iter()
-                .zip(&a.inv_inertia)
-                .map(|(w, inv_i)| 0.5 * w.length_squared() / inv_i)
-                .sum()
-        });
+        let rotational: Real = (0..self.len()).map(|k| self.spin_energy(k)).sum();
         translational + rotational
+    }
+
+    /// Rotational kinetic energy of particle `k`, J (zero without spin, or frozen).
+    pub fn spin_energy(&self, k: usize) -> Real {
+        self.angular.as_ref().map_or(0.0, |a| {
+            let inv_i = a.inv_inertia[k];
+            if inv_i > 0.0 {
+                0.5 * a.omega[k].length_squared() / inv_i
+            } else {
+                0.0
+            }
+        })
     }
 
     pub fn total_mass(&self) -> Real {
         self.mass.iter().sum()
+    }
+
+    /// Mass of the particles that move (all but the frozen), kg: kinetic energy per mass is
+    /// per this mass.
+    pub fn mobile_mass(&self) -> Real {
+        self.mass
+            .iter()
+            .zip(&self.inv_mass)
+            .filter(|(_, &inv)| inv > 0.0)
+            .map(|(m, _)| m)
+            .sum()
     }
 }

@@ -85,17 +85,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     ) -> Self {
         let mut particles = particles;
         if Self::ROTATES && particles.angular.is_none() {
-            let mut rotating = Particles::new(true);
-            for k in 0..particles.len() {
-                rotating.push(
-                    particles.species[k],
-                    particles.position[k],
-                    particles.radius[k],
-                    particles.mass[k],
-                );
-                rotating.velocity[k] = particles.velocity[k];
-            }
-            particles = rotating;
+            particles = particles.with_rotation();
         }
         let mut world = World {
             particles,
@@ -622,10 +612,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Kinetic plus gravitational energy of particle `k` (as in `mechanical_energy`).
     fn particle_energy(&self, k: usize) -> Real {
         let p = &self.particles;
-        let spin = p.angular.as_ref().map_or(0.0, |a| {
-            0.5 * a.omega[k].length_squared() / a.inv_inertia[k]
-        });
-        0.5 * p.mass[k] * p.velocity[k].length_squared() + spin
+        0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
             - p.mass[k] * self.gravity.dot(p.position[k] - self.potential_origin())
     }
 
@@ -680,7 +667,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         match self.guard.energy_reference {
             Some(reference) => {
-                let scale = reference.max(self.particles.total_mass() * s.energy_floor_per_mass);
+                let scale = reference.max(self.particles.mobile_mass() * s.energy_floor_per_mass);
                 let rise = (energy - reference) / scale;
                 self.guard.peaks.energy_rise = self.guard.peaks.energy_rise.max(rise);
                 (rise > s.energy_growth).then(|| self.diagnose_energy(energy, reference))
@@ -758,7 +745,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             if fraction > worst.0 {
                 let normal = d / distance;
                 let speed = (p.velocity[i] - p.velocity[j]).dot(normal);
-                let m_eff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+                let m_eff = 1.0 / (p.inv_mass[i] + p.inv_mass[j]);
                 let species_pair = p.species[i] as usize * self.n_species + p.species[j] as usize;
                 let force_at = |distance: Real| {
                     let contact = Contact {
@@ -769,8 +756,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                         radius_i: r_i,
                         radius_j: r_j,
                         r_eff: r_i * r_j / (r_i + r_j),
-                        mass_i: p.mass[i],
-                        mass_j: p.mass[j],
+                        inv_mass_i: p.inv_mass[i],
+                        inv_mass_j: p.inv_mass[j],
                         m_eff,
                         relative_velocity: Vec3::ZERO,
                         normal_speed: 0.0,
@@ -949,7 +936,7 @@ fn pair_force<L: PairLaw>(
         }
     }
     let normal_speed = relative_velocity.dot(normal);
-    let (mass_i, mass_j) = (p.mass[i], p.mass[j]);
+    let (inv_mass_i, inv_mass_j) = (p.inv_mass[i], p.inv_mass[j]);
     let contact = Contact {
         species_pair,
         normal,
@@ -958,9 +945,11 @@ fn pair_force<L: PairLaw>(
         radius_i,
         radius_j,
         r_eff: radius_i * radius_j / (radius_i + radius_j),
-        mass_i,
-        mass_j,
-        m_eff: mass_i * mass_j / (mass_i + mass_j),
+        inv_mass_i,
+        inv_mass_j,
+        // A frozen particle (inverse mass 0) acts with infinite mass, as in LIGGGHTS and
+        // LAMMPS with `fix freeze`; two frozen particles are never listed.
+        m_eff: 1.0 / (inv_mass_i + inv_mass_j),
         relative_velocity,
         normal_speed,
         tangential_velocity: relative_velocity - normal_speed * normal,

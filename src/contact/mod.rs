@@ -28,9 +28,10 @@ pub struct Contact {
     pub radius_j: Real,
     /// Effective radius `r_i r_j / (r_i + r_j)`.
     pub r_eff: Real,
-    pub mass_i: Real,
-    pub mass_j: Real,
-    /// Effective mass `m_i m_j / (m_i + m_j)`.
+    /// Inverse masses, 1/kg; zero for a frozen particle (infinite mass).
+    pub inv_mass_i: Real,
+    pub inv_mass_j: Real,
+    /// Effective mass `1 / (1/m_i + 1/m_j)`: the mobile particle's mass against a frozen one.
     pub m_eff: Real,
     /// Relative velocity `v_i - v_j` at the contact point (spins included when rotating).
     pub relative_velocity: Vec3,
@@ -349,8 +350,8 @@ pub(crate) mod tests {
             radius_i: r,
             radius_j: r,
             r_eff,
-            mass_i: 2e-3,
-            mass_j: 2e-3,
+            inv_mass_i: 500.0,
+            inv_mass_j: 500.0,
             m_eff: 1e-3,
             relative_velocity: Vec3::ZERO,
             normal_speed: 0.0,

@@ -214,7 +214,8 @@ impl VerletList {
     }
 }
 
-/// All pairs `i < j` (with image) closer than `r_i + r_j + extra`, sorted by `(i, j, image)`.
+/// All pairs `i < j` (with image) closer than `r_i + r_j + extra`, sorted by `(i, j, image)`,
+/// except pairs of two frozen particles.
 fn find_pairs(grid: &CellGrid, domain: &Domain, particles: &Particles, extra: Real) -> Vec<Pair> {
     let positions = &particles.position;
     let radii = &particles.radius;
@@ -222,6 +223,7 @@ fn find_pairs(grid: &CellGrid, domain: &Domain, particles: &Particles, extra: Re
         .into_par_iter()
         .map(|i| {
             let mut found = Vec::new();
+            let frozen_i = particles.is_frozen(i);
             let home = grid.cell_coords(positions[i]);
             for dz in -1i32..=1 {
                 for dy in -1i32..=1 {
@@ -232,7 +234,8 @@ fn find_pairs(grid: &CellGrid, domain: &Domain, particles: &Particles, extra: Re
                         };
                         let shift = domain.image_shift(image);
                         for &j in grid.particles_in(cell) {
-                            if (j as usize) <= i {
+                            // Two frozen particles never interact (neither moves).
+                            if (j as usize) <= i || (frozen_i && particles.is_frozen(j as usize)) {
                                 continue;
                             }
                             let reach = radii[i] + radii[j as usize] + extra;
@@ -281,7 +284,8 @@ fn neighbour_cell(
     Some((grid.linear(cell), Domain::image_index(image)))
 }
 
-/// Reference answer for tests: every pair `i < j` over all images within `r_i + r_j + extra`.
+/// Reference answer for tests: every pair `i < j` over all images within `r_i + r_j + extra`,
+/// except pairs of two frozen particles.
 pub fn brute_force_pairs(particles: &Particles, domain: &Domain, extra: Real) -> Vec<Pair> {
     let mut pairs = Vec::new();
     let range = |axis: usize| if domain.periodic[axis] { -1..=1 } else { 0..=0 };
@@ -289,6 +293,9 @@ pub fn brute_force_pairs(particles: &Particles, domain: &Domain, extra: Real) ->
     let positions: Vec<Vec3> = particles.position.iter().map(|&p| domain.wrap(p)).collect();
     for i in 0..n {
         for j in i + 1..n {
+            if particles.is_frozen(i) && particles.is_frozen(j) {
+                continue;
+            }
             for a in range(0) {
                 for b in range(1) {
                     for c in range(2) {

@@ -20,7 +20,7 @@ use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
 use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, SdfGrid};
 use crate::guard::{GuardKind, GuardPeaks, GuardSettings, GuardTrip};
-use crate::insertion::{insert_random_where, InsertionFailed};
+use crate::insertion::{insert_random_where, lattice_sites, InsertionFailed};
 use crate::io::{vtk::VtkSeries, write_atomic};
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
@@ -52,6 +52,13 @@ pub enum RunError {
         file: String,
         index: usize,
         source: InsertionFailed,
+    },
+    #[error("{file}: insert[{index}]: the lattice site {site:?} overlaps particle {id} of an earlier insertion; move the lattice's box or the other insertion")]
+    LatticeOverlap {
+        file: String,
+        index: usize,
+        site: [Real; 3],
+        id: u32,
     },
     #[error("{file}: contact: the combination damping/tangential/rolling/cohesion = {combination} is not compiled; supported: {supported}")]
     Unsupported {
@@ -285,11 +292,13 @@ pub fn initial_particles(
         let species = &scene.species[ins.species];
         let radius = species.radius();
         let count = match ins.amount {
-            InsertAmount::Count(n) => n,
-            InsertAmount::SolidVolume(v) => (v
-                / (std::f64::consts::PI / 6.0 * species.diameter.powi(3)))
-            .round()
-            .max(1.0) as u64,
+            InsertAmount::Count(n) => Some(n),
+            InsertAmount::SolidVolume(v) => Some(
+                (v / (std::f64::consts::PI / 6.0 * species.diameter.powi(3)))
+                    .round()
+                    .max(1.0) as u64,
+            ),
+            InsertAmount::Lattice(_) => None,
         };
         let region = match &ins.mesh {
             None => None,
@@ -313,25 +322,49 @@ pub fn initial_particles(
                 .all(|b| b.query(p, radius).is_none_or(|(d, _)| d > radius))
         };
         let first = particles.len();
-        insert_random_where(
-            &mut particles,
-            ins.species as u16,
-            radius,
-            species.mass(),
-            ins.lo,
-            ins.hi,
-            count,
-            ins.seed,
-            ins.overlap,
-            accept,
-        )
-        .map_err(|source| RunError::Insertion {
-            file: file.clone(),
-            index,
-            source,
-        })?;
+        match (count, &ins.amount) {
+            (Some(count), _) => insert_random_where(
+                &mut particles,
+                ins.species as u16,
+                radius,
+                species.mass(),
+                ins.lo,
+                ins.hi,
+                count,
+                ins.seed,
+                ins.overlap,
+                accept,
+            )
+            .map_err(|source| RunError::Insertion {
+                file: file.clone(),
+                index,
+                source,
+            })?,
+            (None, InsertAmount::Lattice(lattice)) => {
+                let sites = lattice_sites(lattice, ins.lo, ins.hi, radius);
+                for p in sites.into_iter().filter(|&p| accept(p)) {
+                    if let Some(k) = (0..first).find(|&k| {
+                        (particles.position[k] - p).length() < particles.radius[k] + radius
+                    }) {
+                        return Err(RunError::LatticeOverlap {
+                            file: file.clone(),
+                            index,
+                            site: p.to_array(),
+                            id: particles.id[k],
+                        });
+                    }
+                    particles.push(ins.species as u16, p, radius, species.mass());
+                }
+            }
+            (None, _) => unreachable!("only a lattice has no count"),
+        }
         for v in &mut particles.velocity[first..] {
             *v = ins.velocity;
+        }
+        if species.frozen {
+            for k in first..particles.len() {
+                particles.freeze(k);
+            }
         }
     }
     Ok(particles)
@@ -594,7 +627,7 @@ fn execute<L: PairLaw, W: WallLaw>(
             if world.time + 0.5 * dt >= next_row {
                 next_row += scene.output.timeseries_interval;
                 let ke = world.kinetic_energy();
-                let mass = world.particles.total_mass();
+                let mass = world.particles.mobile_mass();
                 let profile = heap_profile(&world);
                 let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
                 let wall_height = profile.as_ref().map(|p| p.wall_height());

@@ -20,6 +20,10 @@ pub struct Species {
     pub name: String,
     pub diameter: Real,
     pub density: Real,
+    /// Particles of a frozen species never move (LIGGGHTS/LAMMPS `fix freeze`): they are
+    /// not integrated, act with infinite mass in their contacts, and pairs of two frozen
+    /// particles are never listed.
+    pub frozen: bool,
 }
 
 impl Species {
@@ -121,6 +125,29 @@ pub enum InsertAmount {
     /// Total solid volume, m^3: the count follows from the particle size, so coarse-graining
     /// keeps the mass.
     SolidVolume(Real),
+    /// Every site of a lattice inside the box (and within `radius`, if given).
+    Lattice(Lattice),
+}
+
+/// `lattice = "cubic" | "hexagonal"`: hexagonal layers (close-packed rows in x, rows
+/// `spacing sqrt(3)/2` apart in y, every other row shifted by half a spacing) stacked
+/// `spacing` apart in z.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LatticeKind {
+    Cubic,
+    Hexagonal,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lattice {
+    pub kind: LatticeKind,
+    /// Distance between nearest sites, m.
+    pub spacing: Real,
+    /// A site of the lattice; sites are kept where the whole sphere lies inside the box.
+    /// Default: the box corner `lo` plus one particle radius.
+    pub origin: Option<Vec3>,
+    /// Keep only sites within this distance of `origin` in the x-y plane (a disk), m.
+    pub radius: Option<Real>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

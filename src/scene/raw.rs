@@ -102,6 +102,8 @@ pub struct RawSpecies {
     pub name: String,
     pub diameter: f64,
     pub density: f64,
+    #[serde(default)]
+    pub frozen: bool,
 }
 
 #[derive(Debug, Deserialize)]
@@ -176,6 +178,10 @@ pub struct RawInsertion {
     pub mesh: Option<String>,
     pub velocity: Option<[f64; 3]>,
     pub overlap: Option<f64>,
+    pub lattice: Option<String>,
+    pub spacing: Option<f64>,
+    pub origin: Option<[f64; 3]>,
+    pub radius: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -104,6 +104,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
             name: s.name.clone(),
             diameter,
             density,
+            frozen: s.frozen,
         });
     }
 
@@ -321,16 +322,74 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 ));
             }
         }
-        let amount = match (ins.count, ins.solid_volume) {
-            (Some(n), None) if n > 0 => InsertAmount::Count(n),
-            (None, Some(v)) => {
+        let lattice_only = [
+            ("spacing", ins.spacing.is_some()),
+            ("origin", ins.origin.is_some()),
+            ("radius", ins.radius.is_some()),
+        ];
+        let amount = match (&ins.lattice, ins.count, ins.solid_volume) {
+            (Some(kind), None, None) => {
+                let kind = match kind.as_str() {
+                    "cubic" => LatticeKind::Cubic,
+                    "hexagonal" => LatticeKind::Hexagonal,
+                    other => {
+                        return Err(c.invalid(
+                            format!("insert[{k}].lattice"),
+                            other,
+                            "\"cubic\" or \"hexagonal\"",
+                        ))
+                    }
+                };
+                let spacing = ins.spacing.ok_or_else(|| {
+                    c.invalid(
+                        format!("insert[{k}].spacing"),
+                        "missing",
+                        "the distance between nearest lattice sites, m (at least the diameter)",
+                    )
+                })?;
+                let diameter = species[species_index].diameter;
+                if !(spacing >= diameter * (1.0 - 1e-9)) || !spacing.is_finite() {
+                    return Err(c.invalid(
+                        format!("insert[{k}].spacing"),
+                        spacing,
+                        format!("at least the species' diameter, {diameter} m, so that no two particles overlap"),
+                    ));
+                }
+                InsertAmount::Lattice(Lattice {
+                    kind,
+                    spacing,
+                    origin: ins
+                        .origin
+                        .map(|o| c.vector(&format!("insert[{k}].origin"), o))
+                        .transpose()?,
+                    radius: ins
+                        .radius
+                        .map(|r| c.positive(&format!("insert[{k}].radius"), r))
+                        .transpose()?,
+                })
+            }
+            (Some(_), _, _) => return Err(c.invalid(
+                format!("insert[{k}]"),
+                "lattice with count or solid_volume",
+                "a lattice insertion fills every site in the box: leave out count and solid_volume",
+            )),
+            (None, _, _) if lattice_only.iter().any(|(_, given)| *given) => {
+                let (field, _) = lattice_only.iter().find(|(_, given)| *given).unwrap();
+                return Err(c.invalid(
+                    format!("insert[{k}].{field}"),
+                    "given without lattice",
+                    "only with lattice = \"cubic\" or \"hexagonal\"",
+                ));
+            }
+            (None, Some(n), None) if n > 0 => InsertAmount::Count(n),
+            (None, None, Some(v)) => {
                 InsertAmount::SolidVolume(c.positive(&format!("insert[{k}].solid_volume"), v)?)
             }
             _ => {
                 return Err(c.invalid(
                     format!("insert[{k}]"),
                     "count and solid_volume",
-                    "exactly one of count (> 0) or solid_volume (m^3)",
+                    "exactly one of count (> 0), solid_volume (m^3) or lattice",
                 ))
             }
         };

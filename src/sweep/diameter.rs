@@ -85,8 +85,14 @@ pub fn scale_to_diameter(scene: &Scene, diameter: Real) -> Result<Scene, String>
     for ins in &mut out.insertions {
         ins.lo *= s;
         ins.hi *= s;
-        if let InsertAmount::SolidVolume(v) = &mut ins.amount {
-            *v *= s * s * s;
+        match &mut ins.amount {
+            InsertAmount::SolidVolume(v) => *v *= s * s * s,
+            InsertAmount::Lattice(lattice) => {
+                lattice.spacing *= s;
+                lattice.origin = lattice.origin.map(|o| o * s);
+                lattice.radius = lattice.radius.map(|r| r * s);
+            }
+            InsertAmount::Count(_) => {}
         }
     }
     for (lo, hi) in &mut out.deletions {

@@ -354,3 +354,31 @@ fn one_and_two_threads_give_bitwise_identical_positions() {
         );
     }
 }
+
+#[test]
+fn a_frozen_particle_stays_put_and_acts_with_infinite_mass() {
+    // Against a frozen partner the contact's effective mass is the mobile particle's mass
+    // (LIGGGHTS/LAMMPS `fix freeze`), so the damping ratio is gamma / (2 sqrt(k m)).
+    let coke = Coke::at(1.0);
+    let m_eff = coke.mass();
+    let zeta = coke.gamma_n / (2.0 * (coke.wca.contact_stiffness() * m_eff).sqrt());
+    let predicted = linear_restitution(zeta);
+    let dt = coke.pair_period() / 200.0;
+    let mut world = binary_collision(&coke, 0.1, 0.0, dt);
+    world.particles.freeze(1);
+    world.particles.velocity[0] = Vec3::new(0.1, 0.0, 0.0);
+    let frozen_at = world.particles.position[1];
+    let (_, relative) = collide(&mut world, coke.diameter());
+    let e = -relative.x / 0.1;
+    assert!(
+        (e / predicted - 1.0).abs() < 2e-3,
+        "e = {e}, predicted {predicted}"
+    );
+    let k = world.particles.id.iter().position(|&id| id == 1).unwrap();
+    assert_eq!(world.particles.position[k], frozen_at);
+    assert_eq!(world.particles.velocity[k], Vec3::ZERO);
+    // Two frozen particles are never listed.
+    world.particles.freeze(0);
+    world.rebuild();
+    assert!(world.pairs().is_empty());
+}

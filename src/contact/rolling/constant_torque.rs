@@ -44,8 +44,8 @@ impl RollingModel for ConstantTorque {
         }
         let torque =
             self.rolling_friction[contact.species_pair] * contact.r_eff * normal_force.abs();
-        let inv_inertia = 2.5 / (contact.mass_i * contact.radius_i * contact.radius_i)
-            + 2.5 / (contact.mass_j * contact.radius_j * contact.radius_j);
+        let inv_inertia = 2.5 * contact.inv_mass_i / (contact.radius_i * contact.radius_i)
+            + 2.5 * contact.inv_mass_j / (contact.radius_j * contact.radius_j);
         let no_reversal = spin / (MAX_CONTACTS * dt * inv_inertia);
         -(torque.min(no_reversal) / spin) * w
     }
