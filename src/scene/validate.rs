@@ -348,7 +348,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                     )
                 })?;
                 let diameter = species[species_index].diameter;
-                if !(spacing >= diameter * (1.0 - 1e-9)) || !spacing.is_finite() {
+                if !spacing.is_finite() || spacing < diameter * (1.0 - 1e-9) {
                     return Err(c.invalid(
                         format!("insert[{k}].spacing"),
                         spacing,
