@@ -108,6 +108,40 @@ enum Command {
         #[arg(long)]
         keep_going: bool,
     },
+    /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
+    /// starts from one state that cgdem prepares, runs the same steps, alternating (A B C,
+    /// C B A, ...) over the repetitions, at each thread (MPI rank) count. Writes
+    /// OUT/bench.json, OUT/bench_runs.csv and OUT/throughput.{png,svg,csv}, and prints the
+    /// medians, the ratios cgdem / other per repetition and the heap each code leaves.
+    Bench {
+        /// Case files (one stage with a duration), e.g. validation/bench/heap.toml.
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "reports/bench")]
+        out: PathBuf,
+        /// Codes, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "cgdem,liggghts,lammps")]
+        codes: Vec<String>,
+        /// Thread (MPI rank) counts, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Repetitions of the alternating sequence (medians over them).
+        #[arg(long, default_value_t = 5)]
+        pairs: usize,
+        /// Steps per timed run.
+        #[arg(long, default_value_t = 10_000)]
+        steps: u64,
+        /// Simulated seconds cgdem runs each case before the timed window.
+        #[arg(long, default_value_t = 0.15)]
+        prepare: f64,
+        /// Skip the untimed runs to the scene's end that compare the heaps.
+        #[arg(long)]
+        no_outcome: bool,
+        /// Time limit of one reference-code run, seconds.
+        #[arg(long, default_value_t = 1800)]
+        reference_timeout: u64,
+    },
     /// Add a nightly report (a `cgdem validate` output) to the history in DIR: appends its
     /// metrics to DIR/history.json, rewrites DIR/index.html with the history table, trend
     /// plots and flags, and prints the metrics that moved beyond tolerance since the
@@ -417,6 +451,56 @@ fn main() -> ExitCode {
             }
         },
         Command::Geometry { command } => geometry(command),
+        Command::Bench {
+            cases,
+            out,
+            codes,
+            threads,
+            pairs,
+            steps,
+            prepare,
+            no_outcome,
+            reference_timeout,
+        } => {
+            let mut parsed = Vec::new();
+            for name in &codes {
+                parsed.push(match name.as_str() {
+                    "cgdem" => cgdem::harness::suite::Code::Cgdem,
+                    "liggghts" => cgdem::harness::suite::Code::Liggghts,
+                    "lammps" => cgdem::harness::suite::Code::Lammps,
+                    other => {
+                        eprintln!("error: --codes: `{other}` is not a code; allowed: cgdem, liggghts, lammps");
+                        return ExitCode::FAILURE;
+                    }
+                });
+            }
+            if threads.contains(&0) || pairs == 0 || steps == 0 || prepare.is_nan() || prepare < 0.0 {
+                eprintln!("error: --threads, --pairs and --steps must be at least 1 and --prepare at least 0");
+                return ExitCode::FAILURE;
+            }
+            let options = cgdem::harness::bench::BenchOptions {
+                cases,
+                out: out.clone(),
+                codes: parsed,
+                threads,
+                pairs,
+                steps,
+                prepare_s: prepare,
+                outcome: !no_outcome,
+                timeout: std::time::Duration::from_secs(reference_timeout),
+            };
+            match cgdem::harness::bench::bench(&options) {
+                Ok(report) => {
+                    print!("{}", cgdem::harness::bench::format_report(&report));
+                    println!("report in {}", out.join("bench.json").display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::History {
             dir,
             add,
@@ -515,6 +599,7 @@ fn main() -> ExitCode {
                             quiet,
                             force_dt,
                             keep_going,
+                            ..Default::default()
                         };
                         run(&scene, &options)
                             .map(|summary| (summary, out_dir))

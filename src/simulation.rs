@@ -22,6 +22,20 @@ use crate::walls::{WallContact, WallLaw, WallParticle, WallSet};
 
 const CHUNK: usize = 512;
 
+/// Bytes the world holds, from its arrays' capacities (what `cgdem bench` reports).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct MemoryUse {
+    pub particles: usize,
+    /// Per-particle arrays: state, forces, wall history, body loads, list offsets.
+    pub particle_bytes: usize,
+    pub pairs: usize,
+    /// Per-pair arrays: the list, its reverse index, the contact history and the results.
+    pub pair_bytes: usize,
+    /// Contact-history entries (one per listed pair: the store is rebuilt with the list,
+    /// so it never outgrows it).
+    pub history_entries: usize,
+}
+
 /// Neighbour-list settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NeighborSettings {
@@ -189,6 +203,37 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Per-pair contact history, parallel to `pairs()`.
     pub fn history(&self) -> &[L::History] {
         &self.history
+    }
+
+    /// The memory the world's arrays hold now.
+    pub fn memory_use(&self) -> MemoryUse {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let p = &self.particles;
+        let mut particle_bytes = bytes(&p.id)
+            + bytes(&p.species)
+            + bytes(&p.position)
+            + bytes(&p.velocity)
+            + bytes(&p.force)
+            + bytes(&p.radius)
+            + bytes(&p.mass)
+            + bytes(&p.inv_mass)
+            + bytes(&self.wall_history)
+            + bytes(&self.body_loads)
+            + bytes(&self.old_force)
+            + bytes(&self.old_torque)
+            + self.list.particle_bytes();
+        if let Some(a) = &p.angular {
+            particle_bytes += bytes(&a.omega) + bytes(&a.torque) + bytes(&a.inv_inertia);
+        }
+        MemoryUse {
+            particles: p.len(),
+            particle_bytes,
+            pairs: self.list.pairs.len(),
+            pair_bytes: self.list.pair_bytes() + bytes(&self.history) + bytes(&self.pair_result),
+            history_entries: self.history.len(),
+        }
     }
 
     pub fn list_builds(&self) -> u64 {

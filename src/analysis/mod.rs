@@ -2,6 +2,7 @@
 //! go through the same functions (heap profiles and repose angles; porosity, distance
 //! transforms and pore-size distributions of packings).
 
+pub mod conical_heap;
 pub mod conveying;
 pub mod distance_transform;
 pub mod heap;

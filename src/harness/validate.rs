@@ -253,6 +253,14 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 }
 
 fn provenance(suite: &Suite, options: &ValidateOptions) -> BTreeMap<String, String> {
+    let mut p = machine_provenance();
+    p.insert("suite file".into(), suite.source.display().to_string());
+    p.insert("output".into(), options.out.display().to_string());
+    p
+}
+
+/// cgdem's version and commit, the machine, the date, the command line and the threads.
+pub(crate) fn machine_provenance() -> BTreeMap<String, String> {
     let command = |program: &str, args: &[&str]| -> String {
         std::process::Command::new(program)
             .args(args)
@@ -284,8 +292,6 @@ fn provenance(suite: &Suite, options: &ValidateOptions) -> BTreeMap<String, Stri
         "command".into(),
         std::env::args().collect::<Vec<_>>().join(" "),
     );
-    p.insert("suite file".into(), suite.source.display().to_string());
-    p.insert("output".into(), options.out.display().to_string());
     p.insert("threads".into(), rayon::current_num_threads().to_string());
     p
 }
@@ -401,6 +407,7 @@ fn run_cgdem(
         quiet: options.quiet,
         force_dt: false,
         keep_going: options.keep_going,
+        ..Default::default()
     };
     run(&coarse, &run_options)
         .map(|_| false)

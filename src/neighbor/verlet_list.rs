@@ -117,6 +117,18 @@ impl VerletList {
         permutation
     }
 
+    /// Bytes of the per-particle arrays (offsets, reference positions).
+    pub fn particle_bytes(&self) -> usize {
+        (self.out_start.capacity() + self.in_start.capacity()) * std::mem::size_of::<u32>()
+            + self.reference.capacity() * std::mem::size_of::<Vec3>()
+    }
+
+    /// Bytes of the per-pair arrays (pairs and the reverse index).
+    pub fn pair_bytes(&self) -> usize {
+        self.pairs.capacity() * std::mem::size_of::<Pair>()
+            + self.in_pairs.capacity() * std::mem::size_of::<u32>()
+    }
+
     fn index_pairs(&mut self, n: usize) {
         let mut out_start = vec![0u32; n + 1];
         let mut in_start = vec![0u32; n + 1];

@@ -307,6 +307,7 @@ mod tests {
             quiet: true,
             force_dt: false,
             keep_going: false,
+            ..Default::default()
         };
         let message = run_hertz(&scene, &h, &options).unwrap_err().to_string();
         assert!(

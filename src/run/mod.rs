@@ -29,13 +29,18 @@ use crate::simulation::{NeighborSettings, World};
 use crate::timestep::{self, LinearContact, Timescales, UnstableTimeStep};
 use crate::walls::{Wall, WallLaw, WallSet, WcaWall};
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct RunOptions {
     pub out_dir: PathBuf,
     pub quiet: bool,
     pub force_dt: bool,
     /// A guard that fires only warns (once per guard) instead of stopping the run.
     pub keep_going: bool,
+    /// Start from these particles instead of the scene's insertions (as LAMMPS `read_data`
+    /// after `write_data`): the benchmark starts every code from one prepared state.
+    pub initial_state: Option<Particles>,
+    /// Keep the particles at the end of the run in [`RunSummary::final_state`].
+    pub keep_final_state: bool,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -176,6 +181,11 @@ pub struct RunSummary {
     /// `Scene::digest` of the (coarse-grained) scene this run simulated.
     pub scene_digest: String,
     pub cgdem_version: String,
+    /// The particles at the end (with `RunOptions::keep_final_state`).
+    #[serde(skip)]
+    pub final_state: Option<Particles>,
+    /// The solver's arrays at the end (none for reference codes).
+    pub memory: Option<crate::simulation::MemoryUse>,
 }
 
 /// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.
@@ -436,7 +446,10 @@ fn execute<L: PairLaw, W: WallLaw>(
             scene.source.display()
         )));
     }
-    let particles = initial_particles(scene, L::NEEDS_ROTATION, &bodies)?;
+    let particles = match &options.initial_state {
+        Some(state) => state.clone(),
+        None => initial_particles(scene, L::NEEDS_ROTATION, &bodies)?,
+    };
     let n_inserted = particles.len();
     let neighbor = NeighborSettings {
         skin: scene.skin_fraction * scene.max_diameter(),
@@ -853,6 +866,8 @@ fn execute<L: PairLaw, W: WallLaw>(
         scene_file: file.clone(),
         scene_digest: scene.digest(),
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
+        final_state: options.keep_final_state.then(|| world.particles.clone()),
+        memory: Some(world.memory_use()),
     };
     let path = out.join("summary.json");
     let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&path, e))?;

@@ -248,6 +248,7 @@ pub fn diameter_sweep(
             quiet,
             force_dt,
             keep_going,
+            ..Default::default()
         };
         let started = Instant::now();
         let summary = run(s, &options).map_err(|e| e.to_string())?;

@@ -78,6 +78,32 @@ pub(crate) fn boundary_line(scene: &Scene) -> String {
     format!("boundary        {} {} {}\n", flag(0), flag(1), flag(2))
 }
 
+/// Frozen species (LAMMPS and LIGGGHTS alike): the `nve/sphere` fix's group, and the lines
+/// that freeze the rest (`fix freeze`, which also makes pair styles use the mobile partner's
+/// mass as the effective mass) and exclude frozen-frozen pairs from the neighbour list, as
+/// cgdem does. Without frozen species: `all` and nothing.
+pub(crate) fn frozen_lines(scene: &Scene) -> (&'static str, String) {
+    let frozen: Vec<usize> = (0..scene.species.len())
+        .filter(|&k| scene.species[k].frozen)
+        .map(|k| k + 1)
+        .collect();
+    if frozen.is_empty() {
+        return ("all", String::new());
+    }
+    let types: Vec<String> = frozen.iter().map(|t| t.to_string()).collect();
+    let mut lines = format!("group           frozen type {}
+", types.join(" "));
+    lines += "group           mobile subtract all frozen
+";
+    for (k, a) in frozen.iter().enumerate() {
+        for b in &frozen[k..] {
+            lines += &format!("neigh_modify    exclude type {a} {b}\n");
+        }
+    }
+    lines += "fix             freeze frozen freeze\n";
+    ("mobile", lines)
+}
+
 pub(crate) fn g(x: Real) -> String {
     format!("{x:.17e}")
 }

@@ -17,7 +17,7 @@
 use std::fmt::Write as _;
 
 use super::deck::{
-    boundary_line, data_file, g, Deck, DeckError, DeckPlan, DATA_FILE, TRAJECTORY_FILE,
+    boundary_line, data_file, frozen_lines, g, Deck, DeckError, DeckPlan, DATA_FILE, TRAJECTORY_FILE,
 };
 use crate::contact::damping::restitution_beta;
 use crate::contact::normal::{Hertz, Material};
@@ -215,7 +215,9 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         g(scene.skin_fraction * scene.max_diameter())
     );
     d += "neigh_modify    every 1 delay 0 check yes\n";
-    d += "fix             integ all nve/sphere\n";
+    let (integrated, freeze) = frozen_lines(scene);
+    d += &freeze;
+    let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
     if scene.gravity.length() > 0.0 {
         let dir = scene.gravity / scene.gravity.length();
         let _ = writeln!(

@@ -343,6 +343,8 @@ pub fn postprocess(
         scene_file: scene.source.display().to_string(),
         scene_digest: scene.digest(),
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
+        final_state: None,
+        memory: None,
     })
 }
 

@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::harness::lammps::deck::{
-    boundary_line, data_file, g, Deck, DeckError, DeckPlan, DATA_FILE,
+    boundary_line, data_file, frozen_lines, g, Deck, DeckError, DeckPlan, DATA_FILE,
 };
 use crate::harness::lammps::hertz::{hertz_settings, material, wall_axis, wall_material};
 use crate::math::Real;
@@ -92,6 +92,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         g(scene.skin_fraction * scene.max_diameter())
     );
     d += "neigh_modify    delay 0\n";
+    let (integrated, freeze) = frozen_lines(scene);
+    d += &freeze;
     let _ = writeln!(
         d,
         "fix             m1 all property/global youngsModulus peratomtype {}",
@@ -128,7 +130,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     );
     d += "pair_coeff      * *\n";
     let _ = writeln!(d, "timestep        {}", g(dt));
-    d += "fix             integ all nve/sphere\n";
+    let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
     if scene.gravity.length() > 0.0 {
         let dir = scene.gravity / scene.gravity.length();
         let _ = writeln!(
