@@ -474,7 +474,8 @@ fn main() -> ExitCode {
                     }
                 });
             }
-            if threads.contains(&0) || pairs == 0 || steps == 0 || prepare.is_nan() || prepare < 0.0 {
+            if threads.contains(&0) || pairs == 0 || steps == 0 || prepare.is_nan() || prepare < 0.0
+            {
                 eprintln!("error: --threads, --pairs and --steps must be at least 1 and --prepare at least 0");
                 return ExitCode::FAILURE;
             }

@@ -73,7 +73,12 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// Per particle, per planar wall (particle-major, `wall_slots()` each) contact history;
     /// zero-sized for stateless wall laws.
     wall_history: Vec<W::History>,
-    pair_result: Vec<PairResult>,
+    /// Per particle, the sum of its own pairs' forces (and torques) on it.
+    own_force: Vec<Vec3>,
+    own_torque: Vec<Vec3>,
+    /// Per listed pair, the force (and torque) on its `j` (torques empty without spin).
+    reaction_force: Vec<Vec3>,
+    reaction_torque: Vec<Vec3>,
     integrator: Integrator,
     /// PCVV's `F0`, `T0` (empty for velocity Verlet).
     old_force: Vec<Vec3>,
@@ -117,7 +122,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             list: VerletList::new(neighbor.skin),
             history: Vec::new(),
             wall_history: Vec::new(),
-            pair_result: Vec::new(),
+            own_force: Vec::new(),
+            own_torque: Vec::new(),
+            reaction_force: Vec::new(),
+            reaction_torque: Vec::new(),
             bodies: Vec::new(),
             body_loads: Vec::new(),
             delete_regions: Vec::new(),
@@ -223,6 +231,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             + bytes(&self.body_loads)
             + bytes(&self.old_force)
             + bytes(&self.old_torque)
+            + bytes(&self.own_force)
+            + bytes(&self.own_torque)
             + self.list.particle_bytes();
         if let Some(a) = &p.angular {
             particle_bytes += bytes(&a.omega) + bytes(&a.torque) + bytes(&a.inv_inertia);
@@ -231,7 +241,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             particles: p.len(),
             particle_bytes,
             pairs: self.list.pairs.len(),
-            pair_bytes: self.list.pair_bytes() + bytes(&self.history) + bytes(&self.pair_result),
+            pair_bytes: self.list.pair_bytes()
+                + bytes(&self.history)
+                + bytes(&self.reaction_force)
+                + bytes(&self.reaction_torque),
             history_entries: self.history.len(),
         }
     }
@@ -435,46 +448,60 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.history =
             self.list
                 .carry_history(&old_pairs, &old_history, wraps.as_deref(), remap.as_deref());
-        self.pair_result
-            .resize(self.list.pairs.len(), PairResult::default());
     }
 
-    /// Pair forces (each pair once, in parallel), then a per-particle gather in a fixed
-    /// order with walls and gravity. No atomics, no thread-count dependence.
+    /// Pair forces, then a per-particle gather in a fixed order with walls and gravity. No
+    /// atomics, no thread-count dependence.
+    ///
+    /// Each pair is evaluated once, by its owner `i` (the list holds `i < j`, grouped by `i`):
+    /// the owner sums its own share as it goes, and stores only what `j` receives (the
+    /// reaction force, and the torque on `j` when particles spin), which the gather adds in
+    /// list order.
     pub fn compute_forces(&mut self) {
+        let n = self.particles.len();
+        let pairs = self.list.pairs.len();
+        self.own_force.resize(n, Vec3::ZERO);
+        self.reaction_force.resize(pairs, Vec3::ZERO);
+        if Self::ROTATES {
+            self.own_torque.resize(n, Vec3::ZERO);
+            self.reaction_torque.resize(pairs, Vec3::ZERO);
+        }
         let p = &self.particles;
-        let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
-        let omega = p.angular.as_ref().map(|a| a.omega.as_slice());
-        let law = &self.law;
-        let n_species = self.n_species;
-        let dt = self.dt;
+        let pass = OwnerPass {
+            law: &self.law,
+            particles: p,
+            omega: p.angular.as_ref().map(|a| a.omega.as_slice()),
+            images: std::array::from_fn(|k| self.domain.image_shift(k as u8)),
+            n_species: self.n_species,
+            dt: self.dt,
+            pairs: &self.list.pairs,
+            out_start: &self.list.out_start,
+            rotates: Self::ROTATES,
+        };
         // The largest overlap fraction, for the overlap guard (max is exact in any order).
-        self.guard.pair_overlap = self
-            .list
-            .pairs
-            .par_iter()
-            .zip(self.history.par_iter_mut())
-            .zip(self.pair_result.par_iter_mut())
-            .with_min_len(CHUNK)
-            .map(|((pair, history), result)| {
-                let (r, overlap) =
-                    pair_force(law, p, omega, &images, n_species, *pair, history, dt);
-                *result = r;
-                overlap
-            })
-            .reduce(|| 0.0, larger);
+        self.guard.pair_overlap = pass.run(
+            0,
+            OwnerSlices {
+                own_force: &mut self.own_force,
+                own_torque: &mut self.own_torque,
+                history: &mut self.history,
+                reaction_force: &mut self.reaction_force,
+                reaction_torque: &mut self.reaction_torque,
+            },
+        );
 
         if Self::ROTATES {
             self.gather_with_torques();
             return;
         }
+        let dt = self.dt;
         let p = &mut self.particles;
-        let (list, results) = (&self.list, &self.pair_result);
+        let (list, own, reaction) = (&self.list, &self.own_force, &self.reaction_force);
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let (position, velocity, radius, mass, species) =
             (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
         let gather = |i: usize| -> (Vec3, WallParticle, Real) {
-            let mut f = mass[i] * gravity;
+            let mut f = own[i] + mass[i] * gravity;
             let particle = WallParticle {
                 species: species[i] as usize,
                 position: position[i],
@@ -484,11 +511,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             };
             let (wall_force, overlap) = walls.force_on(wall_law, &particle, dt);
             f += wall_force;
-            for k in list.out_start[i]..list.out_start[i + 1] {
-                f += results[k as usize].force_on_i;
-            }
             for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                f -= results[k as usize].force_on_i;
+                f += reaction[k as usize];
             }
             (f, particle, overlap)
         };
@@ -551,7 +575,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.wall_history.resize(n * slots, W::History::default());
         }
         let wall_history = &mut self.wall_history;
-        let (list, results, dt) = (&self.list, &self.pair_result, self.dt);
+        let (list, dt) = (&self.list, self.dt);
+        let (own_force, own_torque) = (&self.own_force, &self.own_torque);
+        let (reaction_force, reaction_torque) = (&self.reaction_force, &self.reaction_torque);
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let Particles {
             position,
@@ -574,7 +600,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .enumerate()
             .with_min_len(CHUNK)
             .map(|(i, ((force, torque), wall_history))| {
-                let mut f = mass[i] * gravity;
+                let mut f = own_force[i] + mass[i] * gravity;
                 let particle = WallParticle {
                     species: species[i] as usize,
                     position: position[i],
@@ -582,7 +608,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     radius: radius[i],
                     mass: mass[i],
                 };
-                let mut t = Vec3::ZERO;
+                let mut t = own_torque[i];
                 let overlap = if W::NEEDS_ROTATION {
                     let (wf, wt, overlap) =
                         walls.force_and_torque_on(wall_law, &particle, omega[i], wall_history, dt);
@@ -594,13 +620,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     f += wf;
                     overlap
                 };
-                for k in list.out_start[i]..list.out_start[i + 1] {
-                    f += results[k as usize].force_on_i;
-                    t += results[k as usize].torque_on_i;
-                }
                 for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                    f -= results[k as usize].force_on_i;
-                    t += results[k as usize].torque_on_j;
+                    f += reaction_force[k as usize];
+                    t += reaction_torque[k as usize];
                 }
                 *force = f;
                 *torque = t;
@@ -940,6 +962,117 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             ),
             cause,
         )
+    }
+}
+
+/// Particles per leaf of the owner pass's recursive split.
+const OWNER_LEAF: usize = 256;
+
+/// What the owner pass reads: the law, the particles and the list.
+struct OwnerPass<'a, L: PairLaw> {
+    law: &'a L,
+    particles: &'a Particles,
+    omega: Option<&'a [Vec3]>,
+    images: [Vec3; 27],
+    n_species: usize,
+    dt: Real,
+    pairs: &'a [Pair],
+    out_start: &'a [u32],
+    /// Whether torques are summed and stored (a constant of the world's laws).
+    rotates: bool,
+}
+
+/// What the owner pass writes, for the particles from `first` on and their pairs (torque
+/// slices are empty when particles do not spin).
+struct OwnerSlices<'s, H> {
+    own_force: &'s mut [Vec3],
+    own_torque: &'s mut [Vec3],
+    history: &'s mut [H],
+    reaction_force: &'s mut [Vec3],
+    reaction_torque: &'s mut [Vec3],
+}
+
+/// Splits a slice at `at`, or gives two empty slices when it is empty (unused torques).
+fn split_or_empty<T>(slice: &mut [T], at: usize) -> (&mut [T], &mut [T]) {
+    if slice.is_empty() {
+        (&mut [], &mut [])
+    } else {
+        slice.split_at_mut(at)
+    }
+}
+
+impl<L: PairLaw> OwnerPass<'_, L> {
+    /// Evaluates the pairs owned by particles `first..first + out.own_force.len()`, halving
+    /// the range in parallel down to leaves; returns the largest overlap fraction.
+    fn run(&self, first: usize, out: OwnerSlices<'_, L::History>) -> Real {
+        let n = out.own_force.len();
+        let pair_base = self.out_start[first] as usize;
+        if n > OWNER_LEAF {
+            let mid = n / 2;
+            let split = self.out_start[first + mid] as usize - pair_base;
+            let (own_force_a, own_force_b) = out.own_force.split_at_mut(mid);
+            let (own_torque_a, own_torque_b) = split_or_empty(out.own_torque, mid);
+            let (history_a, history_b) = out.history.split_at_mut(split);
+            let (reaction_force_a, reaction_force_b) = out.reaction_force.split_at_mut(split);
+            let (reaction_torque_a, reaction_torque_b) = split_or_empty(out.reaction_torque, split);
+            let (a, b) = rayon::join(
+                || {
+                    self.run(
+                        first,
+                        OwnerSlices {
+                            own_force: own_force_a,
+                            own_torque: own_torque_a,
+                            history: history_a,
+                            reaction_force: reaction_force_a,
+                            reaction_torque: reaction_torque_a,
+                        },
+                    )
+                },
+                || {
+                    self.run(
+                        first + mid,
+                        OwnerSlices {
+                            own_force: own_force_b,
+                            own_torque: own_torque_b,
+                            history: history_b,
+                            reaction_force: reaction_force_b,
+                            reaction_torque: reaction_torque_b,
+                        },
+                    )
+                },
+            );
+            return larger(a, b);
+        }
+        let mut deepest: Real = 0.0;
+        for local in 0..n {
+            let i = first + local;
+            let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
+            for k in self.out_start[i] as usize..self.out_start[i + 1] as usize {
+                let slot = k - pair_base;
+                let (result, overlap) = pair_force(
+                    self.law,
+                    self.particles,
+                    self.omega,
+                    &self.images,
+                    self.n_species,
+                    self.pairs[k],
+                    &mut out.history[slot],
+                    self.dt,
+                );
+                deepest = larger(deepest, overlap);
+                force += result.force_on_i;
+                out.reaction_force[slot] = -result.force_on_i;
+                if self.rotates {
+                    torque += result.torque_on_i;
+                    out.reaction_torque[slot] = result.torque_on_j;
+                }
+            }
+            out.own_force[local] = force;
+            if self.rotates {
+                out.own_torque[local] = torque;
+            }
+        }
+        deepest
     }
 }
 

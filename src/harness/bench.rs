@@ -183,7 +183,10 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
         }
     }
     let medians = medians(&runs);
-    let ratios = ratios(&runs, &cases.iter().map(|c| c.name.clone()).collect::<Vec<_>>());
+    let ratios = ratios(
+        &runs,
+        &cases.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
+    );
     let mut outcomes = Vec::new();
     if options.outcome {
         let threads = options.threads.iter().copied().max().unwrap_or(1);
@@ -337,11 +340,23 @@ fn run_code(
         }
         Code::Liggghts => {
             let deck = liggghts::deck::write_deck(scene, &case.state, case.dt);
-            finish_reference(deck, dir, |dir| liggghts::runner::run_deck(dir, &runner(threads, options)), liggghts::deck::LOG_FILE, &mut result);
+            finish_reference(
+                deck,
+                dir,
+                |dir| liggghts::runner::run_deck(dir, &runner(threads, options)),
+                liggghts::deck::LOG_FILE,
+                &mut result,
+            );
         }
         Code::Lammps => {
             let deck = lammps::write_hertz_deck(scene, &case.state, case.dt);
-            finish_reference(deck, dir, |dir| lammps::run_deck(dir, &runner(threads, options)), lammps::runner::LOG_FILE, &mut result);
+            finish_reference(
+                deck,
+                dir,
+                |dir| lammps::run_deck(dir, &runner(threads, options)),
+                lammps::runner::LOG_FILE,
+                &mut result,
+            );
         }
     }
     (result, None)
@@ -415,12 +430,17 @@ fn finish_reference(
             result.status = "skipped".into();
             result.reason = Some(format!("{reason}; install with `{install_hint}`"));
         }
-        RunStatus::Failed { exit_code, log_tail } => {
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => {
             *result = RunResult::failed(format!("exit code {exit_code:?}; log tail:\n{log_tail}"));
         }
         RunStatus::TimedOut { after_s, log_tail } => {
             result.status = "timed out".into();
-            result.reason = Some(format!("killed after {after_s:.0} s; log tail:\n{log_tail}"));
+            result.reason = Some(format!(
+                "killed after {after_s:.0} s; log tail:\n{log_tail}"
+            ));
         }
     }
 }
@@ -442,7 +462,8 @@ pub fn log_timing(log: &str) -> Option<LogTiming> {
     let mut memory_per_rank: Option<Real> = None;
     let mut timing: Option<LogTiming> = None;
     for line in log.lines() {
-        if line.starts_with("Memory usage per processor") || line.starts_with("Per MPI rank memory") {
+        if line.starts_with("Memory usage per processor") || line.starts_with("Per MPI rank memory")
+        {
             // LAMMPS: `... (min/avg/max) = a | b | c Mbytes`; LIGGGHTS: `Memory usage per
             // processor = a Mbytes`.
             let numbers: Vec<Real> = line
@@ -459,10 +480,14 @@ pub fn log_timing(log: &str) -> Option<LogTiming> {
         if let Some(rest) = line.strip_prefix("Loop time of ") {
             let f: Vec<&str> = rest.split_whitespace().collect();
             // T on P procs for N steps with M atoms
-            if let (Some(t), Some(p), Some(n), Some(m)) = (f.first(), f.get(2), f.get(5), f.get(8)) {
-                if let (Ok(t), Ok(p), Ok(n), Ok(m)) =
-                    (t.parse::<Real>(), p.parse::<usize>(), n.parse::<u64>(), m.parse::<usize>())
-                {
+            if let (Some(t), Some(p), Some(n), Some(m)) = (f.first(), f.get(2), f.get(5), f.get(8))
+            {
+                if let (Ok(t), Ok(p), Ok(n), Ok(m)) = (
+                    t.parse::<Real>(),
+                    p.parse::<usize>(),
+                    n.parse::<u64>(),
+                    m.parse::<usize>(),
+                ) {
                     timing = Some(LogTiming {
                         loop_s: t,
                         ranks: p,
@@ -521,7 +546,12 @@ fn timed_run(
     )
 }
 
-fn outcome_run(case: &PreparedCase, code: Code, threads: usize, options: &BenchOptions) -> BenchOutcome {
+fn outcome_run(
+    case: &PreparedCase,
+    code: Code,
+    threads: usize,
+    options: &BenchOptions,
+) -> BenchOutcome {
     let Some(full) = &case.full else {
         return BenchOutcome {
             case: case.name.clone(),
@@ -531,7 +561,10 @@ fn outcome_run(case: &PreparedCase, code: Code, threads: usize, options: &BenchO
             heap: None,
         };
     };
-    let dir = options.out.join(&case.name).join(format!("{}-outcome", code.name()));
+    let dir = options
+        .out
+        .join(&case.name)
+        .join(format!("{}-outcome", code.name()));
     let (result, summary) = run_code(case, full, code, threads, &dir, options);
     let simulated_s = match full.stages[0].end {
         StageEnd::Duration(d) => d,
@@ -543,7 +576,14 @@ fn outcome_run(case: &PreparedCase, code: Code, threads: usize, options: &BenchO
     let ring = full.max_diameter();
     let heap = match (code, &summary) {
         (Code::Cgdem, Some(s)) => s.final_state.as_ref().and_then(|p| {
-            conical_heap(&p.position, &p.radius, |k| !p.is_frozen(k), axis, floor_z, ring)
+            conical_heap(
+                &p.position,
+                &p.radius,
+                |k| !p.is_frozen(k),
+                axis,
+                floor_z,
+                ring,
+            )
         }),
         (Code::Liggghts | Code::Lammps, _) if result.status == "completed" => {
             let path = dir.join(lammps::deck::TRAJECTORY_FILE);
@@ -660,7 +700,9 @@ fn medians(runs: &[BenchRun]) -> Vec<BenchMedian> {
 fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
     let speed = |case: &str, code: Code, threads: usize, rep: usize| {
         runs.iter()
-            .find(|r| r.case == case && r.code == code && r.threads == threads && r.repetition == rep)
+            .find(|r| {
+                r.case == case && r.code == code && r.threads == threads && r.repetition == rep
+            })
             .and_then(|r| r.particle_steps_per_s)
     };
     let mut keys: Vec<(usize, usize)> = runs.iter().map(|r| (r.threads, r.repetition)).collect();
@@ -682,26 +724,46 @@ fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
         }
     };
     for &threads in &thread_counts {
-        let reps: Vec<usize> = keys.iter().filter(|k| k.0 == threads).map(|k| k.1).collect();
+        let reps: Vec<usize> = keys
+            .iter()
+            .filter(|k| k.0 == threads)
+            .map(|k| k.1)
+            .collect();
         for case in cases {
             for other in [Code::Liggghts, Code::Lammps] {
                 let values: Vec<Real> = reps
                     .iter()
                     .filter_map(|&rep| {
-                        Some(speed(case, Code::Cgdem, threads, rep)? / speed(case, other, threads, rep)?)
+                        Some(
+                            speed(case, Code::Cgdem, threads, rep)?
+                                / speed(case, other, threads, rep)?,
+                        )
                     })
                     .collect();
-                push(format!("{case} cgdem"), format!("{case} {}", other.name()), threads, values);
+                push(
+                    format!("{case} cgdem"),
+                    format!("{case} {}", other.name()),
+                    threads,
+                    values,
+                );
             }
         }
         for case in cases.iter().skip(1) {
             let values: Vec<Real> = reps
                 .iter()
                 .filter_map(|&rep| {
-                    Some(speed(case, Code::Cgdem, threads, rep)? / speed(&cases[0], Code::Cgdem, threads, rep)?)
+                    Some(
+                        speed(case, Code::Cgdem, threads, rep)?
+                            / speed(&cases[0], Code::Cgdem, threads, rep)?,
+                    )
                 })
                 .collect();
-            push(format!("{case} cgdem"), format!("{} cgdem", cases[0]), threads, values);
+            push(
+                format!("{case} cgdem"),
+                format!("{} cgdem", cases[0]),
+                threads,
+                values,
+            );
         }
     }
     out
@@ -753,7 +815,12 @@ fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
             "throughput",
             &format!(
                 "Throughput, median of {} alternating runs of {} steps (error bar: half the range)",
-                report.runs.iter().map(|r| r.repetition + 1).max().unwrap_or(0),
+                report
+                    .runs
+                    .iter()
+                    .map(|r| r.repetition + 1)
+                    .max()
+                    .unwrap_or(0),
                 report.steps
             ),
             "million particle-steps per second",
@@ -778,7 +845,8 @@ pub fn format_report(report: &BenchReport) -> String {
             m.median_particle_steps_per_s,
             m.min_particle_steps_per_s,
             m.max_particle_steps_per_s,
-            m.parallel_efficiency.map_or("-".into(), |e| format!("{:.0}%", 100.0 * e))
+            m.parallel_efficiency
+                .map_or("-".into(), |e| format!("{:.0}%", 100.0 * e))
         );
     }
     s += "\nratio | threads | median | per repetition\n";
@@ -789,7 +857,11 @@ pub fn format_report(report: &BenchReport) -> String {
             r.denominator,
             r.threads,
             r.median,
-            r.per_repetition.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(" ")
+            r.per_repetition
+                .iter()
+                .map(|v| format!("{v:.2}"))
+                .collect::<Vec<_>>()
+                .join(" ")
         );
     }
     if !report.outcomes.is_empty() {
@@ -828,13 +900,19 @@ mod tests {
     fn reads_loop_time_and_memory_from_lammps_and_liggghts_logs() {
         let lammps = "Per MPI rank memory allocation (min/avg/max) = 12.5 | 13.0 | 13.5 Mbytes\nStep Atoms\nLoop time of 20.5 on 2 procs for 10000 steps with 11103 atoms\n";
         let t = log_timing(lammps).unwrap();
-        assert_eq!((t.loop_s, t.ranks, t.steps, t.atoms), (20.5, 2, 10000, 11103));
+        assert_eq!(
+            (t.loop_s, t.ranks, t.steps, t.atoms),
+            (20.5, 2, 10000, 11103)
+        );
         assert_eq!(t.memory_mb, Some(26.0));
         let liggghts = "Memory usage per processor = 9.5 Mbytes\nLoop time of 41 on 1 procs for 10000 steps with 11103 atoms\n";
         let t = log_timing(liggghts).unwrap();
         assert_eq!((t.loop_s, t.ranks, t.memory_mb), (41.0, 1, Some(9.5)));
         // A truncated log (killed before the loop ended) has no timing.
-        assert!(log_timing("Memory usage per processor = 9.5 Mbytes\nStep Atoms\n100 11103\n").is_none());
+        assert!(
+            log_timing("Memory usage per processor = 9.5 Mbytes\nStep Atoms\n100 11103\n")
+                .is_none()
+        );
     }
 
     #[test]

@@ -91,8 +91,11 @@ pub(crate) fn frozen_lines(scene: &Scene) -> (&'static str, String) {
         return ("all", String::new());
     }
     let types: Vec<String> = frozen.iter().map(|t| t.to_string()).collect();
-    let mut lines = format!("group           frozen type {}
-", types.join(" "));
+    let mut lines = format!(
+        "group           frozen type {}
+",
+        types.join(" ")
+    );
     lines += "group           mobile subtract all frozen
 ";
     for (k, a) in frozen.iter().enumerate() {

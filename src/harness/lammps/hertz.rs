@@ -17,7 +17,8 @@
 use std::fmt::Write as _;
 
 use super::deck::{
-    boundary_line, data_file, frozen_lines, g, Deck, DeckError, DeckPlan, DATA_FILE, TRAJECTORY_FILE,
+    boundary_line, data_file, frozen_lines, g, Deck, DeckError, DeckPlan, DATA_FILE,
+    TRAJECTORY_FILE,
 };
 use crate::contact::damping::restitution_beta;
 use crate::contact::normal::{Hertz, Material};
