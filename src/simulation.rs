@@ -1043,23 +1043,36 @@ impl<L: PairLaw> OwnerPass<'_, L> {
             );
             return larger(a, b);
         }
+        let p = self.particles;
         let mut deepest: Real = 0.0;
         for local in 0..n {
             let i = first + local;
+            let owner = Owner {
+                position: p.position[i],
+                velocity: p.velocity[i],
+                omega: self.omega.map_or(Vec3::ZERO, |w| w[i]),
+                radius: p.radius[i],
+                inv_mass: p.inv_mass[i],
+                species_row: p.species[i] as usize * self.n_species,
+            };
             let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
             for k in self.out_start[i] as usize..self.out_start[i + 1] as usize {
                 let slot = k - pair_base;
-                let (result, overlap) = pair_force(
+                let (result, overlap, smaller_radius) = pair_force(
                     self.law,
-                    self.particles,
+                    p,
                     self.omega,
                     &self.images,
-                    self.n_species,
+                    &owner,
                     self.pairs[k],
                     &mut out.history[slot],
                     self.dt,
                 );
-                deepest = larger(deepest, overlap);
+                // The deepest overlap as a fraction of the smaller radius, dividing only
+                // when it grows.
+                if overlap > deepest * smaller_radius {
+                    deepest = overlap / smaller_radius;
+                }
                 force += result.force_on_i;
                 out.reaction_force[slot] = -result.force_on_i;
                 if self.rotates {
@@ -1076,7 +1089,20 @@ impl<L: PairLaw> OwnerPass<'_, L> {
     }
 }
 
-/// The force of one listed pair; zero (and history reset) when out of range.
+/// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
+#[derive(Clone, Copy)]
+struct Owner {
+    position: Vec3,
+    velocity: Vec3,
+    omega: Vec3,
+    radius: Real,
+    inv_mass: Real,
+    /// `species_i * n_species`: the row of the species-pair tables.
+    species_row: usize,
+}
+
+/// The force of one listed pair `(i, j)` seen from its owner `i`; zero (and history reset)
+/// when out of range. Also returns the overlap and the smaller radius, for the guard.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn pair_force<L: PairLaw>(
@@ -1084,29 +1110,30 @@ fn pair_force<L: PairLaw>(
     p: &Particles,
     omega: Option<&[Vec3]>,
     images: &[Vec3; 27],
-    n_species: usize,
+    owner: &Owner,
     pair: Pair,
     history: &mut L::History,
     dt: Real,
-) -> (PairResult, Real) {
-    let (i, j) = (pair.i as usize, pair.j as usize);
-    let d = p.position[i] - (p.position[j] + images[pair.image as usize]);
+) -> (PairResult, Real, Real) {
+    let j = pair.j as usize;
+    let d = owner.position - (p.position[j] + images[pair.image as usize]);
     let distance_sq = d.length_squared();
-    let (radius_i, radius_j) = (p.radius[i], p.radius[j]);
-    let species_pair = p.species[i] as usize * n_species + p.species[j] as usize;
+    let (radius_i, radius_j) = (owner.radius, p.radius[j]);
+    let species_pair = owner.species_row + p.species[j] as usize;
     let cutoff = law.cutoff(species_pair, radius_i, radius_j);
     if distance_sq >= cutoff * cutoff {
         *history = L::History::default();
-        return (PairResult::default(), 0.0);
+        return (PairResult::default(), 0.0, 1.0);
     }
     let distance = distance_sq.sqrt();
-    let normal = d / distance;
+    // One division, as LIGGGHTS's `rinv`.
+    let normal = d * (1.0 / distance);
     let overlap = radius_i + radius_j - distance;
-    let mut relative_velocity = p.velocity[i] - p.velocity[j];
+    let mut relative_velocity = owner.velocity - p.velocity[j];
     let mut spins = (Vec3::ZERO, Vec3::ZERO);
     if L::NEEDS_ROTATION {
         if let Some(omega) = omega {
-            spins = (omega[i], omega[j]);
+            spins = (owner.omega, omega[j]);
             // Contact point on the line of centres, inside each sphere by half the overlap.
             let arm_i = -normal * (radius_i - 0.5 * overlap);
             let arm_j = normal * (radius_j - 0.5 * overlap);
@@ -1114,7 +1141,7 @@ fn pair_force<L: PairLaw>(
         }
     }
     let normal_speed = relative_velocity.dot(normal);
-    let (inv_mass_i, inv_mass_j) = (p.inv_mass[i], p.inv_mass[j]);
+    let (inv_mass_i, inv_mass_j) = (owner.inv_mass, p.inv_mass[j]);
     let contact = Contact {
         species_pair,
         normal,
@@ -1132,8 +1159,11 @@ fn pair_force<L: PairLaw>(
         normal_speed,
         tangential_velocity: relative_velocity - normal_speed * normal,
     };
-    let overlap_fraction = overlap / radius_i.min(radius_j);
-    (law.evaluate(&contact, history, spins, dt), overlap_fraction)
+    (
+        law.evaluate(&contact, history, spins, dt),
+        overlap,
+        radius_i.min(radius_j),
+    )
 }
 
 /// Force of one body on one particle (the wall law with the SDF distance and normal and the

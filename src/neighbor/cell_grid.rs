@@ -21,7 +21,23 @@ pub struct CellGrid {
 
 impl CellGrid {
     pub fn build(domain: &Domain, positions: &[Vec3], cell_size: Real) -> CellGrid {
-        let length = domain.length();
+        // Periodic axes span the box (images need whole periods); bounded axes span only the
+        // particles, so a large, mostly empty box costs no empty cells.
+        let (mut lo, mut length) = (domain.lo, domain.length());
+        let bounded: Vec<usize> = (0..3).filter(|&a| !domain.periodic[a]).collect();
+        if !bounded.is_empty() && !positions.is_empty() {
+            let (mut min, mut max) = (Vec3::splat(Real::INFINITY), Vec3::splat(Real::NEG_INFINITY));
+            for &p in positions {
+                min = min.min(p);
+                max = max.max(p);
+            }
+            for &axis in &bounded {
+                if min[axis].is_finite() && max[axis].is_finite() {
+                    lo[axis] = min[axis];
+                    length[axis] = (max[axis] - min[axis]).max(cell_size);
+                }
+            }
+        }
         let mut counts = [1usize; 3];
         let mut inv_width = Vec3::ZERO;
         for axis in 0..3 {
@@ -31,7 +47,7 @@ impl CellGrid {
         let mut grid = CellGrid {
             counts,
             inv_width,
-            lo: domain.lo,
+            lo,
             ..Default::default()
         };
         grid.cell_of = positions.iter().map(|&p| grid.cell_index(p)).collect();

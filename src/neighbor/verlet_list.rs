@@ -229,45 +229,62 @@ impl VerletList {
 /// All pairs `i < j` (with image) closer than `r_i + r_j + extra`, sorted by `(i, j, image)`,
 /// except pairs of two frozen particles.
 fn find_pairs(grid: &CellGrid, domain: &Domain, particles: &Particles, extra: Real) -> Vec<Pair> {
-    let positions = &particles.position;
-    let radii = &particles.radius;
-    let per_particle: Vec<Vec<Pair>> = (0..particles.len())
+    // One vector per block of particles (not per particle): few allocations per build.
+    const BLOCK: usize = 256;
+    let n = particles.len();
+    let per_block: Vec<Vec<Pair>> = (0..n.div_ceil(BLOCK))
         .into_par_iter()
-        .map(|i| {
+        .map(|block| {
             let mut found = Vec::new();
-            let frozen_i = particles.is_frozen(i);
-            let home = grid.cell_coords(positions[i]);
-            for dz in -1i32..=1 {
-                for dy in -1i32..=1 {
-                    for dx in -1i32..=1 {
-                        let Some((cell, image)) = neighbour_cell(grid, domain, home, [dx, dy, dz])
-                        else {
-                            continue;
-                        };
-                        let shift = domain.image_shift(image);
-                        for &j in grid.particles_in(cell) {
-                            // Two frozen particles never interact (neither moves).
-                            if (j as usize) <= i || (frozen_i && particles.is_frozen(j as usize)) {
-                                continue;
-                            }
-                            let reach = radii[i] + radii[j as usize] + extra;
-                            let d = positions[j as usize] + shift - positions[i];
-                            if d.length_squared() < reach * reach {
-                                found.push(Pair {
-                                    i: i as u32,
-                                    j,
-                                    image,
-                                });
-                            }
-                        }
-                    }
-                }
+            for i in block * BLOCK..((block + 1) * BLOCK).min(n) {
+                let first = found.len();
+                pairs_of(grid, domain, particles, extra, i, &mut found);
+                found[first..].sort_unstable();
             }
-            found.sort_unstable();
             found
         })
         .collect();
-    per_particle.concat()
+    per_block.concat()
+}
+
+/// Appends the pairs `(i, j > i)` of particle `i` within `r_i + r_j + extra`.
+fn pairs_of(
+    grid: &CellGrid,
+    domain: &Domain,
+    particles: &Particles,
+    extra: Real,
+    i: usize,
+    found: &mut Vec<Pair>,
+) {
+    let positions = &particles.position;
+    let radii = &particles.radius;
+    let frozen_i = particles.is_frozen(i);
+    let home = grid.cell_coords(positions[i]);
+    for dz in -1i32..=1 {
+        for dy in -1i32..=1 {
+            for dx in -1i32..=1 {
+                let Some((cell, image)) = neighbour_cell(grid, domain, home, [dx, dy, dz]) else {
+                    continue;
+                };
+                let shift = domain.image_shift(image);
+                for &j in grid.particles_in(cell) {
+                    // Two frozen particles never interact (neither moves).
+                    if (j as usize) <= i || (frozen_i && particles.is_frozen(j as usize)) {
+                        continue;
+                    }
+                    let reach = radii[i] + radii[j as usize] + extra;
+                    let d = positions[j as usize] + shift - positions[i];
+                    if d.length_squared() < reach * reach {
+                        found.push(Pair {
+                            i: i as u32,
+                            j,
+                            image,
+                        });
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The cell at `home + offset` and the periodic image it is seen through, or None when the
