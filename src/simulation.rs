@@ -76,9 +76,11 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// Per particle, the sum of its own pairs' forces (and torques) on it.
     own_force: Vec<Vec3>,
     own_torque: Vec<Vec3>,
-    /// Per listed pair, the force (and torque) on its `j` (torques empty without spin).
+    /// Per listed pair, the force on its `j` (empty when particles spin).
     reaction_force: Vec<Vec3>,
-    reaction_torque: Vec<Vec3>,
+    /// Per listed pair, the force and torque on its `j`, side by side so the gather reads
+    /// one place (empty without spin).
+    reaction_spin: Vec<[Vec3; 2]>,
     integrator: Integrator,
     /// PCVV's `F0`, `T0` (empty for velocity Verlet).
     old_force: Vec<Vec3>,
@@ -125,7 +127,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             own_force: Vec::new(),
             own_torque: Vec::new(),
             reaction_force: Vec::new(),
-            reaction_torque: Vec::new(),
+            reaction_spin: Vec::new(),
             bodies: Vec::new(),
             body_loads: Vec::new(),
             delete_regions: Vec::new(),
@@ -244,7 +246,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             pair_bytes: self.list.pair_bytes()
                 + bytes(&self.history)
                 + bytes(&self.reaction_force)
-                + bytes(&self.reaction_torque),
+                + bytes(&self.reaction_spin),
             history_entries: self.history.len(),
         }
     }
@@ -461,10 +463,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let n = self.particles.len();
         let pairs = self.list.pairs.len();
         self.own_force.resize(n, Vec3::ZERO);
-        self.reaction_force.resize(pairs, Vec3::ZERO);
+        if !Self::ROTATES {
+            self.reaction_force.resize(pairs, Vec3::ZERO);
+        }
         if Self::ROTATES {
             self.own_torque.resize(n, Vec3::ZERO);
-            self.reaction_torque.resize(pairs, Vec3::ZERO);
+            self.reaction_spin.resize(pairs, [Vec3::ZERO; 2]);
         }
         let p = &self.particles;
         let pass = OwnerPass {
@@ -486,7 +490,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 own_torque: &mut self.own_torque,
                 history: &mut self.history,
                 reaction_force: &mut self.reaction_force,
-                reaction_torque: &mut self.reaction_torque,
+                reaction_spin: &mut self.reaction_spin,
             },
         );
 
@@ -577,7 +581,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let wall_history = &mut self.wall_history;
         let (list, dt) = (&self.list, self.dt);
         let (own_force, own_torque) = (&self.own_force, &self.own_torque);
-        let (reaction_force, reaction_torque) = (&self.reaction_force, &self.reaction_torque);
+        let reaction = &self.reaction_spin;
         let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
         let Particles {
             position,
@@ -621,8 +625,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     overlap
                 };
                 for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                    f += reaction_force[k as usize];
-                    t += reaction_torque[k as usize];
+                    let [rf, rt] = reaction[k as usize];
+                    f += rf;
+                    t += rt;
                 }
                 *force = f;
                 *torque = t;
@@ -982,14 +987,14 @@ struct OwnerPass<'a, L: PairLaw> {
     rotates: bool,
 }
 
-/// What the owner pass writes, for the particles from `first` on and their pairs (torque
-/// slices are empty when particles do not spin).
+/// What the owner pass writes, for the particles from `first` on and their pairs (the
+/// torque slice is empty when particles do not spin, the force-only reactions when they do).
 struct OwnerSlices<'s, H> {
     own_force: &'s mut [Vec3],
     own_torque: &'s mut [Vec3],
     history: &'s mut [H],
     reaction_force: &'s mut [Vec3],
-    reaction_torque: &'s mut [Vec3],
+    reaction_spin: &'s mut [[Vec3; 2]],
 }
 
 /// Splits a slice at `at`, or gives two empty slices when it is empty (unused torques).
@@ -1013,8 +1018,8 @@ impl<L: PairLaw> OwnerPass<'_, L> {
             let (own_force_a, own_force_b) = out.own_force.split_at_mut(mid);
             let (own_torque_a, own_torque_b) = split_or_empty(out.own_torque, mid);
             let (history_a, history_b) = out.history.split_at_mut(split);
-            let (reaction_force_a, reaction_force_b) = out.reaction_force.split_at_mut(split);
-            let (reaction_torque_a, reaction_torque_b) = split_or_empty(out.reaction_torque, split);
+            let (reaction_force_a, reaction_force_b) = split_or_empty(out.reaction_force, split);
+            let (reaction_spin_a, reaction_spin_b) = split_or_empty(out.reaction_spin, split);
             let (a, b) = rayon::join(
                 || {
                     self.run(
@@ -1024,7 +1029,7 @@ impl<L: PairLaw> OwnerPass<'_, L> {
                             own_torque: own_torque_a,
                             history: history_a,
                             reaction_force: reaction_force_a,
-                            reaction_torque: reaction_torque_a,
+                            reaction_spin: reaction_spin_a,
                         },
                     )
                 },
@@ -1036,7 +1041,7 @@ impl<L: PairLaw> OwnerPass<'_, L> {
                             own_torque: own_torque_b,
                             history: history_b,
                             reaction_force: reaction_force_b,
-                            reaction_torque: reaction_torque_b,
+                            reaction_spin: reaction_spin_b,
                         },
                     )
                 },
@@ -1074,10 +1079,11 @@ impl<L: PairLaw> OwnerPass<'_, L> {
                     deepest = overlap / smaller_radius;
                 }
                 force += result.force_on_i;
-                out.reaction_force[slot] = -result.force_on_i;
                 if self.rotates {
                     torque += result.torque_on_i;
-                    out.reaction_torque[slot] = result.torque_on_j;
+                    out.reaction_spin[slot] = [-result.force_on_i, result.torque_on_j];
+                } else {
+                    out.reaction_force[slot] = -result.force_on_i;
                 }
             }
             out.own_force[local] = force;
@@ -1122,7 +1128,10 @@ fn pair_force<L: PairLaw>(
     let species_pair = owner.species_row + p.species[j] as usize;
     let cutoff = law.cutoff(species_pair, radius_i, radius_j);
     if distance_sq >= cutoff * cutoff {
-        *history = L::History::default();
+        // Reset only what holds something: most listed pairs are apart and stay clean.
+        if *history != L::History::default() {
+            *history = L::History::default();
+        }
         return (PairResult::default(), 0.0, 1.0);
     }
     let distance = distance_sq.sqrt();

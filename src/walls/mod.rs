@@ -124,7 +124,12 @@ impl WallSet {
                 force += f;
                 torque += t;
             }
-            None => history[k] = W::History::default(),
+            // Reset only what holds something: most particles are away from most walls.
+            None => {
+                if history[k] != W::History::default() {
+                    history[k] = W::History::default();
+                }
+            }
         });
         (force, torque, overlap)
     }
