@@ -28,6 +28,13 @@ started=$(date +%s)
 "$cgdem" validate --suite nightly --out "$night" --reuse "$@"
 echo "nightly suite: $(( $(date +%s) - started )) s wall time"
 
+# Throughput against LIGGGHTS and LAMMPS on the heap benchmark, side by side (three
+# alternating repetitions at 1 and 2 threads/ranks): its medians and ratios join the history.
+started=$(date +%s)
+"$cgdem" bench validation/bench/heap.toml --pairs 3 --out "$night/bench" || echo "note: cgdem bench failed; the night has no throughput comparison"
+echo "bench: $(( $(date +%s) - started )) s wall time"
+find "$night/bench" -type f \( -name '*.dump' -o -name 'particles.data' -o -name 'timeseries.csv' \) -delete 2>/dev/null || true
+
 # Keep the night small: run directories hold dumps and VTK files; the report needs only
 # its summaries, CSV and figures.
 find "$night/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete

@@ -1128,10 +1128,7 @@ fn pair_force<L: PairLaw>(
     let species_pair = owner.species_row + p.species[j] as usize;
     let cutoff = law.cutoff(species_pair, radius_i, radius_j);
     if distance_sq >= cutoff * cutoff {
-        // Reset only what holds something: most listed pairs are apart and stay clean.
-        if *history != L::History::default() {
-            *history = L::History::default();
-        }
+        *history = L::History::default();
         return (PairResult::default(), 0.0, 1.0);
     }
     let distance = distance_sq.sqrt();

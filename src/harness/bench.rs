@@ -243,16 +243,26 @@ fn prepare(path: &Path, options: &BenchOptions) -> Result<PreparedCase, BenchErr
     };
     let state = if options.prepare_s > 0.0 {
         let dir = options.out.join(&scene.name).join("prepare");
-        let summary = run(
-            &with_duration(&scene, options.prepare_s),
-            &RunOptions {
-                out_dir: dir,
-                quiet: true,
-                keep_final_state: true,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| BenchError::Case(format!("preparing the state: {e}")))?;
+        let threads = options.threads.iter().copied().max().unwrap_or(1);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| BenchError::Case(e.to_string()))?;
+        // In a pool of its own: rayon calls from outside any pool would each be handed over
+        // to the global pool and waited for.
+        let summary = pool
+            .install(|| {
+                run(
+                    &with_duration(&scene, options.prepare_s),
+                    &RunOptions {
+                        out_dir: dir,
+                        quiet: true,
+                        keep_final_state: true,
+                        ..Default::default()
+                    },
+                )
+            })
+            .map_err(|e| BenchError::Case(format!("preparing the state: {e}")))?;
         dt = dt.or(Some(summary.dt_s));
         summary.final_state.expect("asked for the final state")
     } else {

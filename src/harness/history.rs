@@ -162,6 +162,51 @@ pub fn flags(previous: &Night, current: &Night) -> Vec<Flag> {
 /// Adds the night in `night_dir` (a `cgdem validate` output) to the history in
 /// `history_dir` (replacing an earlier record of the same report), rewrites the history
 /// page, and returns the flags against the previous night.
+/// The night's metrics from `cgdem bench` (`bench/bench.json` beside the suite's report):
+/// the median throughput of each case, code and thread count, and the median speed ratio
+/// cgdem / other code, both with the throughput tolerance (relative).
+pub fn bench_metrics(bench: &serde_json::Value) -> BTreeMap<String, Metric> {
+    let empty = Vec::new();
+    let mut out = BTreeMap::new();
+    for m in bench["medians"].as_array().unwrap_or(&empty) {
+        if let Some(value) = m["median_particle_steps_per_s"].as_f64() {
+            out.insert(
+                format!(
+                    "bench {} {} threads={}: throughput",
+                    m["case"].as_str().unwrap_or("?"),
+                    m["code"].as_str().unwrap_or("?"),
+                    m["threads"].as_u64().unwrap_or(0)
+                ),
+                Metric {
+                    quantity: "throughput [particle-steps/s]".into(),
+                    value,
+                    tolerance: THROUGHPUT_TOLERANCE,
+                    relative: true,
+                },
+            );
+        }
+    }
+    for r in bench["ratios"].as_array().unwrap_or(&empty) {
+        if let Some(value) = r["median"].as_f64() {
+            out.insert(
+                format!(
+                    "bench {} / {} threads={}: speed ratio",
+                    r["numerator"].as_str().unwrap_or("?"),
+                    r["denominator"].as_str().unwrap_or("?"),
+                    r["threads"].as_u64().unwrap_or(0)
+                ),
+                Metric {
+                    quantity: "speed ratio cgdem / other".into(),
+                    value,
+                    tolerance: THROUGHPUT_TOLERANCE,
+                    relative: true,
+                },
+            );
+        }
+    }
+    out
+}
+
 pub fn add_night(
     history_dir: &Path,
     night_dir: &Path,
@@ -196,6 +241,18 @@ pub fn add_night(
         comparisons_failed,
         metrics: night_metrics(&summary),
     };
+    let mut night = night;
+    // The night's `cgdem bench`, when it ran (scripts/nightly.sh runs it into bench/).
+    let bench_path = night_dir.join("bench").join("bench.json");
+    if let Ok(text) = std::fs::read_to_string(&bench_path) {
+        let bench: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| HistoryError::Invalid {
+                file: bench_path.clone(),
+                what: "bench report",
+                message: e.to_string(),
+            })?;
+        night.metrics.extend(bench_metrics(&bench));
+    }
     let history_path = history_dir.join("history.json");
     let mut nights = read_history(&history_path)?;
     nights.retain(|n| n.report != report);
@@ -374,6 +431,21 @@ mod tests {
         );
         let rate = &m["c cgdem lambda=8 seed: throughput"];
         assert_eq!((rate.value, rate.relative), (2e6, true));
+    }
+
+    #[test]
+    fn bench_medians_and_ratios_become_relative_metrics() {
+        let bench = serde_json::json!({
+            "medians": [{"case": "bench_heap", "code": "cgdem", "threads": 2, "median_particle_steps_per_s": 1.5e7}],
+            "ratios": [{"numerator": "bench_heap cgdem", "denominator": "bench_heap lammps", "threads": 2, "median": 2.4}]
+        });
+        let m = bench_metrics(&bench);
+        let ratio = &m["bench bench_heap cgdem / bench_heap lammps threads=2: speed ratio"];
+        assert_eq!((ratio.value, ratio.relative), (2.4, true));
+        assert_eq!(
+            m["bench bench_heap cgdem threads=2: throughput"].value,
+            1.5e7
+        );
     }
 
     #[test]

@@ -124,12 +124,7 @@ impl WallSet {
                 force += f;
                 torque += t;
             }
-            // Reset only what holds something: most particles are away from most walls.
-            None => {
-                if history[k] != W::History::default() {
-                    history[k] = W::History::default();
-                }
-            }
+            None => history[k] = W::History::default(),
         });
         (force, torque, overlap)
     }
