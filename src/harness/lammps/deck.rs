@@ -35,7 +35,7 @@ pub const TRAJECTORY_FILE: &str = "traj.dump";
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum DeckError {
-    #[error("{file}: cannot express this scene in LAMMPS: {reason}")]
+    #[error("{file}: cannot write a reference-code deck for this scene: {reason}")]
     Unsupported { file: String, reason: String },
 }
 
