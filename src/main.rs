@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use cgdem::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
 use cgdem::geometry::accuracy::format_accuracy_table;
@@ -174,50 +174,61 @@ enum Command {
 
 #[derive(Subcommand)]
 enum ReferenceCode {
-    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP); see reference/lammps/SEED_MODEL.md.
-    Lammps {
-        /// The scene file, e.g. validation/cases/aor_collapse.toml.
-        case: PathBuf,
-        /// Coarse-graining level (a power of two), applied before the deck is written.
-        #[arg(long, default_value_t = 1)]
-        lambda: u32,
-        /// Coarse-graining rule, as for `cgdem run`.
-        #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
-        cg_rule: CoarseGrainRule,
-        /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Output directory (default: runs/<case>-lambda<N>-lammps).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a scene field before validation, e.g. `--set wall_contact.friction=0.0`
-        /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Name the variant the overrides make: appended to the scene's name
-        /// (`aor_collapse-smooth-walls`), as a suite's `variant` does, so `validate --reuse`
-        /// recognises the run.
-        #[arg(long, requires = "set")]
-        variant: Option<String>,
-        /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp`); default: serial.
-        #[arg(long)]
-        np: Option<u32>,
-        /// Kill LAMMPS after this many seconds.
-        #[arg(long, default_value_t = 7200)]
-        timeout: u64,
-        /// Write the deck even if the time step exceeds the stable limit.
-        #[arg(long)]
-        force_dt: bool,
-        /// Do not run: post-process the LAMMPS outputs already in --out (e.g. of a run that
-        /// was stopped; the samples it reached are used).
-        #[arg(long)]
-        postprocess_only: bool,
-    },
+    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP): the seed's WCA model (reference/lammps/SEED_MODEL.md)
+    /// and Hertz scenes (reference/MAPPING.md).
+    Lammps(ReferenceArgs),
+    /// LIGGGHTS (`liggghts` on PATH or $CGDEM_LIGGGHTS): Hertz scenes with LIGGGHTS's keywords.
+    Liggghts(ReferenceArgs),
 }
 
-fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
+#[derive(Args)]
+struct ReferenceArgs {
+    /// The scene file, e.g. validation/cases/aor_collapse.toml.
+    case: PathBuf,
+    /// Coarse-graining level (a power of two), applied before the deck is written.
+    #[arg(long, default_value_t = 1)]
+    lambda: u32,
+    /// Coarse-graining rule, as for `cgdem run`.
+    #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
+    cg_rule: CoarseGrainRule,
+    /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Output directory (default: runs/<case>-lambda<N>-<code>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Override a scene field before validation, e.g. `--set wall_contact.friction=0.0`
+    /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Name the variant the overrides make: appended to the scene's name
+    /// (`aor_collapse-smooth-walls`), as a suite's `variant` does, so `validate --reuse`
+    /// recognises the run.
+    #[arg(long, requires = "set")]
+    variant: Option<String>,
+    /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp|liggghts`); default: serial.
+    #[arg(long)]
+    np: Option<u32>,
+    /// Kill the code after this many seconds.
+    #[arg(long, default_value_t = 7200)]
+    timeout: u64,
+    /// Write the deck even if the time step exceeds the stable limit.
+    #[arg(long)]
+    force_dt: bool,
+    /// Do not run: post-process the outputs already in --out (e.g. of a run that
+    /// was stopped; the samples it reached are used).
+    #[arg(long)]
+    postprocess_only: bool,
+}
+
+fn reference_run(code: ReferenceCode) -> Result<ExitCode, String> {
     use cgdem::harness::lammps::{self, ReferenceOptions, RunStatus, RunnerOptions};
-    let ReferenceCode::Lammps {
+    let (code, args) = match code {
+        ReferenceCode::Lammps(args) => (lammps::ReferenceCode::Lammps, args),
+        ReferenceCode::Liggghts(args) => (lammps::ReferenceCode::Liggghts, args),
+    };
+    let name = code.name();
+    let ReferenceArgs {
         case,
         lambda,
         cg_rule,
@@ -233,9 +244,15 @@ fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
     let scene = load_scene(&case, &set, variant.as_deref(), seed)?;
     let scene = coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())?;
     let out = out.unwrap_or_else(|| {
-        PathBuf::from("runs").join(format!("{}-lambda{}-lammps", scene.name, scene.lambda))
+        PathBuf::from("runs").join(format!(
+            "{}-lambda{}-{}",
+            scene.name,
+            scene.lambda,
+            name.to_lowercase()
+        ))
     });
     let options = ReferenceOptions {
+        code,
         runner: RunnerOptions {
             np,
             timeout: std::time::Duration::from_secs(timeout),
@@ -261,7 +278,7 @@ fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
         RunStatus::Completed { .. } => {
             let summary = run.summary.expect("a completed run is post-processed");
             println!(
-                "LAMMPS: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
+                "{name}: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
                 summary.steps, summary.wall_s, summary.particle_steps_per_s
             );
             for s in &summary.repose_samples {
@@ -287,7 +304,7 @@ fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
             exit_code,
             log_tail,
         } => Err(format!(
-            "LAMMPS failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}",
+            "{name} failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}",
             out.display()
         )),
         RunStatus::TimedOut { after_s, log_tail } => {
@@ -296,7 +313,7 @@ fn reference_lammps(args: ReferenceCode) -> Result<ExitCode, String> {
                 format!(" (post-processing the partial run failed: {e})")
             });
             Err(format!(
-                "LAMMPS killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}",
+                "{name} killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}",
                 out.display()
             ))
         }
@@ -443,7 +460,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Reference { code } => match reference_lammps(code) {
+        Command::Reference { code } => match reference_run(code) {
             Ok(code) => code,
             Err(message) => {
                 eprintln!("error: {message}");

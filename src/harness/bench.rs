@@ -466,8 +466,9 @@ pub struct LogTiming {
     pub memory_mb: Option<Real>,
 }
 
-/// Reads `Loop time of T on P procs for N steps with M atoms` (the last one) and the memory
-/// line before it; None if the log has no loop line.
+/// Sums the `Loop time of T on P procs for N steps with M atoms` lines (a deck sets up with
+/// `run 0` and may run its stage in pieces) and reads the memory line; None if the log has
+/// no loop line with steps.
 pub fn log_timing(log: &str) -> Option<LogTiming> {
     let mut memory_per_rank: Option<Real> = None;
     let mut timing: Option<LogTiming> = None;
@@ -498,10 +499,14 @@ pub fn log_timing(log: &str) -> Option<LogTiming> {
                     n.parse::<u64>(),
                     m.parse::<usize>(),
                 ) {
+                    if n == 0 {
+                        continue;
+                    }
+                    let before = timing.map_or((0.0, 0), |t| (t.loop_s, t.steps));
                     timing = Some(LogTiming {
-                        loop_s: t,
+                        loop_s: before.0 + t,
                         ranks: p,
-                        steps: n,
+                        steps: before.1 + n,
                         atoms: m,
                         memory_mb: memory_per_rank.map(|mb| mb * p as Real),
                     });
@@ -908,11 +913,12 @@ mod tests {
 
     #[test]
     fn reads_loop_time_and_memory_from_lammps_and_liggghts_logs() {
-        let lammps = "Per MPI rank memory allocation (min/avg/max) = 12.5 | 13.0 | 13.5 Mbytes\nStep Atoms\nLoop time of 20.5 on 2 procs for 10000 steps with 11103 atoms\n";
+        let lammps = "Per MPI rank memory allocation (min/avg/max) = 12.5 | 13.0 | 13.5 Mbytes\nLoop time of 1e-6 on 2 procs for 0 steps with 11103 atoms\nStep Atoms\nLoop time of 20.5 on 2 procs for 6000 steps with 11103 atoms\nLoop time of 10.5 on 2 procs for 4000 steps with 11103 atoms\n";
         let t = log_timing(lammps).unwrap();
+        // The set-up `run 0` is left out; the pieces of the stage add up.
         assert_eq!(
             (t.loop_s, t.ranks, t.steps, t.atoms),
-            (20.5, 2, 10000, 11103)
+            (31.0, 2, 10000, 11103)
         );
         assert_eq!(t.memory_mb, Some(26.0));
         let liggghts = "Memory usage per processor = 9.5 Mbytes\nLoop time of 41 on 1 procs for 10000 steps with 11103 atoms\n";

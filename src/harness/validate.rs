@@ -347,9 +347,10 @@ fn run_case(
                     let outcome = match code {
                         Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options)
                             .map(|reused| record.reused = reused),
-                        Code::Lammps => run_lammps(scene, lambda, rule, seed, &dir, options)
-                            .map(|reused| record.reused = reused),
-                        Code::Liggghts => Err(RunOutcome::Skipped("LIGGGHTS cannot express the seed's WCA model; Hertz decks for LIGGGHTS are not written yet".into())),
+                        Code::Lammps | Code::Liggghts => {
+                            run_reference_code(code, scene, lambda, rule, seed, &dir, options)
+                                .map(|reused| record.reused = reused)
+                        }
                     };
                     match outcome {
                         Ok(()) => fill_from_summary(&mut record),
@@ -421,7 +422,10 @@ fn finished_digest(dir: &Path) -> Option<String> {
     value.get("scene_digest")?.as_str().map(str::to_string)
 }
 
-fn run_lammps(
+/// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
+/// reused. LIGGGHTS cannot express the seed's WCA model: its runs of such a case are skipped.
+fn run_reference_code(
+    code: Code,
     scene: &Scene,
     lambda: u32,
     rule: CoarseGrainRule,
@@ -429,10 +433,24 @@ fn run_lammps(
     dir: &Path,
     validate: &ValidateOptions,
 ) -> Result<bool, RunOutcome> {
-    use super::lammps::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
+    use super::lammps::{run_reference, ReferenceCode, ReferenceOptions, RunStatus, RunnerOptions};
+    let reference = match code {
+        Code::Liggghts => ReferenceCode::Liggghts,
+        _ => ReferenceCode::Lammps,
+    };
+    if reference == ReferenceCode::Liggghts
+        && matches!(scene.contact, crate::scene::ContactSettings::Wca { .. })
+    {
+        return Err(RunOutcome::Skipped(
+            "LIGGGHTS cannot express the seed's WCA model (model = \"wca\"); it runs Hertz cases"
+                .into(),
+        ));
+    }
+    let name = reference.name();
     let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
     let mut options = ReferenceOptions {
+        code: reference,
         runner: RunnerOptions {
             np: None,
             timeout: std::time::Duration::from_secs(validate.reference_timeout_s),
@@ -467,10 +485,10 @@ fn run_lammps(
             exit_code,
             log_tail,
         } => Err(RunOutcome::Failed(format!(
-            "LAMMPS exit code {exit_code:?}; log tail: {log_tail}"
+            "{name} exit code {exit_code:?}; log tail: {log_tail}"
         ))),
         RunStatus::TimedOut { after_s, log_tail } => Err(RunOutcome::Failed(format!(
-            "LAMMPS timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
+            "{name} timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
         ))),
     }
 }

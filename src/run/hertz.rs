@@ -238,6 +238,33 @@ where
     )
 }
 
+/// The time step `run_hertz` takes for a scene with LIGGGHTS's keywords (`damping = "hertz"`,
+/// `tangential = "history"`, rolling none or epsd2, no cohesion: the reference decks' scenes),
+/// with its contact time scales. The rolling slot does not enter the linearized contacts.
+pub fn time_step(
+    scene: &Scene,
+    h: &HertzSettings,
+    force_dt: bool,
+) -> Result<(Real, crate::timestep::Timescales, Option<String>), RunError> {
+    match (h.damping, h.tangential, h.rolling, h.cohesion) {
+        (
+            HertzDampingKind::Restitution,
+            TangentialKind::History,
+            RollingKind::None | RollingKind::Epsd2,
+            CohesionKind::None,
+        ) => super::time_step_for(
+            scene,
+            &hertz_law::<HertzDamping, Mindlin, NoRolling, NoCohesion>(scene, h),
+            &hertz_history_wall(scene, h),
+            force_dt,
+        ),
+        (d, t, r, c) => Err(RunError::NotAvailable(format!(
+            "{}: the time step is computed ahead of the run only for damping = \"hertz\", tangential = \"history\", rolling = \"none\" or \"epsd2\", no cohesion (the reference decks' keywords), not {d:?}/{t:?}/{r:?}/{c:?}",
+            scene.source.display()
+        ))),
+    }
+}
+
 /// The compiled combinations, as (damping, tangential, rolling, cohesion) keywords.
 pub const SUPPORTED: &[&str] = &[
     "hertz/history/none/none",

@@ -199,7 +199,7 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> 
     }
 }
 
-/// The time step cgdem uses for a seed-model scene, with the contact time scales behind it
+/// The time step cgdem uses for a scene (for Hertz, the LIGGGHTS keyword combinations), with the contact time scales behind it
 /// (the reference decks run at the same step).
 pub fn time_step(
     scene: &Scene,
@@ -210,10 +210,7 @@ pub fn time_step(
             let (law, wall_law) = seed_laws(scene);
             time_step_for(scene, &law, &wall_law, force_dt)
         }
-        ContactSettings::Hertz(_) => Err(RunError::NotAvailable(format!(
-            "{}: the time step of a Hertz scene is chosen when it runs (it depends on the law combination)",
-            scene.source.display()
-        ))),
+        ContactSettings::Hertz(h) => hertz::time_step(scene, h, force_dt),
     }
 }
 

@@ -1,9 +1,11 @@
 //! Integration tests, one binary: physics of the seed's model, coarse-graining invariants,
-//! determinism across thread counts, scene validation, the solver guards and the command line.
+//! determinism across thread counts, scene validation, the solver guards, the command line and
+//! the multi-stage Hertz decks in LIGGGHTS and LAMMPS.
 
 mod bodies;
 mod cli;
 mod common;
 mod guards;
 mod physics;
+mod reference_stages;
 mod scenes;

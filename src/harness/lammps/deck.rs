@@ -35,13 +35,19 @@ pub const TRAJECTORY_FILE: &str = "traj.dump";
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum DeckError {
-    #[error("{file}: cannot express this scene in LAMMPS: {reason}")]
+    #[error("{file}: cannot write a reference-code deck for this scene: {reason}")]
     Unsupported { file: String, reason: String },
 }
 
 /// What the deck will do, for post-processing.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DeckPlan {
+    /// The code the deck is for (`lammps` or `liggghts`), as the summary names it.
+    pub code: &'static str,
+    /// The code's log file in the run directory.
+    pub log_file: &'static str,
+    /// Known differences of this deck's model from cgdem's, carried into the summary's warnings.
+    pub notes: Vec<String>,
     pub dt: Real,
     /// Steps between trajectory frames (one time-series interval).
     pub dump_every: u64,
@@ -172,7 +178,153 @@ pub fn data_file(
     data
 }
 
-/// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`.
+/// Dump columns of the WCA deck (no rotation).
+const WCA_COLUMNS: &str = "id type x y z vx vy vz radius";
+
+/// How a deck writes its repose samples: `write_dump all custom FILE {columns} modify {modify}`.
+pub(crate) struct StageDumps<'a> {
+    pub columns: &'a str,
+    pub modify: &'a str,
+}
+
+/// The kinetic energy per mass the settle loops test (`v_kepm`) and the thermo line: LAMMPS
+/// and LIGGGHTS alike. With `rotation`, the rotational energy counts too, as in cgdem.
+pub(crate) fn kinetic_energy_lines(dump_every: u64, rotation: bool) -> String {
+    let mut d = String::from("compute         ke all ke\n");
+    if rotation {
+        d += "compute         rke all erotate/sphere\nvariable        kepm equal (c_ke+c_rke)/mass(all)\n";
+    } else {
+        d += "variable        kepm equal c_ke/mass(all)\n";
+    }
+    d += "thermo_style    custom step time atoms c_ke v_kepm\n";
+    let _ = writeln!(d, "thermo          {dump_every}");
+    d += "thermo_modify   lost ignore norm no\n";
+    d
+}
+
+/// The scene's stages as deck lines (LAMMPS and LIGGGHTS take the same commands), appended to
+/// `d` after the trajectory dump is defined; returns the repose samples (stage, time after
+/// its start, file). One `run 0` sets the system up; every later run is `pre no`, so it is set
+/// up exactly once: LAMMPS's `fix wall/gran ... damping tsuji` applies its polynomial to its
+/// stored coefficient in every setup (measured: a second setup turned the wall restitution
+/// 0.49998 into 0.60055, a third into 0.49247; `reference/HERTZ_COLLAPSE.md`), and the LAMMPS
+/// decks pad their fix list for the `unfix` that follows ([`removal_pads`]). A stage first
+/// removes its walls (`unfix(name)` gives the lines), prints
+/// `CGDEM_STAGE name start STEP`, then either runs its duration, stopping at each repose time
+/// for a `write_dump`, or runs in chunks of one output interval until the first chunk end
+/// after `min_duration` with `v_kepm` below the threshold (at most `max_duration`), and prints
+/// `CGDEM_STAGE name end STEP how`.
+pub(crate) fn stage_lines(
+    d: &mut String,
+    scene: &Scene,
+    dt: Real,
+    dump_every: u64,
+    dumps: &StageDumps,
+    unfix: impl Fn(&str) -> String,
+) -> Vec<(String, Real, String)> {
+    let write_dump = |file: &str| {
+        format!(
+            "all custom {file} {} modify {}",
+            dumps.columns, dumps.modify
+        )
+    };
+    *d += "run             0 post no\n";
+    let mut repose_dumps = Vec::new();
+    for (k, stage) in scene.stages.iter().enumerate() {
+        let _ = writeln!(d, "\n# stage `{}`", stage.name);
+        for name in &stage.remove_walls {
+            *d += &unfix(name);
+        }
+        let _ = writeln!(
+            d,
+            "print           \"CGDEM_STAGE {} start $(step)\"",
+            stage.name
+        );
+        let repose_times: Vec<Real> = match &scene.repose {
+            Some(r) if r.stage == stage.name => r.at_times.clone(),
+            _ => Vec::new(),
+        };
+        match stage.end {
+            StageEnd::Duration(duration) => {
+                let total = (duration / dt).round() as u64;
+                let mut done = 0;
+                for (j, &t) in repose_times.iter().enumerate() {
+                    let at = ((t / dt).round() as u64).min(total);
+                    if at > done {
+                        let _ = writeln!(d, "run             {} pre no post no", at - done);
+                        done = at;
+                    }
+                    let file = format!("repose_{j}.dump");
+                    let _ = writeln!(d, "write_dump      {}", write_dump(&file));
+                    repose_dumps.push((stage.name.clone(), t, file));
+                }
+                if total > done {
+                    let _ = writeln!(d, "run             {} pre no post no", total - done);
+                }
+                let _ = writeln!(
+                    d,
+                    "print           \"CGDEM_STAGE {} end $(step) duration\"",
+                    stage.name
+                );
+            }
+            StageEnd::Settled {
+                kinetic_energy_per_mass,
+                min_duration,
+                max_duration,
+            } => {
+                let chunk_s = dump_every as Real * dt;
+                let min_chunks = (min_duration / chunk_s - 1e-9).ceil().max(0.0) as u64;
+                let max_chunks = ((max_duration / chunk_s).round() as u64).max(1);
+                let (var, label) = (format!("chunk{k}"), format!("stage{k}"));
+                let _ = writeln!(d, "variable        {var} loop {max_chunks}");
+                let _ = writeln!(d, "label           loop_{label}");
+                let _ = writeln!(d, "run             {dump_every} pre no post no");
+                // Fixed-time repose samples inside a stage that ends by itself: the loop
+                // counts chunks of one output interval, so sample j is chunk round(t_j / chunk).
+                for (j, &t) in repose_times.iter().enumerate() {
+                    let chunk = ((t / chunk_s).round() as u64).max(1);
+                    let file = format!("repose_{j}.dump");
+                    // Inside the if's double quotes: single quotes around a dump format.
+                    let _ = writeln!(
+                        d,
+                        "if              \"${{{var}}} == {chunk}\" then \"write_dump {}\"",
+                        write_dump(&file).replace('"', "'")
+                    );
+                    repose_dumps.push((stage.name.clone(), t, file));
+                }
+                let _ = writeln!(d, "if              \"${{{var}}} >= {min_chunks} && ${{kepm}} < {}\" then \"print 'CGDEM_STAGE {} end $(step) settled'\" \"jump SELF end_{label}\"", g(kinetic_energy_per_mass), stage.name);
+                let _ = writeln!(d, "next            {var}");
+                let _ = writeln!(d, "jump            SELF loop_{label}");
+                let _ = writeln!(
+                    d,
+                    "print           \"CGDEM_STAGE {} end $(step) max_duration\"",
+                    stage.name
+                );
+                let _ = writeln!(d, "label           end_{label}");
+                let _ = writeln!(d, "variable        {var} delete");
+            }
+        }
+    }
+    repose_dumps
+}
+
+/// `fix pad_k all addforce 0 0 0` lines, one per wall fix some stage removes, to follow the
+/// wall fixes of a LAMMPS deck. LAMMPS builds its per-stage fix lists in the setup only;
+/// `unfix` shifts the fix array down and a `run pre no` then walks the old list, so the last
+/// fixes are applied twice (measured: the floor's restitution 0.366 instead of 0.49998 after
+/// removing a wall defined before it). With zero-force pads at the end of the list, the pads
+/// are the ones applied twice.
+pub(crate) fn removal_pads(scene: &Scene, fixes_per_wall: usize) -> String {
+    let removed: usize = scene.stages.iter().map(|s| s.remove_walls.len()).sum();
+    let mut d = String::new();
+    for k in 0..removed * fixes_per_wall {
+        let _ = writeln!(d, "fix             pad_{k} all addforce 0.0 0.0 0.0");
+    }
+    d
+}
+
+/// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`:
+/// the seed's WCA model here, a Hertz scene by `hertz::write_hertz_deck`.
 pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let unsupported = |reason: String| DeckError::Unsupported {
         file: scene.source.display().to_string(),
@@ -185,9 +337,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         gamma_t,
     } = scene.contact
     else {
-        return Err(unsupported(
-            "only the seed's WCA model has a LAMMPS deck writer so far (Hertz decks are not written yet)".into(),
-        ));
+        // Hertz: `pair_style granular hertz/material`, mapped in reference/MAPPING.md.
+        return super::hertz::write_hertz_deck(scene, particles, dt);
     };
     if gamma_n <= 0.0 {
         return Err(unsupported(
@@ -320,94 +471,29 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             );
             let _ = writeln!(d, "fix             wgran_{0} all wall/gran/region granular hooke 0.0 {1} damping velocity tangential linear_nohistory {2} {3} region w_{0}", w.name, g(gamma_w), g(x_t), g(scene.wall_contact.friction));
         }
+        d += &removal_pads(scene, 2);
     }
 
-    d += "compute         ke all ke\nvariable        kepm equal c_ke/mass(all)\n";
-    d += "thermo_style    custom step time atoms c_ke v_kepm\n";
-    let _ = writeln!(d, "thermo          {dump_every}");
-    d += "thermo_modify   lost ignore norm no\n";
-    let _ = writeln!(d, "dump            traj all custom {dump_every} {TRAJECTORY_FILE} id type x y z vx vy vz radius");
+    d += &kinetic_energy_lines(dump_every, false);
+    let _ = writeln!(
+        d,
+        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {WCA_COLUMNS}"
+    );
     d += "dump_modify     traj format float %.16g sort id\n";
-    d += "run             0 post no\n";
-
-    let mut repose_dumps = Vec::new();
-    for (k, stage) in scene.stages.iter().enumerate() {
-        let _ = writeln!(d, "\n# stage `{}`", stage.name);
-        for name in &stage.remove_walls {
-            let _ = writeln!(
-                d,
-                "unfix           wlj_{name}\nunfix           wgran_{name}"
-            );
-        }
-        let _ = writeln!(
-            d,
-            "print           \"CGDEM_STAGE {} start $(step)\"",
-            stage.name
-        );
-        let repose_times: Vec<Real> = match &scene.repose {
-            Some(r) if r.stage == stage.name => r.at_times.clone(),
-            _ => Vec::new(),
-        };
-        match stage.end {
-            StageEnd::Duration(duration) => {
-                let total = (duration / dt).round() as u64;
-                let mut done = 0;
-                for (j, &t) in repose_times.iter().enumerate() {
-                    let at = ((t / dt).round() as u64).min(total);
-                    if at > done {
-                        let _ = writeln!(d, "run             {} post no", at - done);
-                        done = at;
-                    }
-                    let file = format!("repose_{j}.dump");
-                    let _ = writeln!(d, "write_dump      all custom {file} id type x y z vx vy vz radius modify format float %.16g sort id");
-                    repose_dumps.push((stage.name.clone(), t, file));
-                }
-                if total > done {
-                    let _ = writeln!(d, "run             {} post no", total - done);
-                }
-                let _ = writeln!(
-                    d,
-                    "print           \"CGDEM_STAGE {} end $(step) duration\"",
-                    stage.name
-                );
-            }
-            StageEnd::Settled {
-                kinetic_energy_per_mass,
-                min_duration,
-                max_duration,
-            } => {
-                let chunk_s = dump_every as Real * dt;
-                let min_chunks = (min_duration / chunk_s - 1e-9).ceil().max(0.0) as u64;
-                let max_chunks = ((max_duration / chunk_s).round() as u64).max(1);
-                let (var, label) = (format!("chunk{k}"), format!("stage{k}"));
-                let _ = writeln!(d, "variable        {var} loop {max_chunks}");
-                let _ = writeln!(d, "label           loop_{label}");
-                let _ = writeln!(d, "run             {dump_every} pre no post no");
-                // Fixed-time repose samples inside a stage that ends by itself: the loop
-                // counts chunks of one output interval, so sample j is chunk round(t_j / chunk).
-                for (j, &t) in repose_times.iter().enumerate() {
-                    let chunk = ((t / chunk_s).round() as u64).max(1);
-                    let file = format!("repose_{j}.dump");
-                    let _ = writeln!(d, "if              \"${{{var}}} == {chunk}\" then \"write_dump all custom {file} id type x y z vx vy vz radius modify format float %.16g sort id\"");
-                    repose_dumps.push((stage.name.clone(), t, file));
-                }
-                let _ = writeln!(d, "if              \"${{{var}}} >= {min_chunks} && ${{kepm}} < {}\" then \"print 'CGDEM_STAGE {} end $(step) settled'\" \"jump SELF end_{label}\"", g(kinetic_energy_per_mass), stage.name);
-                let _ = writeln!(d, "next            {var}");
-                let _ = writeln!(d, "jump            SELF loop_{label}");
-                let _ = writeln!(
-                    d,
-                    "print           \"CGDEM_STAGE {} end $(step) max_duration\"",
-                    stage.name
-                );
-                let _ = writeln!(d, "label           end_{label}");
-                let _ = writeln!(d, "variable        {var} delete");
-            }
-        }
-    }
+    let stages = StageDumps {
+        columns: WCA_COLUMNS,
+        modify: "format float %.16g sort id",
+    };
+    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &stages, |name| {
+        format!("unfix           wlj_{name}\nunfix           wgran_{name}\n")
+    });
     Ok(Deck {
         input: d,
         data,
         plan: DeckPlan {
+            code: "lammps",
+            log_file: super::runner::LOG_FILE,
+            notes: vec!["LAMMPS caps wall friction with the wall dashpot force only, cgdem with WCA + dashpot (reference/lammps/SEED_MODEL.md claim 11)".into()],
             dt,
             dump_every,
             repose_dumps,
@@ -451,6 +537,14 @@ mod tests {
         let unfix = d.find("unfix           wgran_gate").unwrap();
         assert!(settle_end < unfix && unfix < d.find("repose_0.dump").unwrap());
         assert!(!d.contains("unfix           wgran_floor"));
+        // Two zero-force pads after the last wall fix, for the two gate fixes unfixed.
+        let last_wall = d.find("fix             wgran_end").unwrap();
+        assert!(
+            last_wall
+                < d.find("fix             pad_0 all addforce 0.0 0.0 0.0")
+                    .unwrap()
+        );
+        assert!(d.contains("fix             pad_1 all addforce") && !d.contains("pad_2"));
         // 0.4 s minimum = 40 chunks of 0.01 s, at most 3 s = 300 chunks.
         assert!(d.contains("variable        chunk0 loop 300"));
         assert!(d.contains(&format!("${{chunk0}} >= 40 && ${{kepm}} < {}", g(1e-6))));

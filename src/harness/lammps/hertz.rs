@@ -12,22 +12,26 @@
 //! to give the particle-wall `Y_eff`, `G_eff` (see the wall lines below: the wall fix of this
 //! LAMMPS does not use `1 - nu^2`).
 //!
-//! Supported: one stage ending after a duration, no wall removal, no repose samples.
+//! Stages, wall removal (`unfix w_NAME`) and repose samples are written by `deck::stage_lines`,
+//! as for the seed's deck, so the run goes through the same post-processing.
 
 use std::fmt::Write as _;
 
 use super::deck::{
-    boundary_line, data_file, frozen_lines, g, Deck, DeckError, DeckPlan, DATA_FILE,
-    TRAJECTORY_FILE,
+    boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines, Deck, DeckError,
+    DeckPlan, StageDumps, DATA_FILE, TRAJECTORY_FILE,
 };
 use crate::contact::damping::restitution_beta;
 use crate::contact::normal::{Hertz, Material};
 use crate::math::Real;
 use crate::particles::Particles;
 use crate::scene::{
-    CohesionKind, ContactSettings, HertzDampingKind, HertzSettings, RollingKind, Scene, StageEnd,
+    CohesionKind, ContactSettings, HertzDampingKind, HertzSettings, RollingKind, Scene,
     TangentialKind, WallSettings,
 };
+
+/// Dump columns of the Hertz decks (LAMMPS and LIGGGHTS): with spins.
+pub(crate) const HERTZ_COLUMNS: &str = "id type x y z vx vy vz omegax omegay omegaz radius";
 
 /// LAMMPS's Tsuji polynomial `P(q)`: `damping tsuji q` gives `gamma_n = P(q) sqrt(m_eff k_n)`.
 pub fn tsuji_polynomial(q: Real) -> Real {
@@ -84,14 +88,10 @@ pub(crate) fn hertz_settings<'a>(
             "{code} decks are written for damping = \"hertz\", tangential = \"history\", rolling = \"none\" or \"epsd2\", cohesion = \"none\" only"
         )));
     }
-    if scene.stages.len() != 1
-        || !matches!(scene.stages[0].end, StageEnd::Duration(_))
-        || !scene.stages[0].remove_walls.is_empty()
-        || scene.repose.is_some()
-    {
-        return Err(unsupported(
-            "collision decks take one stage with a duration, no wall removal, no repose".into(),
-        ));
+    if !scene.bodies.is_empty() || !scene.deletions.is_empty() {
+        return Err(unsupported(format!(
+            "{code} Hertz decks take planar walls only (no [[body]], no [[delete]])"
+        )));
     }
     Ok(h)
 }
@@ -157,10 +157,6 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     let (y_eff, g_eff) = (Material::y_eff(m, m), Material::g_eff(m, m));
     let x_t = tangential_damping_ratio(y_eff, g_eff);
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
-    let StageEnd::Duration(duration) = scene.stages[0].end else {
-        unreachable!("checked by hertz_settings")
-    };
-    let steps = (duration / dt).round() as u64;
     // Rolling stiffness at the scene's characteristic speed, for the first species pair.
     let s0 = &scene.species[0];
     let rolling = |y: Real, gg: Real, r: Real, mass: Real| match h.rolling {
@@ -278,25 +274,109 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
                 ["x", "y", "z"][axis]
             );
         }
+        d += &super::deck::removal_pads(scene, 1);
     }
-    d += "thermo          1000\nthermo_modify   lost ignore norm no\n";
-    let _ = writeln!(d, "dump            traj all custom {dump_every} {TRAJECTORY_FILE} id type x y z vx vy vz omegax omegay omegaz radius");
+    d += &kinetic_energy_lines(dump_every, true);
+    let _ = writeln!(
+        d,
+        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {HERTZ_COLUMNS}"
+    );
     d += "dump_modify     traj format float %.17g sort id\n";
-    let _ = writeln!(d, "run             {steps}");
+    let dumps = StageDumps {
+        columns: HERTZ_COLUMNS,
+        modify: "format float %.17g sort id",
+    };
+    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &dumps, |name| {
+        format!("unfix           w_{name}\n")
+    });
+    let mut notes = Vec::new();
+    if h.rolling == RollingKind::Epsd2 {
+        notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
+    }
+    notes.push("LAMMPS tangential mindlin is not LIGGGHTS tangential history: full radii in the contact-point velocity, spring + dashpot capped at the Coulomb limit (reference/MAPPING.md)".into());
     Ok(Deck {
         input: d,
         data,
         plan: DeckPlan {
+            code: "lammps",
+            log_file: super::runner::LOG_FILE,
+            notes,
             dt,
             dump_every,
-            repose_dumps: Vec::new(),
+            repose_dumps,
         },
     })
+}
+
+/// The deck of `validation/cases/aor_hertz.toml` with one particle, for the deck tests of
+/// both codes.
+#[cfg(test)]
+pub(crate) fn collapse_scene_and_particle() -> (Scene, Particles) {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/cases/aor_hertz.toml");
+    let scene = Scene::load(&path).unwrap();
+    let mut particles = Particles::new(true);
+    let s = &scene.species[0];
+    particles.push(
+        0,
+        crate::math::Vec3::new(0.05, 0.025, 0.1),
+        s.radius(),
+        s.mass(),
+    );
+    (scene, particles)
+}
+
+/// Position of `needle` in `deck`, failing with the needle's text when it is absent.
+#[cfg(test)]
+pub(crate) fn at(deck: &str, needle: &str) -> usize {
+    deck.find(needle)
+        .unwrap_or_else(|| panic!("no `{needle}` in the deck:\n{deck}"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {
+        let (scene, particles) = collapse_scene_and_particle();
+        let deck = write_hertz_deck(&scene, &particles, 5e-5).unwrap();
+        let d = &deck.input;
+        assert_eq!(deck.plan.code, "lammps");
+        assert_eq!(deck.plan.dump_every, 200);
+        for wall in ["floor", "back", "gate", "end"] {
+            at(
+                d,
+                &format!("fix             w_{wall} all wall/gran granular hertz/material"),
+            );
+        }
+        at(d, "xplane NULL 1.00000000000000006e-1");
+        // One zero-force pad after the last wall fix, for the one wall unfixed.
+        assert!(
+            at(d, "fix             w_end")
+                < at(d, "fix             pad_0 all addforce 0.0 0.0 0.0")
+        );
+        assert!(!d.contains("pad_1"));
+        // Kinetic energy with the spins, as cgdem counts it.
+        at(d, "variable        kepm equal (c_ke+c_rke)/mass(all)");
+        // Settle: chunks of 0.01 s, at least 0.4 s (40), at most 2 s (200).
+        let settle = at(d, "variable        chunk0 loop 200");
+        at(d, &format!("${{chunk0}} >= 40 && ${{kepm}} < {}", g(1e-5)));
+        let settle_end = at(d, "label           end_stage0");
+        // The gate goes between the stages, and only the gate.
+        let unfix = at(d, "unfix           w_gate");
+        assert!(!d.contains("unfix           w_floor"));
+        let collapse = at(d, "CGDEM_STAGE collapse start");
+        assert!(settle < settle_end && settle_end < unfix && unfix < collapse);
+        // Collapse: at least 1 s, at most 3 s, samples at chunks 25, 50, 100 with spins.
+        at(d, "variable        chunk1 loop 300");
+        at(d, &format!("${{chunk1}} >= 100 && ${{kepm}} < {}", g(1e-5)));
+        let sample = at(d, "if              \"${chunk1} == 25\" then \"write_dump all custom repose_0.dump id type x y z vx vy vz omegax omegay omegaz radius modify format float %.17g sort id\"");
+        assert!(collapse < sample);
+        let times: Vec<Real> = deck.plan.repose_dumps.iter().map(|r| r.1).collect();
+        assert_eq!(times, [0.25, 0.5, 1.0]);
+        assert!(deck.plan.notes.iter().any(|n| n.contains("rolling sds")));
+    }
 
     #[test]
     fn tsuji_q_matches_the_mapping_table() {

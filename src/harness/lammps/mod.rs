@@ -1,5 +1,7 @@
-//! LAMMPS (29 Sep 2021) as a reference for the seed model (and, `hertz`, the Hertz family); how the model is expressed in
-//! LAMMPS and what it cannot reproduce is in `reference/lammps/SEED_MODEL.md`.
+//! LAMMPS (29 Sep 2021) as a reference for the seed model (and, `hertz`, the Hertz family); how
+//! the model is expressed in LAMMPS and what it cannot reproduce is in
+//! `reference/lammps/SEED_MODEL.md` and `reference/MAPPING.md`. `run_reference` also runs
+//! LIGGGHTS (`harness::liggghts`): both codes share the stage lines, runner and post-processing.
 
 pub mod deck;
 pub mod dump;
@@ -18,9 +20,29 @@ use std::path::Path;
 use crate::run::RunSummary;
 use crate::scene::Scene;
 
-/// How `run_reference` runs: the runner's settings plus the two choices a user makes.
+/// The reference code a deck is written for and run by.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ReferenceCode {
+    /// LAMMPS (`lmp`): the seed's WCA model and the Hertz family.
+    #[default]
+    Lammps,
+    /// LIGGGHTS (`liggghts`): the Hertz family with LIGGGHTS's own keywords.
+    Liggghts,
+}
+
+impl ReferenceCode {
+    pub fn name(self) -> &'static str {
+        match self {
+            ReferenceCode::Lammps => "LAMMPS",
+            ReferenceCode::Liggghts => "LIGGGHTS",
+        }
+    }
+}
+
+/// How `run_reference` runs: the code, the runner's settings and the two choices a user makes.
 #[derive(Clone, Debug, Default)]
 pub struct ReferenceOptions {
+    pub code: ReferenceCode,
     pub runner: RunnerOptions,
     /// Write the deck even if the time step exceeds the stable limit.
     pub force_dt: bool,
@@ -43,8 +65,8 @@ pub struct ReferenceRun {
     pub partial_error: Option<String>,
 }
 
-/// Writes the deck for `scene` (already coarse-grained) into `out`, runs LAMMPS there and
-/// post-processes its dumps into cgdem's output files. Returns how the run ended, with the
+/// Writes the deck for `scene` (already coarse-grained) into `out`, runs the reference code
+/// (`options.code`) there and post-processes its dumps into cgdem's output files. Returns how the run ended, with the
 /// summary when there is one (also for a timed-out, partial run).
 pub fn run_reference(
     scene: &Scene,
@@ -54,7 +76,11 @@ pub fn run_reference(
     let (dt, scales, dt_warning) =
         crate::run::time_step(scene, options.force_dt).map_err(|e| e.to_string())?;
     let particles = crate::run::initial_particles(scene, false, &[]).map_err(|e| e.to_string())?;
-    let deck = write_deck(scene, &particles, dt).map_err(|e| e.to_string())?;
+    let deck = match options.code {
+        ReferenceCode::Lammps => write_deck(scene, &particles, dt),
+        ReferenceCode::Liggghts => crate::harness::liggghts::write_deck(scene, &particles, dt),
+    }
+    .map_err(|e| e.to_string())?;
     let status = if options.postprocess_only {
         let path = out.join(deck::DECK_FILE);
         let previous = std::fs::read_to_string(&path)
@@ -69,7 +95,10 @@ pub fn run_reference(
     } else {
         deck.write_to(out)
             .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
-        run_deck(out, &options.runner)
+        match options.code {
+            ReferenceCode::Lammps => run_deck(out, &options.runner),
+            ReferenceCode::Liggghts => crate::harness::liggghts::run_deck(out, &options.runner),
+        }
     };
     let mut run = ReferenceRun {
         status,
@@ -96,7 +125,8 @@ pub fn run_reference(
     };
     if let RunStatus::TimedOut { after_s, .. } = &run.status {
         summary.warnings.push(format!(
-            "LAMMPS killed after {after_s:.0} s (time limit): partial run"
+            "{} killed after {after_s:.0} s (time limit): partial run",
+            options.code.name()
         ));
     }
     write_summary(&summary, out).map_err(|e| e.to_string())?;

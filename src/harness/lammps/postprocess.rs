@@ -1,12 +1,12 @@
-//! LAMMPS dumps turned into cgdem's outputs with cgdem's own analysis (`analysis::heap`):
-//! `timeseries.csv` (same columns), `repose.csv`, `profile.csv` and `summary.json` with
-//! `code = "lammps"`. Particle-steps per second come from LAMMPS's `Loop time` lines.
+//! LAMMPS and LIGGGHTS dumps turned into cgdem's outputs with cgdem's own analysis
+//! (`analysis::heap`): `timeseries.csv` (same columns), `repose.csv`, `profile.csv` and
+//! `summary.json` with `code` from the deck's plan. Particle-steps per second come from the
+//! `Loop time` lines of the log (the same in both codes).
 
 use std::path::{Path, PathBuf};
 
 use super::deck::{DeckPlan, TRAJECTORY_FILE};
 use super::dump::{read_dump, DumpError, Frame};
-use super::runner::LOG_FILE;
 use crate::analysis::heap::{self, HeapProfile};
 use crate::io::write_atomic;
 use crate::math::{Real, Vec3};
@@ -24,13 +24,16 @@ pub enum PostprocessError {
     Output { path: PathBuf, message: String },
 }
 
-/// Positions, radii (the species' own, not LAMMPS's contact radius), masses and velocities
-/// of one frame.
+/// Positions, radii (the species' own, not LAMMPS's contact radius), masses, velocities and,
+/// when the dump has spins, the rotational kinetic energy of one frame.
 pub struct FrameParticles {
     pub position: Vec<Vec3>,
     pub velocity: Vec<Vec3>,
     pub radius: Vec<Real>,
     pub mass: Vec<Real>,
+    /// Sum of `I omega^2 / 2` with `I = 2/5 m r^2` (0 without `omegax` columns), as cgdem's
+    /// kinetic energy counts it.
+    pub rotational_energy: Real,
 }
 
 /// Reads the per-atom state of a frame by column name, species from `type`.
@@ -52,11 +55,20 @@ pub fn frame_particles(
     let (x, y, z) = (column("x")?, column("y")?, column("z")?);
     let (vx, vy, vz) = (column("vx")?, column("vy")?, column("vz")?);
     let types = column("type")?;
+    let spins = match (
+        frame.column("omegax"),
+        frame.column("omegay"),
+        frame.column("omegaz"),
+    ) {
+        (Some(wx), Some(wy), Some(wz)) => Some((wx, wy, wz)),
+        _ => None,
+    };
     let mut out = FrameParticles {
         position: Vec::new(),
         velocity: Vec::new(),
         radius: Vec::new(),
         mass: Vec::new(),
+        rotational_energy: 0.0,
     };
     for k in 0..frame.len() {
         let t = types[k] as usize;
@@ -76,6 +88,10 @@ pub fn frame_particles(
         out.velocity.push(Vec3::new(vx[k], vy[k], vz[k]));
         out.radius.push(species.radius());
         out.mass.push(species.mass());
+        if let Some((wx, wy, wz)) = spins {
+            let w2 = wx[k] * wx[k] + wy[k] * wy[k] + wz[k] * wz[k];
+            out.rotational_energy += 0.2 * species.mass() * species.radius().powi(2) * w2;
+        }
     }
     Ok(out)
 }
@@ -137,7 +153,8 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> PostprocessError {
     }
 }
 
-/// Post-processes a finished LAMMPS run in `dir` into cgdem's output files and summary.
+/// Post-processes a finished LAMMPS or LIGGGHTS run in `dir` (the code and its log named by
+/// `plan`) into cgdem's output files and summary.
 pub fn postprocess(
     scene: &Scene,
     dir: &Path,
@@ -146,7 +163,7 @@ pub fn postprocess(
     wall_s: Real,
     ranks: usize,
 ) -> Result<RunSummary, PostprocessError> {
-    let log_path = dir.join(LOG_FILE);
+    let log_path = dir.join(plan.log_file);
     let log = std::fs::read_to_string(&log_path).map_err(|e| PostprocessError::Content {
         file: log_path.clone(),
         message: format!("cannot read: {e}"),
@@ -185,7 +202,8 @@ pub fn postprocess(
             .iter()
             .zip(&p.mass)
             .map(|(v, m)| 0.5 * m * v.length_squared())
-            .sum();
+            .sum::<Real>()
+            + p.rotational_energy;
         let mass: Real = p.mass.iter().sum();
         let profile = heap_profile(&p);
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
@@ -204,7 +222,7 @@ pub fn postprocess(
     let path = dir.join("timeseries.csv");
     write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
 
-    let mut warnings = vec!["LAMMPS caps wall friction with the wall dashpot force only, cgdem with WCA + dashpot (reference/lammps/SEED_MODEL.md claim 11)".to_string()];
+    let mut warnings = plan.notes.clone();
     let mut samples = Vec::new();
     let mut final_profile = None;
     for (_, t, file) in &plan.repose_dumps {
@@ -281,7 +299,8 @@ pub fn postprocess(
                 .unwrap_or((last_step.max(m.start), "did not finish".into()));
             if how == "did not finish" {
                 warnings.push(format!(
-                    "partial run: LAMMPS stopped during stage `{}`, {:.3} s after it began",
+                    "partial run: {} stopped during stage `{}`, {:.3} s after it began",
+                    plan.code,
                     m.name,
                     (end - m.start) as Real * dt
                 ));
@@ -312,7 +331,7 @@ pub fn postprocess(
     let headline = headline_sample(&samples);
     Ok(RunSummary {
         case: scene.name.clone(),
-        code: "lammps".into(),
+        code: plan.code.into(),
         lambda: scene.lambda,
         cg_rule: scene.cg_rule,
         deleted_particles: 0,
@@ -335,7 +354,7 @@ pub fn postprocess(
         threads: ranks,
         repose_angle_deg: headline.and_then(|s| s.repose_angle_deg),
         repose_fit_r2: headline.and_then(|s| s.repose_fit_r2),
-        repose_rule: scene.repose.as_ref().map(|r| format!("as cgdem's (analysis::heap), on the LAMMPS write_dump at {:?} s after stage `{}` began", r.at_times, r.stage)),
+        repose_rule: scene.repose.as_ref().map(|r| format!("as cgdem's (analysis::heap), on the {} write_dump at {:?} s after stage `{}` began", plan.code, r.at_times, r.stage)),
         runout_m: headline.map(|s| s.runout_m),
         repose_samples: samples,
         stages,

@@ -6,18 +6,24 @@
 //!
 //! LIGGGHTS needs `newton off`, `communicate single vel yes`, Young's modulus >= 5e6 Pa in SI
 //! units (it refuses softer materials), and an explicit dump format (default: 6 digits).
-//! Supported: what `lammps::hertz` supports (one duration stage, no wall removal).
+//! Supported: what `lammps::hertz` supports; stages, wall removal (`unfix w_NAME`) and repose
+//! samples come from `lammps::deck::stage_lines`, the same lines as the LAMMPS decks (LIGGGHTS
+//! takes LAMMPS's loop, if, print and write_dump commands), so both go through one
+//! post-processing.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::harness::lammps::deck::{
-    boundary_line, data_file, frozen_lines, g, Deck, DeckError, DeckPlan, DATA_FILE,
+    boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines, Deck, DeckError,
+    DeckPlan, StageDumps, DATA_FILE,
 };
-use crate::harness::lammps::hertz::{hertz_settings, material, wall_axis, wall_material};
+use crate::harness::lammps::hertz::{
+    hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS,
+};
 use crate::math::Real;
 use crate::particles::Particles;
-use crate::scene::{RollingKind, Scene, StageEnd};
+use crate::scene::{RollingKind, Scene};
 
 pub const DECK_FILE: &str = "deck.in";
 pub const LOG_FILE: &str = "log.liggghts";
@@ -46,10 +52,6 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         }
     }
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
-    let StageEnd::Duration(duration) = scene.stages[0].end else {
-        unreachable!("checked by hertz_settings")
-    };
-    let steps = (duration / dt).round() as u64;
 
     let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
     let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
@@ -154,21 +156,31 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             g(at)
         );
     }
-    d += "thermo          1000\nthermo_modify   lost ignore norm no\n";
-    let _ = writeln!(d, "dump            traj all custom {dump_every} {TRAJECTORY_FILE} id type x y z vx vy vz omegax omegay omegaz radius");
+    d += &kinetic_energy_lines(dump_every, true);
+    // LIGGGHTS's dump_modify format is one C format for the whole line (default: 6 digits).
+    let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
     let _ = writeln!(
         d,
-        "dump_modify     traj sort id format \"%d %d{}\"",
-        " %.17g".repeat(10)
+        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {HERTZ_COLUMNS}"
     );
-    let _ = writeln!(d, "run             {steps}");
+    let _ = writeln!(d, "dump_modify     traj {modify}");
+    let dumps = StageDumps {
+        columns: HERTZ_COLUMNS,
+        modify: &modify,
+    };
+    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &dumps, |name| {
+        format!("unfix           w_{name}\n")
+    });
     Ok(Deck {
         input: d,
         data,
         plan: DeckPlan {
+            code: "liggghts",
+            log_file: LOG_FILE,
+            notes: Vec::new(),
             dt,
             dump_every,
-            repose_dumps: Vec::new(),
+            repose_dumps,
         },
     })
 }
@@ -176,4 +188,47 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
 /// The trajectory file of a run directory.
 pub fn trajectory(dir: &Path) -> std::path::PathBuf {
     dir.join(TRAJECTORY_FILE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::harness::lammps::hertz::{at, collapse_scene_and_particle};
+
+    #[test]
+    fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {
+        let (scene, particles) = collapse_scene_and_particle();
+        let deck = write_deck(&scene, &particles, 5e-5).unwrap();
+        let d = &deck.input;
+        assert_eq!((deck.plan.code, deck.plan.log_file), ("liggghts", LOG_FILE));
+        // Walls are primitives of the extra atom type 2, each removable on its own.
+        let gate = at(d, "fix             w_gate all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 2 xplane 1.00000000000000006e-1");
+        let settle = at(d, "variable        chunk0 loop 200");
+        let settle_end = at(d, "label           end_stage0");
+        let unfix = at(d, "unfix           w_gate");
+        assert!(!d.contains("unfix           w_floor"));
+        let collapse = at(d, "CGDEM_STAGE collapse start");
+        assert!(gate < settle && settle < settle_end && settle_end < unfix && unfix < collapse);
+        at(d, "variable        kepm equal (c_ke+c_rke)/mass(all)");
+        // LIGGGHTS takes one C format per line; inside an `if`, in single quotes.
+        let format = format!("format '%d %d{}'", " %.17g".repeat(10));
+        let sample = at(d, &format!("if              \"${{chunk1}} == 25\" then \"write_dump all custom repose_0.dump id type x y z vx vy vz omegax omegay omegaz radius modify sort id {format}\""));
+        assert!(collapse < sample);
+        assert_eq!(deck.plan.repose_dumps.len(), 3);
+    }
+
+    #[test]
+    fn a_soft_material_is_refused_with_the_field_named() {
+        let (mut scene, particles) = collapse_scene_and_particle();
+        if let crate::scene::ContactSettings::Hertz(h) = &mut scene.contact {
+            h.youngs_modulus = 1e6;
+        }
+        let e = write_deck(&scene, &particles, 5e-5)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("aor_hertz.toml") && e.contains("contact.youngs_modulus = 1000000 Pa"),
+            "{e}"
+        );
+    }
 }
