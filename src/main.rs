@@ -500,6 +500,16 @@ fn main() -> ExitCode {
                             let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
                             return Ok((last, out_dir));
                         }
+                        if let Some(Sweep::ScrewRatio(ratios)) = &sweep {
+                            let results = cgdem::sweep::screw_ratio_sweep(&scene, ratios, &out_dir, quiet, force_dt, keep_going)?;
+                            for (r, s) in &results {
+                                if let Some(c) = &s.conveying {
+                                    println!("r_s/r_p = {r}: {} screw particles, {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (ratio {:.3}), wall {:.1} s", s.n_body_particles, c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.ratio_to_eq7, s.wall_s);
+                                }
+                            }
+                            let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
+                            return Ok((last, out_dir));
+                        }
                         if let Some(Sweep::Rpm(speeds)) = &sweep {
                             let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going)?;
                             for (rpm, s) in &results {
