@@ -212,6 +212,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         self.rebuild();
         self.compute_forces();
+        self.record_kinematic_loads();
         self.reset_energy_reference();
     }
 

@@ -1202,3 +1202,58 @@ impl RefillRegion {
         trial.position[before..].to_vec()
     }
 }
+
+#[cfg(test)]
+mod refill_tests {
+    use super::*;
+
+    #[test]
+    fn top_up_restores_the_count_in_the_region_without_overlap() {
+        let (r, m) = (1e-3, 1e-6);
+        let region = RefillRegion {
+            species: 0,
+            radius: r,
+            lo: Vec3::ZERO,
+            hi: Vec3::splat(0.02),
+            bvh: None,
+            overlap: 0.0,
+        };
+        let mut particles = Particles::new(false);
+        insert_random_where(
+            &mut particles,
+            0,
+            r,
+            m,
+            region.lo,
+            region.hi,
+            60,
+            7,
+            0.0,
+            |_| true,
+        )
+        .unwrap();
+        // One outside the region (not counted) and a frozen one inside (not counted).
+        particles.push(0, Vec3::splat(0.03), r, m);
+        particles.push(0, Vec3::splat(0.0105), r, m);
+        particles.freeze(particles.len() - 1);
+        assert_eq!(region.count(&particles), 60);
+        // Drain 25 of them, as the screw would.
+        let keep: Vec<bool> = (0..particles.len()).map(|k| k >= 25).collect();
+        particles.retain(&keep);
+        assert_eq!(region.count(&particles), 35);
+        let added = region.top_up(&particles, &[], 60, 11);
+        assert_eq!(added.len(), 25);
+        for (k, a) in added.iter().enumerate() {
+            assert!(a.cmpge(region.lo).all() && a.cmple(region.hi).all());
+            for b in particles.position.iter().chain(&added[..k]) {
+                assert!((*a - *b).length() >= 2.0 * r * (1.0 - 1e-12));
+            }
+        }
+        for &a in &added {
+            particles.push(0, a, r, m);
+        }
+        assert_eq!(region.count(&particles), 60);
+        // Full: nothing more.
+        assert!(region.top_up(&particles, &[], 60, 12).is_empty());
+    }
+}
