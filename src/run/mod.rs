@@ -250,8 +250,7 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
         .diameter;
     let pair = |a: usize, b: usize| WcaCoefficients {
         epsilon,
-        sigma: if scene.species[a].diameter == reference && scene.species[b].diameter == reference
-        {
+        sigma: if scene.species[a].diameter == reference && scene.species[b].diameter == reference {
             sigma
         } else {
             sigma * (scene.species[a].diameter + scene.species[b].diameter) / (2.0 * reference)
@@ -489,10 +488,9 @@ pub fn build_bodies<W: WallLaw>(
             wall_law.reach(bp.species, species.radius()),
         );
         let clear = |p: Vec3| {
-            bodies.iter().all(|o| {
-                o.query(p, reach)
-                    .is_none_or(|(d, _)| d > radius.max(reach))
-            })
+            bodies
+                .iter()
+                .all(|o| o.query(p, reach).is_none_or(|(d, _)| d > radius.max(reach)))
         };
         let kept: Vec<Vec3> = fcc_sites_inside(&mesh, species.diameter, b.point)
             .into_iter()
@@ -992,7 +990,7 @@ fn execute<L: PairLaw, W: WallLaw>(
         n_particles: world.particles.len(),
         n_particles_inserted: n_inserted,
         n_particles_refilled: refilled,
-        n_body_particles: n_body_particles,
+        n_body_particles,
         lost_particles: world.lost,
         steps: world.steps,
         dt_s: dt,
@@ -1147,9 +1145,7 @@ impl RefillRegion {
 
     /// Whether a centre lies in the region (box, and inside the mesh if there is one).
     fn contains(&self, winding: Option<&FastWindingNumber>, p: Vec3) -> bool {
-        p.cmpge(self.lo).all()
-            && p.cmple(self.hi).all()
-            && winding.is_none_or(|w| w.is_inside(p))
+        p.cmpge(self.lo).all() && p.cmple(self.hi).all() && winding.is_none_or(|w| w.is_inside(p))
     }
 
     /// Mobile particles of the species with centres in the region.
@@ -1167,7 +1163,13 @@ impl RefillRegion {
     /// Positions for as many new particles (up to `target` in the region) as random
     /// sequential addition places without overlap, inside the mesh by one radius and clear of
     /// the bodies, as the first insertion did. New particles start at rest.
-    fn top_up(&self, particles: &Particles, bodies: &[Body], target: usize, seed: u64) -> Vec<Vec3> {
+    fn top_up(
+        &self,
+        particles: &Particles,
+        bodies: &[Body],
+        target: usize,
+        seed: u64,
+    ) -> Vec<Vec3> {
         let missing = target.saturating_sub(self.count(particles));
         if missing == 0 {
             return Vec::new();

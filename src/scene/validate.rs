@@ -610,10 +610,13 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                     return Err(c.invalid(
                         format!("body[{k}].particles.species"),
                         &bp.species,
-                        format!(
-                            "a species with frozen = true (the body's particles are moved by the body, not integrated); frozen species: {}",
-                            names(species.iter().filter(|s| s.frozen).map(|s| &s.name))
-                        ),
+                        {
+                            let frozen = names(species.iter().filter(|s| s.frozen).map(|s| &s.name));
+                            format!(
+                                "a species with frozen = true (the body's particles are moved by the body, not integrated); frozen species: {}",
+                                if frozen.is_empty() { "none".to_string() } else { frozen }
+                            )
+                        },
                     ));
                 };
                 if let Some(lattice) = bp.lattice.as_deref().filter(|l| *l != "fcc") {

@@ -95,7 +95,12 @@ impl Sweep {
 /// every speed (the discharge pulses once per turn, so a window must hold whole turns).
 pub fn at_speed(scene: &Scene, body: &str, rpm: Real) -> Scene {
     let mut s = scene.clone();
-    let Some(old) = s.bodies.iter().find(|b| b.name == body).map(|b| b.rpm.abs()) else {
+    let Some(old) = s
+        .bodies
+        .iter()
+        .find(|b| b.name == body)
+        .map(|b| b.rpm.abs())
+    else {
         return s;
     };
     for b in s.bodies.iter_mut().filter(|b| b.name == body) {
