@@ -90,7 +90,7 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
 }
 
 /// The angle measured at one time after the repose stage began.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ReposeSample {
     pub time_after_start_s: Real,
     /// "fixed time" or "stage end" (the stage's own end condition).
@@ -127,7 +127,7 @@ impl ReposeSample {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct StageRecord {
     pub name: String,
     pub start_s: Real,
@@ -137,7 +137,7 @@ pub struct StageRecord {
 }
 
 /// Everything `summary.json` holds.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct RunSummary {
     pub case: String,
     pub code: String,
