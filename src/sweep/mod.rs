@@ -349,10 +349,10 @@ mod tests {
         let screw = s.bodies.iter().find(|b| b.name == "screw").unwrap();
         assert_eq!(screw.rpm, -20.0);
         let c = s.conveying.as_ref().unwrap();
-        // 100 rpm: 0.6 s discarded (1 turn) of 1.8 s (3 turns); 20 rpm: 3 s of 9 s.
-        assert!((c.discard - 3.0).abs() < 1e-12);
+        // 100 rpm: 1.2 s discarded (2 turns) of 2.4 s (4 turns); 20 rpm: 6 s of 12 s.
+        assert!((c.discard - 6.0).abs() < 1e-12);
         let convey = s.stages.iter().find(|st| st.name == "convey").unwrap();
-        assert_eq!(convey.end, StageEnd::Duration(9.0));
+        assert_eq!(convey.end, StageEnd::Duration(12.0));
         let settle = s.stages.iter().find(|st| st.name == "settle").unwrap();
         assert_eq!(settle.end, StageEnd::Duration(0.5));
     }
