@@ -38,7 +38,9 @@ pub enum CoarseGrainError {
 /// Which quantities a coarse-graining keeps. Both scale diameters by `lambda` and masses by
 /// `lambda^3` and keep the damping ratio (hence each contact's restitution); they differ in
 /// how the contact energy and the dashpots scale (derivation: reference/COARSE_GRAINING.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum CoarseGrainRule {
     /// Paper A: `phi'(r) = lambda^3 phi(r/lambda)`, `gamma' = lambda^2 gamma`,

@@ -53,7 +53,7 @@ impl Default for GuardSettings {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GuardKind {
     NonFinite,
@@ -73,7 +73,7 @@ impl GuardKind {
 
 /// A guard that fired: when, what was measured, which particles, why, and a step that would
 /// be stable.
-#[derive(Clone, Debug, PartialEq, thiserror::Error, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error, serde::Serialize, serde::Deserialize)]
 #[error("guard `{}` fired at step {step} (t = {time:.6e} s): {detail}; particles (id) {}; likely cause: {cause}; a stable time step: {}", kind.name(), format_ids(particles), format_stable(*stable_dt, *dt))]
 pub struct GuardTrip {
     pub kind: GuardKind,
@@ -149,7 +149,7 @@ pub(crate) struct GuardState {
 /// How close a run came to each guard's threshold: the largest overlap fraction seen and
 /// the largest energy rise as a fraction of the scale it is judged against (the guard fires
 /// above `energy_growth`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GuardPeaks {
     pub overlap_fraction: Real,
     pub energy_rise: Real,

@@ -64,6 +64,10 @@ enum Command {
         /// model (gravity, cohesion, rolling with Hertz), instead of warning.
         #[arg(long)]
         strict: bool,
+        /// With `--sweep rpm=` or `screw_ratio=`: a run directory whose summary.json holds
+        /// the same scene (digest) is not run again, so a sweep can be resumed or extended.
+        #[arg(long)]
+        reuse: bool,
         /// Override a scene field before validation, e.g. `--set wall_contact.friction=0.0`
         /// or `--set 'wall[2].point=[0.1, 0.0, 0.0]'` (TOML value; repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -559,6 +563,7 @@ fn main() -> ExitCode {
             force_dt,
             keep_going,
             strict,
+            reuse,
             sweep,
             set,
             variant,
@@ -602,8 +607,18 @@ fn main() -> ExitCode {
                             let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
                             return Ok((last, out_dir));
                         }
+                        if let Some(Sweep::ScrewRatio(ratios)) = &sweep {
+                            let results = cgdem::sweep::screw_ratio_sweep(&scene, ratios, &out_dir, quiet, force_dt, keep_going, reuse)?;
+                            for (r, s) in &results {
+                                if let Some(c) = &s.conveying {
+                                    println!("r_s/r_p = {r}: {} screw particles, {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (ratio {:.3}), wall {:.1} s", s.n_body_particles, c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.ratio_to_eq7, s.wall_s);
+                                }
+                            }
+                            let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
+                            return Ok((last, out_dir));
+                        }
                         if let Some(Sweep::Rpm(speeds)) = &sweep {
-                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going)?;
+                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going, reuse)?;
                             for (rpm, s) in &results {
                                 if let Some(c) = &s.conveying {
                                     println!("{rpm} rpm: {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (a = {:.3}), wall {:.1} s", c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.fill_ratio, s.wall_s);

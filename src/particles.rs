@@ -131,11 +131,14 @@ impl Particles {
 
     /// Total kinetic energy (translational plus rotational), J.
     pub fn kinetic_energy(&self) -> Real {
+        // Frozen particles moved with a body are not material: their motion is prescribed.
         let translational: Real = self
             .velocity
             .iter()
             .zip(&self.mass)
-            .map(|(v, m)| 0.5 * m * v.length_squared())
+            .zip(&self.inv_mass)
+            .filter(|(_, &inv_m)| inv_m > 0.0)
+            .map(|((v, m), _)| 0.5 * m * v.length_squared())
             .sum();
         let rotational: Real = (0..self.len()).map(|k| self.spin_energy(k)).sum();
         translational + rotational

@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use crate::bodies::{Body, BodyLoad};
+use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
@@ -23,7 +23,7 @@ use crate::walls::{WallContact, WallLaw, WallParticle, WallSet};
 const CHUNK: usize = 512;
 
 /// Bytes the world holds, from its arrays' capacities (what `cgdem bench` reports).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MemoryUse {
     pub particles: usize,
     /// Per-particle arrays: state, forces, wall history, body loads, list offsets.
@@ -62,6 +62,8 @@ pub struct World<L: PairLaw, W: WallLaw> {
     bodies: Vec<Body>,
     /// Per particle, per body (particle-major) load, reduced in fixed order after the gather.
     body_loads: Vec<BodyLoad>,
+    /// Frozen particles that move with a body (a body built of particles).
+    kinematic: Vec<KinematicParticles>,
     /// Particles whose centre enters one of these boxes are deleted (e.g. an outlet).
     delete_regions: Vec<Aabb>,
     /// Count and mass of particles deleted by `delete_regions`.
@@ -130,6 +132,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             reaction_spin: Vec::new(),
             bodies: Vec::new(),
             body_loads: Vec::new(),
+            kinematic: Vec::new(),
             delete_regions: Vec::new(),
             deleted: 0,
             deleted_mass: 0.0,
@@ -172,6 +175,69 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             }
             None => false,
         }
+    }
+
+    /// Frozen particles that move with bodies (each body's `Particles` shape); their
+    /// positions and velocities are set from the bodies' motion from the next step on.
+    pub fn set_kinematic(&mut self, kinematic: Vec<KinematicParticles>) {
+        self.kinematic = kinematic;
+    }
+
+    /// Moves the particles of bodies built of particles to the bodies' pose at time `t`:
+    /// position `c + R (q - point)`, velocity `omega x r + v` (zero before the motion
+    /// starts). They are frozen (zero inverse mass), so the integrator never changes them.
+    fn drive_kinematic_particles(&mut self, t: Real) {
+        if self.kinematic.is_empty() {
+            return;
+        }
+        self.pose_bodies_at(t);
+        let p = &mut self.particles;
+        for group in &self.kinematic {
+            let body = &self.bodies[group.body];
+            for k in 0..p.id.len() {
+                if let Some(q) = group.reference_of(p.id[k]) {
+                    let x = body.to_world(q);
+                    p.position[k] = x;
+                    p.velocity[k] = body.surface_velocity(x);
+                }
+            }
+        }
+    }
+
+    /// Adds the load of the grains on the particles of bodies built of particles (contact
+    /// force `F - m g` on each, torque about the body's axis point) to the bodies' loads,
+    /// after the force evaluation.
+    fn record_kinematic_loads(&mut self) {
+        let p = &self.particles;
+        for group in &self.kinematic {
+            let body = &mut self.bodies[group.body];
+            let mut load = BodyLoad::default();
+            for k in 0..p.id.len() {
+                if group.reference_of(p.id[k]).is_some() {
+                    let f = p.force[k] - p.mass[k] * self.gravity;
+                    load.force += f;
+                    load.torque += (p.position[k] - body.center()).cross(f);
+                }
+            }
+            body.load += load;
+        }
+    }
+
+    /// Appends mobile particles at rest (ids after the largest so far), rebuilds the pair
+    /// list and re-evaluates the forces; the energy guard takes the new state as reference.
+    pub fn add_particles(&mut self, species: u16, positions: &[Vec3], radius: Real, mass: Real) {
+        if positions.is_empty() {
+            return;
+        }
+        let next = self.particles.id.iter().max().map_or(0, |&m| m + 1);
+        for (n, &x) in positions.iter().enumerate() {
+            self.particles.push(species, x, radius, mass);
+            *self.particles.id.last_mut().expect("just pushed") = next + n as u32;
+        }
+        self.rebuild();
+        self.compute_forces();
+        self.record_kinematic_loads();
+        self.reset_energy_reference();
     }
 
     /// Boxes in which particles are deleted (checked every step).
@@ -273,6 +339,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         self.time += self.dt;
         self.steps += 1;
+        self.record_kinematic_loads();
         self.check_guards();
     }
 
@@ -286,6 +353,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 pcvv::predict_rate(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
+        self.drive_kinematic_particles(self.time + dt);
         if self.list.needs_rebuild(&self.particles.position) || self.any_in_delete_region() {
             self.rebuild();
         }
@@ -324,6 +392,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
+        self.drive_kinematic_particles(self.time + dt);
         if self.list.needs_rebuild(&self.particles.position) || self.any_in_delete_region() {
             self.rebuild();
         }

@@ -53,7 +53,7 @@ pub struct ConveyingSample {
     pub bulk_density: Real,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ConveyingSummary {
     pub stage: String,
     pub rpm: Real,

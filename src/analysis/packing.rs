@@ -14,7 +14,7 @@ use super::porosity::{bed_measurement_region, porosity_z_slab, BedRegionRule};
 use crate::math::{Real, Vec3};
 
 /// What was measured, for `summary.json`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct PackingSummary {
     pub diameter_m: Real,
     pub porosity: Real,

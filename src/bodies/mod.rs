@@ -3,8 +3,10 @@
 
 mod body;
 mod motion;
+mod particle_body;
 mod shape;
 
 pub use body::{Body, BodyLoad};
 pub use motion::Motion;
+pub use particle_body::{fcc_sites_inside, KinematicParticles};
 pub use shape::BodyShape;

@@ -12,6 +12,9 @@ pub enum BodyShape {
     Sphere(Sphere),
     Cylinder(Cylinder),
     Box(AxisAlignedBox),
+    /// No surface: a body built of particles, which act through the pair law; `bounds` holds
+    /// the particles' centres.
+    Particles(Aabb),
 }
 
 impl BodyShape {
@@ -24,6 +27,7 @@ impl BodyShape {
             BodyShape::Sphere(s) => Some((s.distance(p), s.normal(p))),
             BodyShape::Cylinder(c) => Some((c.distance(p), c.normal(p))),
             BodyShape::Box(b) => Some((b.distance(p), b.normal(p))),
+            BodyShape::Particles(_) => None,
         }
     }
 
@@ -52,6 +56,7 @@ impl BodyShape {
                 min: b.center - b.half_extents,
                 max: b.center + b.half_extents,
             },
+            BodyShape::Particles(bounds) => *bounds,
         }
     }
 }

@@ -15,7 +15,7 @@ use serde::Serialize;
 use crate::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
 use crate::analysis::heap::{self, HeapProfile};
 use crate::analysis::{measure_packing, PackingSummary};
-use crate::bodies::{Body, BodyShape, Motion};
+use crate::bodies::{fcc_sites_inside, Body, BodyShape, KinematicParticles, Motion};
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
 use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, SdfGrid};
@@ -95,7 +95,7 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
 }
 
 /// The angle measured at one time after the repose stage began.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ReposeSample {
     pub time_after_start_s: Real,
     /// "fixed time" or "stage end" (the stage's own end condition).
@@ -132,7 +132,7 @@ impl ReposeSample {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct StageRecord {
     pub name: String,
     pub start_s: Real,
@@ -142,7 +142,7 @@ pub struct StageRecord {
 }
 
 /// Everything `summary.json` holds.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct RunSummary {
     pub case: String,
     pub code: String,
@@ -150,6 +150,10 @@ pub struct RunSummary {
     pub cg_rule: crate::coarse_graining::CoarseGrainRule,
     pub n_particles: usize,
     pub n_particles_inserted: usize,
+    /// Particles added by top-ups (`[[insert]] refill`).
+    pub n_particles_refilled: u64,
+    /// Particles that make up bodies built of particles (frozen, counted in `n_particles`).
+    pub n_body_particles: usize,
     pub lost_particles: u64,
     pub steps: u64,
     pub dt_s: Real,
@@ -242,10 +246,31 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
         panic!("seed_laws needs a scene with model = \"wca\"");
     };
     let n = scene.species.len();
-    let wca = WcaCoefficients { epsilon, sigma };
-    let law = SeedModel::seed(vec![wca; n * n], vec![gamma_n; n * n], vec![gamma_t; n * n]);
-    let per_species: Vec<(WcaCoefficients, Real)> =
-        scene.species.iter().map(|s| (wca, s.mass())).collect();
+    // `sigma` belongs to the first mobile species; a pair of other diameters gets it scaled
+    // by the mean diameter (Lorentz mixing), so the cut-off `2^(1/6) sigma_ab` stays at the
+    // touching distance. Equal diameters: every pair is the scene's `sigma`.
+    let reference = scene
+        .species
+        .iter()
+        .find(|s| !s.frozen)
+        .unwrap_or(&scene.species[0])
+        .diameter;
+    let pair = |a: usize, b: usize| WcaCoefficients {
+        epsilon,
+        sigma: if scene.species[a].diameter == reference && scene.species[b].diameter == reference {
+            sigma
+        } else {
+            sigma * (scene.species[a].diameter + scene.species[b].diameter) / (2.0 * reference)
+        },
+    };
+    let table: Vec<WcaCoefficients> = (0..n * n).map(|ab| pair(ab / n, ab % n)).collect();
+    let law = SeedModel::seed(table, vec![gamma_n; n * n], vec![gamma_t; n * n]);
+    let per_species: Vec<(WcaCoefficients, Real)> = scene
+        .species
+        .iter()
+        .enumerate()
+        .map(|(a, s)| (pair(a, a), s.mass()))
+        .collect();
     let wall_law = WcaWall::new(
         &per_species,
         scene.wall_contact.restitution,
@@ -264,7 +289,13 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
     let mut contacts = Vec::new();
     for (a, sa) in scene.species.iter().enumerate() {
         for (b, sb) in scene.species.iter().enumerate().skip(a) {
-            let m_eff = sa.mass() * sb.mass() / (sa.mass() + sb.mass());
+            // Two frozen particles never meet; against a frozen one, the mobile mass moves.
+            let m_eff = match (sa.frozen, sb.frozen) {
+                (true, true) => continue,
+                (true, false) => sb.mass(),
+                (false, true) => sa.mass(),
+                (false, false) => sa.mass() * sb.mass() / (sa.mass() + sb.mass()),
+            };
             let (k, gamma) = law.linearized(a * n + b, sa.radius(), sb.radius(), m_eff);
             contacts.push(LinearContact {
                 label: format!("{}-{} particle", sa.name, sb.name),
@@ -273,7 +304,7 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
                 mass: m_eff,
             });
         }
-        if !scene.walls.is_empty() || !scene.bodies.is_empty() {
+        if !sa.frozen && (!scene.walls.is_empty() || !scene.bodies.is_empty()) {
             let (k, gamma) = wall_law.linearized(a, sa.radius(), sa.mass());
             contacts.push(LinearContact {
                 label: format!("{}-wall", sa.name),
@@ -293,8 +324,37 @@ pub fn initial_particles(
     rotation: bool,
     bodies: &[Body],
 ) -> Result<Particles, RunError> {
+    initial_particles_with_bodies(scene, rotation, bodies, &[]).map(|(p, _)| p)
+}
+
+/// As [`initial_particles`], with the particles of bodies built of particles first (`sites`:
+/// per such body, its index in `bodies` and its lattice sites), frozen, and the record that
+/// moves them with their bodies.
+pub fn initial_particles_with_bodies(
+    scene: &Scene,
+    rotation: bool,
+    bodies: &[Body],
+    sites: &[(usize, Vec<Vec3>)],
+) -> Result<(Particles, Vec<KinematicParticles>), RunError> {
     let file = scene.source.display().to_string();
     let mut particles = Particles::new(rotation);
+    let mut kinematic = Vec::new();
+    for (body, positions) in sites {
+        let Some(bp) = &scene.bodies[*body].particles else {
+            continue;
+        };
+        let species = &scene.species[bp.species];
+        let first = particles.len();
+        for &x in positions {
+            particles.push(bp.species as u16, x, species.radius(), species.mass());
+            particles.freeze(particles.len() - 1);
+        }
+        kinematic.push(KinematicParticles {
+            body: *body,
+            first_id: first as u32,
+            reference: positions.clone(),
+        });
+    }
     for (index, ins) in scene.insertions.iter().enumerate() {
         let species = &scene.species[ins.species];
         let radius = species.radius();
@@ -374,14 +434,24 @@ pub fn initial_particles(
             }
         }
     }
-    Ok(particles)
+    Ok((particles, kinematic))
 }
 
 /// The scene's bodies as SDF grids, posed at t = 0; bodies without a start stage move from
 /// the start.
-fn build_bodies(scene: &Scene) -> Result<Vec<Body>, RunError> {
+///
+/// A body built of particles gets no grid: its particles are the fcc sites inside its mesh
+/// (nearest-neighbour distance = the species' diameter, one site on the body's axis point)
+/// whose spheres are clear of every SDF body by the wall law's reach, returned with the
+/// body's index.
+#[allow(clippy::type_complexity)]
+pub fn build_bodies<W: WallLaw>(
+    scene: &Scene,
+    wall_law: &W,
+) -> Result<(Vec<Body>, Vec<(usize, Vec<Vec3>)>), RunError> {
     let file = scene.source.display().to_string();
     let mut bodies = Vec::new();
+    let mut particle_meshes = Vec::new();
     for (k, b) in scene.bodies.iter().enumerate() {
         let error = |message: String| RunError::Geometry {
             file: file.clone(),
@@ -389,19 +459,79 @@ fn build_bodies(scene: &Scene) -> Result<Vec<Body>, RunError> {
             message,
         };
         let mesh = b.mesh.load().map_err(error)?;
+        let motion = Motion::rotation_rpm(b.axis, b.point, b.rpm).with_velocity(b.velocity);
+        if b.particles.is_some() {
+            // Shape set below, once the SDF bodies exist.
+            particle_meshes.push((k, mesh));
+            let empty = Aabb {
+                min: b.point,
+                max: b.point,
+            };
+            let mut body = Body::new(b.name.clone(), BodyShape::Particles(empty), motion);
+            if b.start_stage.is_none() {
+                body.start(0.0);
+            }
+            bodies.push(body);
+            continue;
+        }
         let padding = b
             .padding
             .unwrap_or(3.0 * b.cell_size + scene.max_diameter());
         let grid =
             SdfGrid::from_mesh(&mesh, b.cell_size, padding).map_err(|e| error(e.to_string()))?;
-        let motion = Motion::rotation_rpm(b.axis, b.point, b.rpm).with_velocity(b.velocity);
         let mut body = Body::new(b.name.clone(), BodyShape::Grid(grid), motion);
         if b.start_stage.is_none() {
             body.start(0.0);
         }
         bodies.push(body);
     }
-    Ok(bodies)
+    let mut sites = Vec::new();
+    for (k, mesh) in particle_meshes {
+        let b = &scene.bodies[k];
+        let Some(bp) = &b.particles else { continue };
+        let species = &scene.species[bp.species];
+        let (radius, reach) = (
+            species.radius(),
+            wall_law.reach(bp.species, species.radius()),
+        );
+        let clear = |p: Vec3| {
+            bodies
+                .iter()
+                .all(|o| o.query(p, reach).is_none_or(|(d, _)| d > radius.max(reach)))
+        };
+        let kept: Vec<Vec3> = fcc_sites_inside(&mesh, species.diameter, b.point)
+            .into_iter()
+            .filter(|&p| clear(p))
+            .collect();
+        if kept.is_empty() {
+            return Err(RunError::Geometry {
+                file: file.clone(),
+                field: format!("body[{k}].particles"),
+                message: format!(
+                    "no fcc site of spacing {} m (the diameter of species `{}`) lies inside the mesh clear of the other bodies; use a smaller diameter",
+                    species.diameter, species.name
+                ),
+            });
+        }
+        let mut bounds = Aabb {
+            min: Vec3::splat(Real::INFINITY),
+            max: Vec3::splat(Real::NEG_INFINITY),
+        };
+        for &p in &kept {
+            bounds = bounds.grown(p);
+        }
+        let mut body = Body::new(
+            b.name.clone(),
+            BodyShape::Particles(bounds),
+            bodies[k].motion,
+        );
+        if b.start_stage.is_none() {
+            body.start(0.0);
+        }
+        bodies[k] = body;
+        sites.push((k, kept));
+    }
+    Ok((bodies, sites))
 }
 
 /// The scene's walls as planes bounded by the box.
@@ -436,18 +566,26 @@ fn execute<L: PairLaw, W: WallLaw>(
         eprintln!("warning: {w}");
     }
 
-    let bodies = build_bodies(scene)?;
+    let (bodies, body_sites) = build_bodies(scene, &wall_law)?;
     if !bodies.is_empty() && (L::NEEDS_ROTATION || W::NEEDS_ROTATION) {
         return Err(RunError::NotAvailable(format!(
             "{}: bodies (SDF walls) are implemented for the seed's model only so far; this scene's contact law rotates the particles",
             scene.source.display()
         )));
     }
-    let particles = match &options.initial_state {
-        Some(state) => state.clone(),
-        None => initial_particles(scene, L::NEEDS_ROTATION, &bodies)?,
+    let (particles, kinematic) = match &options.initial_state {
+        // A given state carries no particle-built bodies (the bench's heap has none).
+        Some(_) if !body_sites.is_empty() => {
+            return Err(RunError::NotAvailable(format!(
+                "{}: starting from a given state is not supported with particle-built bodies",
+                scene.source.display()
+            )))
+        }
+        Some(state) => (state.clone(), Vec::new()),
+        None => initial_particles_with_bodies(scene, L::NEEDS_ROTATION, &bodies, &body_sites)?,
     };
     let n_inserted = particles.len();
+    let n_body_particles: usize = kinematic.iter().map(|k| k.reference.len()).sum();
     let neighbor = NeighborSettings {
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: scene.resort_every,
@@ -472,6 +610,7 @@ fn execute<L: PairLaw, W: WallLaw>(
     let mut stopped_by: Option<GuardTrip> = None;
     if !bodies.is_empty() {
         world.set_bodies(bodies);
+        world.set_kinematic(kinematic);
     }
     world.set_delete_regions(
         scene
@@ -557,6 +696,14 @@ fn execute<L: PairLaw, W: WallLaw>(
         bar
     };
 
+    let refill_regions: Vec<(usize, RefillRegion)> = scene
+        .insertions
+        .iter()
+        .enumerate()
+        .filter(|(_, ins)| ins.refill.is_some())
+        .map(|(k, ins)| RefillRegion::new(scene, k, ins).map(|r| (k, r)))
+        .collect::<Result<_, _>>()?;
+    let mut refilled: u64 = 0;
     let started = Instant::now();
     let mut particle_steps: u64 = 0;
     let mut stages = Vec::new();
@@ -577,6 +724,18 @@ fn execute<L: PairLaw, W: WallLaw>(
         }
         progress.set_message(stage.name.clone());
         let start = world.time;
+        // Top-ups of this stage: (insertion, region, particles it held at the stage start,
+        // top-ups so far).
+        let mut refills: Vec<(usize, &RefillRegion, usize, u64)> = refill_regions
+            .iter()
+            .filter(|(k, _)| {
+                scene.insertions[*k]
+                    .refill
+                    .as_ref()
+                    .is_some_and(|r| r.stage == stage.name)
+            })
+            .map(|(k, region)| (*k, region, region.count(&world.particles), 0))
+            .collect();
         let measuring = conveying_body.filter(|(c, _)| c.stage == stage.name);
         let start_steps = world.steps;
         let (duration, settle_threshold, min_duration) = match stage.end {
@@ -622,6 +781,23 @@ fn execute<L: PairLaw, W: WallLaw>(
                     }
                 }
             }
+            for (index, region, target, done) in &mut refills {
+                let ins = &scene.insertions[*index];
+                let interval = ins.refill.as_ref().map_or(Real::INFINITY, |r| r.interval);
+                if world.time - start + 0.5 * dt >= (*done + 1) as Real * interval {
+                    *done += 1;
+                    let seed = ins.seed.wrapping_add(1_000_003 * *done);
+                    let added = region.top_up(&world.particles, world.bodies(), *target, seed);
+                    let species = &scene.species[ins.species];
+                    world.add_particles(
+                        ins.species as u16,
+                        &added,
+                        species.radius(),
+                        species.mass(),
+                    );
+                    refilled += added.len() as u64;
+                }
+            }
             if let Some((c, k)) = measuring {
                 if world.time - start >= c.discard - 0.5 * dt {
                     let body = &world.bodies()[k];
@@ -648,7 +824,12 @@ fn execute<L: PairLaw, W: WallLaw>(
                 }
                 if let Some((c, k)) = conveying_body {
                     let body = &world.bodies()[k];
+                    // The grains only: a body's own (frozen) particles are not material.
                     let p = &world.particles;
+                    let mobile: Vec<usize> = (0..p.len()).filter(|&k| !p.is_frozen(k)).collect();
+                    let position: Vec<Vec3> = mobile.iter().map(|&k| p.position[k]).collect();
+                    let radius: Vec<Real> = mobile.iter().map(|&k| p.radius[k]).collect();
+                    let mass: Vec<Real> = mobile.iter().map(|&k| p.mass[k]).collect();
                     let sample = ConveyingSample {
                         time: world.time,
                         deleted_mass: world.deleted_mass,
@@ -656,10 +837,10 @@ fn execute<L: PairLaw, W: WallLaw>(
                             c,
                             body.motion.axis,
                             body.motion.point,
-                            &p.position,
-                            &p.radius,
+                            &position,
+                            &radius,
                         ),
-                        bulk_density: conveying::bulk_density(c, &p.position, &p.mass),
+                        bulk_density: conveying::bulk_density(c, &position, &mass),
                     };
                     extra += &format!(",{:.6e},{:.6e}", sample.fill_ratio, sample.bulk_density);
                     if measuring.is_some() {
@@ -824,6 +1005,8 @@ fn execute<L: PairLaw, W: WallLaw>(
         cg_rule: scene.cg_rule,
         n_particles: world.particles.len(),
         n_particles_inserted: n_inserted,
+        n_particles_refilled: refilled,
+        n_body_particles,
         lost_particles: world.lost,
         steps: world.steps,
         dt_s: dt,
@@ -944,4 +1127,153 @@ fn write_measurements(
         write_atomic(&path, repose_csv(samples).as_bytes()).map_err(|e| output_error(&path, e))?;
     }
     Ok(())
+}
+
+/// The region of an insertion with `refill`: its box (and mesh), where it is topped up.
+struct RefillRegion {
+    species: u16,
+    radius: Real,
+    lo: Vec3,
+    hi: Vec3,
+    bvh: Option<Bvh>,
+    overlap: Real,
+}
+
+impl RefillRegion {
+    fn new(scene: &Scene, index: usize, ins: &crate::scene::Insertion) -> Result<Self, RunError> {
+        let bvh = match &ins.mesh {
+            None => None,
+            Some(source) => Some(Bvh::new(&source.load().map_err(|message| {
+                RunError::Geometry {
+                    file: scene.source.display().to_string(),
+                    field: format!("insert[{index}].mesh"),
+                    message,
+                }
+            })?)),
+        };
+        Ok(RefillRegion {
+            species: ins.species as u16,
+            radius: scene.species[ins.species].radius(),
+            lo: ins.lo,
+            hi: ins.hi,
+            bvh,
+            overlap: ins.overlap,
+        })
+    }
+
+    /// Whether a centre lies in the region (box, and inside the mesh if there is one).
+    fn contains(&self, winding: Option<&FastWindingNumber>, p: Vec3) -> bool {
+        p.cmpge(self.lo).all() && p.cmple(self.hi).all() && winding.is_none_or(|w| w.is_inside(p))
+    }
+
+    /// Mobile particles of the species with centres in the region.
+    fn count(&self, particles: &Particles) -> usize {
+        let winding = self.bvh.as_ref().map(FastWindingNumber::new);
+        (0..particles.len())
+            .filter(|&k| {
+                particles.species[k] == self.species
+                    && !particles.is_frozen(k)
+                    && self.contains(winding.as_ref(), particles.position[k])
+            })
+            .count()
+    }
+
+    /// Positions for as many new particles (up to `target` in the region) as random
+    /// sequential addition places without overlap, inside the mesh by one radius and clear of
+    /// the bodies, as the first insertion did. New particles start at rest.
+    fn top_up(
+        &self,
+        particles: &Particles,
+        bodies: &[Body],
+        target: usize,
+        seed: u64,
+    ) -> Vec<Vec3> {
+        let missing = target.saturating_sub(self.count(particles));
+        if missing == 0 {
+            return Vec::new();
+        }
+        let winding = self.bvh.as_ref().map(FastWindingNumber::new);
+        let radius = self.radius;
+        let accept = |p: Vec3| {
+            if let (Some(bvh), Some(winding)) = (&self.bvh, &winding) {
+                if !winding.is_inside(p) || bvh.nearest_within(p, radius).is_some() {
+                    return false;
+                }
+            }
+            bodies
+                .iter()
+                .all(|b| b.query(p, radius).is_none_or(|(d, _)| d > radius))
+        };
+        let mut trial = particles.clone();
+        let before = trial.len();
+        // Fewer than `missing` when the region has no more room: the rest next time.
+        let _ = insert_random_where(
+            &mut trial,
+            self.species,
+            radius,
+            1.0,
+            self.lo,
+            self.hi,
+            missing as u64,
+            seed,
+            self.overlap,
+            accept,
+        );
+        trial.position[before..].to_vec()
+    }
+}
+
+#[cfg(test)]
+mod refill_tests {
+    use super::*;
+
+    #[test]
+    fn top_up_restores_the_count_in_the_region_without_overlap() {
+        let (r, m) = (1e-3, 1e-6);
+        let region = RefillRegion {
+            species: 0,
+            radius: r,
+            lo: Vec3::ZERO,
+            hi: Vec3::splat(0.02),
+            bvh: None,
+            overlap: 0.0,
+        };
+        let mut particles = Particles::new(false);
+        insert_random_where(
+            &mut particles,
+            0,
+            r,
+            m,
+            region.lo,
+            region.hi,
+            60,
+            7,
+            0.0,
+            |_| true,
+        )
+        .unwrap();
+        // One outside the region (not counted) and a frozen one inside (not counted).
+        particles.push(0, Vec3::splat(0.03), r, m);
+        particles.push(0, Vec3::splat(0.0105), r, m);
+        particles.freeze(particles.len() - 1);
+        assert_eq!(region.count(&particles), 60);
+        // Drain 25 of them, as the screw would.
+        let keep: Vec<bool> = (0..particles.len()).map(|k| k >= 25).collect();
+        particles.retain(&keep);
+        assert_eq!(region.count(&particles), 35);
+        let added = region.top_up(&particles, &[], 60, 11);
+        assert_eq!(added.len(), 25);
+        for (k, a) in added.iter().enumerate() {
+            assert!(a.cmpge(region.lo).all() && a.cmple(region.hi).all());
+            for b in particles.position.iter().chain(&added[..k]) {
+                assert!((*a - *b).length() >= 2.0 * r * (1.0 - 1e-12));
+            }
+        }
+        for &a in &added {
+            particles.push(0, a, r, m);
+        }
+        assert_eq!(region.count(&particles), 60);
+        // Full: nothing more.
+        assert!(region.top_up(&particles, &[], 60, 12).is_empty());
+    }
 }

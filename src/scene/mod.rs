@@ -165,6 +165,26 @@ pub struct Insertion {
     /// Overlap allowed between inserted particles, as a fraction of the sum of their radii
     /// (0: none; stability tests use it to start from a compressed packing).
     pub overlap: Real,
+    /// Keep the region topped up (e.g. a hopper, so the feed stays flooded).
+    pub refill: Option<Refill>,
+}
+
+/// Top-up of an insertion region: from the start of `stage`, every `interval` seconds, new
+/// particles are inserted at random (no overlap) in the region until it again holds as many
+/// particles of the species as it did when the stage began.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Refill {
+    /// s of simulated time between top-ups.
+    pub interval: Real,
+    pub stage: String,
+}
+
+/// A body built of particles of a frozen species on an fcc lattice fitted inside its mesh
+/// (paper A sec. 4), moving with the body's prescribed motion.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyParticles {
+    /// Index into `Scene::species` (a frozen species).
+    pub species: usize,
 }
 
 /// Where a triangle mesh comes from: an STL file (path relative to the scene file) or, with
@@ -203,7 +223,10 @@ impl MeshSource {
 pub struct BodySettings {
     pub name: String,
     pub mesh: MeshSource,
+    /// SDF grid spacing, m (unused for a body built of particles).
     pub cell_size: Real,
+    /// `Some`: the body is built of particles instead of an SDF grid.
+    pub particles: Option<BodyParticles>,
     /// Grid padding around the mesh; `None`: 3 cells plus the largest particle diameter.
     pub padding: Option<Real>,
     pub rpm: Real,

@@ -54,8 +54,9 @@ pub struct RawPacking {
 pub struct RawBody {
     pub name: String,
     pub mesh: String,
-    pub cell_size: f64,
+    pub cell_size: Option<f64>,
     pub padding: Option<f64>,
+    pub particles: Option<RawBodyParticles>,
     #[serde(default)]
     pub rpm: f64,
     pub axis: Option<[f64; 3]>,
@@ -182,6 +183,23 @@ pub struct RawInsertion {
     pub spacing: Option<f64>,
     pub origin: Option<[f64; 3]>,
     pub radius: Option<f64>,
+    pub refill: Option<RawRefill>,
+}
+
+/// `[[body]] particles = { species = "...", lattice = "fcc" }`: a body built of particles.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBodyParticles {
+    pub species: String,
+    pub lattice: Option<String>,
+}
+
+/// `[[insert]] refill = { interval = 0.1, stage = "..." }`: top the region up.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRefill {
+    pub interval: f64,
+    pub stage: String,
 }
 
 #[derive(Debug, Deserialize)]

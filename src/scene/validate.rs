@@ -160,8 +160,9 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 )?,
             )?;
             // The WCA cut-off 2^(1/6) sigma is the particle diameter (paper A); a mismatch
-            // would make particles touch before or after they repel.
-            for s in &species {
+            // would make particles touch before or after they repel. Frozen species (e.g. a
+            // body's particles) get sigma mixed by the mean diameter of each pair instead.
+            for s in species.iter().filter(|s| !s.frozen) {
                 let rc = TWO_POW_ONE_SIXTH * sigma;
                 if (rc / s.diameter - 1.0).abs() > 0.01 {
                     return Err(c.invalid("contact.sigma", sigma, format!("2^(1/6) sigma within 1% of the diameter of species `{}` ({} m), i.e. sigma near {:.6e}", s.name, s.diameter, s.diameter / TWO_POW_ONE_SIXTH)));
@@ -393,7 +394,34 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 ))
             }
         };
+        let refill = match &ins.refill {
+            None => None,
+            Some(r) => {
+                if !raw.stages.iter().any(|s| s.name == r.stage) {
+                    return Err(c.invalid(
+                        format!("insert[{k}].refill.stage"),
+                        &r.stage,
+                        format!(
+                            "one of the stages: {}",
+                            names(raw.stages.iter().map(|s| &s.name))
+                        ),
+                    ));
+                }
+                if matches!(amount, InsertAmount::Lattice(_)) {
+                    return Err(c.invalid(
+                        format!("insert[{k}].refill"),
+                        "given with lattice",
+                        "refill only for a random insertion (count or solid_volume)",
+                    ));
+                }
+                Some(Refill {
+                    interval: c.positive(&format!("insert[{k}].refill.interval"), r.interval)?,
+                    stage: r.stage.clone(),
+                })
+            }
+        };
         insertions.push(Insertion {
+            refill,
             species: species_index,
             lo: ilo,
             hi: ihi,
@@ -574,10 +602,56 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 "a non-zero vector",
             ));
         }
+        let particles = match &b.particles {
+            None => None,
+            Some(bp) => {
+                let index = species.iter().position(|s| s.name == bp.species);
+                let Some(index) = index.filter(|&i| species[i].frozen) else {
+                    return Err(c.invalid(
+                        format!("body[{k}].particles.species"),
+                        &bp.species,
+                        {
+                            let frozen = names(species.iter().filter(|s| s.frozen).map(|s| &s.name));
+                            format!(
+                                "a species with frozen = true (the body's particles are moved by the body, not integrated); frozen species: {}",
+                                if frozen.is_empty() { "none".to_string() } else { frozen }
+                            )
+                        },
+                    ));
+                };
+                if let Some(lattice) = bp.lattice.as_deref().filter(|l| *l != "fcc") {
+                    return Err(c.invalid(
+                        format!("body[{k}].particles.lattice"),
+                        lattice,
+                        "\"fcc\" (the default)",
+                    ));
+                }
+                if b.cell_size.is_some() || b.padding.is_some() {
+                    return Err(c.invalid(
+                        format!("body[{k}].cell_size"),
+                        "given with particles",
+                        "no cell_size or padding for a body built of particles (it has no SDF grid)",
+                    ));
+                }
+                Some(BodyParticles { species: index })
+            }
+        };
+        let cell_size = match (&particles, b.cell_size) {
+            (Some(_), _) => 0.0,
+            (None, Some(cell)) => c.positive(&format!("body[{k}].cell_size"), cell)?,
+            (None, None) => {
+                return Err(c.invalid(
+                    format!("body[{k}].cell_size"),
+                    "missing",
+                    "the SDF grid spacing, m (or particles = { species = ..., lattice = \"fcc\" } for a body built of particles)",
+                ))
+            }
+        };
         bodies.push(BodySettings {
             name: b.name.clone(),
             mesh: mesh_source(&b.mesh, file),
-            cell_size: c.positive(&format!("body[{k}].cell_size"), b.cell_size)?,
+            cell_size,
+            particles,
             padding: b
                 .padding
                 .map(|p| c.positive(&format!("body[{k}].padding"), p))

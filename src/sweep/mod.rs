@@ -6,13 +6,12 @@
 //!   beside the published values and pore-size distributions (paper B Fig. 2).
 
 use std::path::Path;
-use std::time::Instant;
 
 use crate::io::write_atomic;
 use crate::math::Real;
 use crate::report::{write_figure, Figure, Series, SeriesStyle};
 use crate::run::{run, RunOptions, RunSummary};
-use crate::scene::Scene;
+use crate::scene::{Scene, StageEnd};
 
 mod diameter;
 pub use diameter::{
@@ -26,11 +25,13 @@ pub enum Sweep {
     Rpm(Vec<Real>),
     /// Particle diameters, m.
     Diameter(Vec<Real>),
+    /// Screw-particle radius over grain radius, r_s / r_p, of a body built of particles.
+    ScrewRatio(Vec<Real>),
 }
 
 /// The keys `--sweep` knows, with what their values mean.
 pub const SWEEP_KEYS: &str =
-    "rpm (screw speeds, rev/min, > 0) or diameter (particle diameters, m, > 0)";
+    "rpm (screw speeds, rev/min, > 0), diameter (particle diameters, m, > 0) or screw_ratio (r_s / r_p of a particle-built screw, > 0)";
 
 /// A bad `--sweep` argument; the message names the option, the key and the value.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -58,6 +59,7 @@ impl Sweep {
         let unit = match key {
             "rpm" => "rev/min",
             "diameter" => "m",
+            "screw_ratio" => "r_s / r_p",
             _ => return Err(SweepError::UnknownKey(key.to_string())),
         };
         let bad = |value: &str, allowed: String| SweepError::BadValue {
@@ -81,12 +83,69 @@ impl Sweep {
         }
         Ok(match key {
             "rpm" => Sweep::Rpm(values),
+            "screw_ratio" => Sweep::ScrewRatio(values),
             _ => Sweep::Diameter(values),
         })
     }
 }
 
-/// Runs `scene` once per speed (|rpm|; the scene's sense of rotation is kept) into
+/// Runs `scene` into `options.out_dir`, or with `reuse`, takes the run already there when its
+/// `summary.json` holds this very scene (same digest) and a conveying measurement.
+fn run_or_reuse(scene: &Scene, options: &RunOptions, reuse: bool) -> Result<RunSummary, String> {
+    if reuse {
+        let path = options.out_dir.join("summary.json");
+        if let Some(summary) = std::fs::read_to_string(&path)
+            .ok()
+            .and_then(|text| serde_json::from_str::<RunSummary>(&text).ok())
+            .filter(|s| s.scene_digest == scene.digest() && s.conveying.is_some())
+        {
+            eprintln!("reusing {}", path.display());
+            return Ok(summary);
+        }
+    }
+    run(scene, options).map_err(|e| e.to_string())
+}
+
+/// `scene` with the conveying body at `rpm` (its sense kept) and the conveying stage's
+/// duration and `discard` scaled by `|rpm_scene| / rpm`: the same number of screw turns at
+/// every speed (the discharge pulses once per turn, so a window must hold whole turns).
+pub fn at_speed(scene: &Scene, body: &str, rpm: Real) -> Scene {
+    let mut s = scene.clone();
+    let Some(old) = s
+        .bodies
+        .iter()
+        .find(|b| b.name == body)
+        .map(|b| b.rpm.abs())
+    else {
+        return s;
+    };
+    for b in s.bodies.iter_mut().filter(|b| b.name == body) {
+        b.rpm = if b.rpm < 0.0 { -rpm.abs() } else { rpm.abs() };
+    }
+    if old > 0.0 {
+        let factor = old / rpm.abs();
+        if let Some(c) = &mut s.conveying {
+            c.discard *= factor;
+            for stage in s.stages.iter_mut().filter(|st| st.name == c.stage) {
+                match &mut stage.end {
+                    StageEnd::Duration(d) => *d *= factor,
+                    StageEnd::Settled {
+                        min_duration,
+                        max_duration,
+                        ..
+                    } => {
+                        *min_duration *= factor;
+                        *max_duration *= factor;
+                    }
+                }
+            }
+        }
+    }
+    s
+}
+
+/// Runs `scene` once per speed (|rpm|; the scene's sense of rotation kept, the conveying
+/// stage and its discarded start-up scaled to the same number of turns, [`at_speed`]) into
 /// `out/rpm<N>/`, then writes `out/mass_flow_vs_rpm.csv` and the plot `out/mass_flow_vs_rpm_plot.png|svg|csv`.
 pub fn rpm_sweep(
     scene: &Scene,
@@ -95,6 +154,7 @@ pub fn rpm_sweep(
     quiet: bool,
     force_dt: bool,
     keep_going: bool,
+    reuse: bool,
 ) -> Result<Vec<(Real, RunSummary)>, String> {
     let body = scene
         .conveying
@@ -109,10 +169,7 @@ pub fn rpm_sweep(
     let mut results = Vec::new();
     let mut csv = String::from("rpm,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,drive_torque_nm,drive_power_w,wall_s\n");
     for &rpm in speeds {
-        let mut s = scene.clone();
-        for b in s.bodies.iter_mut().filter(|b| b.name == body) {
-            b.rpm = if b.rpm < 0.0 { -rpm.abs() } else { rpm.abs() };
-        }
+        let s = at_speed(scene, &body, rpm);
         let options = RunOptions {
             out_dir: out.join(format!("rpm{rpm}")),
             quiet,
@@ -120,9 +177,8 @@ pub fn rpm_sweep(
             keep_going,
             ..Default::default()
         };
-        let started = Instant::now();
-        let summary = run(&s, &options).map_err(|e| e.to_string())?;
-        let wall = started.elapsed().as_secs_f64();
+        let summary = run_or_reuse(&s, &options, reuse)?;
+        let wall = summary.wall_s;
         let c = summary.conveying.as_ref();
         let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
         csv += &format!(
@@ -180,9 +236,128 @@ pub fn rpm_sweep(
     Ok(results)
 }
 
+/// Runs a scene whose conveying body is built of particles once per r_s / r_p (the body's
+/// species diameter set to the ratio times the first mobile species' diameter) into
+/// `out/ratio<R>/`, then writes `out/mass_flow_vs_screw_ratio.csv` and the plot
+/// `out/mass_flow_vs_screw_ratio_plot.png|svg|csv` (paper A Fig. 4).
+pub fn screw_ratio_sweep(
+    scene: &Scene,
+    ratios: &[Real],
+    out: &Path,
+    quiet: bool,
+    force_dt: bool,
+    keep_going: bool,
+    reuse: bool,
+) -> Result<Vec<(Real, RunSummary)>, String> {
+    let file = scene.source.display();
+    let c = scene
+        .conveying
+        .as_ref()
+        .ok_or_else(|| format!("{file}: --sweep screw_ratio needs a [conveying] section"))?;
+    let screw_species = scene
+        .bodies
+        .iter()
+        .find(|b| b.name == c.body)
+        .and_then(|b| b.particles.as_ref())
+        .map(|p| p.species)
+        .ok_or_else(|| {
+            format!(
+                "{file}: --sweep screw_ratio needs the conveying body `{}` built of particles (particles = {{ species = ..., lattice = \"fcc\" }})",
+                c.body
+            )
+        })?;
+    let grain = scene
+        .species
+        .iter()
+        .find(|s| !s.frozen)
+        .map(|s| s.diameter)
+        .ok_or_else(|| format!("{file}: --sweep screw_ratio: no mobile species"))?;
+    let mut results = Vec::new();
+    let mut csv = String::from("screw_ratio,screw_particles,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,ratio_to_eq7,drive_torque_nm,wall_s\n");
+    for &ratio in ratios {
+        let mut s = scene.clone();
+        s.species[screw_species].diameter = ratio * grain;
+        let options = RunOptions {
+            out_dir: out.join(format!("ratio{ratio}")),
+            quiet,
+            force_dt,
+            keep_going,
+            ..Default::default()
+        };
+        let summary = run_or_reuse(&s, &options, reuse)?;
+        let wall = summary.wall_s;
+        let c = summary.conveying.as_ref();
+        let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+        csv += &format!(
+            "{ratio},{},{},{},{},{},{},{},{},{},{wall:.1}\n",
+            summary.n_body_particles,
+            f(c.map(|c| c.mass_flow_kg_s)),
+            f(c.map(|c| c.mass_flow_std_error_kg_s)),
+            f(c.map(|c| c.fill_ratio)),
+            f(c.map(|c| c.bulk_density_kg_m3)),
+            f(c.map(|c| c.eq7_mass_flow_kg_s)),
+            f(c.map(|c| c.eq7_full_mass_flow_kg_s)),
+            f(c.map(|c| c.ratio_to_eq7)),
+            f(c.map(|c| c.drive_torque_nm)),
+        );
+        let path = out.join("mass_flow_vs_screw_ratio.csv");
+        write_atomic(&path, csv.as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        results.push((ratio, summary));
+    }
+    let points = |v: &dyn Fn(&crate::analysis::conveying::ConveyingSummary) -> Real| {
+        results
+            .iter()
+            .filter_map(|(r, s)| s.conveying.as_ref().map(|c| (*r, v(c))))
+            .collect::<Vec<_>>()
+    };
+    let errors: Vec<Real> = points(&|c| c.mass_flow_std_error_kg_s)
+        .iter()
+        .map(|p| p.1)
+        .collect();
+    let fig = Figure::new(
+        "Particle-built screw at 100 rpm: mass flow vs screw-particle size",
+        "r_s / r_p",
+        "mass flow (kg/s)",
+    )
+    .with_series(
+        Series::new("DEM (particle screw)", points(&|c| c.mass_flow_kg_s))
+            .style(SeriesStyle::Markers)
+            .y_err(errors),
+    )
+    .with_series(
+        Series::new(
+            "Eq. (7), measured a and bulk density",
+            points(&|c| c.eq7_mass_flow_kg_s),
+        )
+        .style(SeriesStyle::Line),
+    )
+    .with_series(
+        Series::new("Eq. (7), a = 1", points(&|c| c.eq7_full_mass_flow_kg_s))
+            .style(SeriesStyle::Dashed),
+    );
+    write_figure(out, "mass_flow_vs_screw_ratio_plot", &fig).map_err(|e| e.to_string())?;
+    Ok(results)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_speed_sweep_runs_the_same_turns_at_every_speed() {
+        let scene = Scene::load(Path::new("validation/cases/screw_feeder_nightly.toml")).unwrap();
+        let s = at_speed(&scene, "screw", 20.0);
+        let screw = s.bodies.iter().find(|b| b.name == "screw").unwrap();
+        assert_eq!(screw.rpm, -20.0);
+        let c = s.conveying.as_ref().unwrap();
+        // 100 rpm: 1.2 s discarded (2 turns) of 2.4 s (4 turns); 20 rpm: 6 s of 12 s.
+        assert!((c.discard - 6.0).abs() < 1e-12);
+        let convey = s.stages.iter().find(|st| st.name == "convey").unwrap();
+        assert_eq!(convey.end, StageEnd::Duration(12.0));
+        let settle = s.stages.iter().find(|st| st.name == "settle").unwrap();
+        assert_eq!(settle.end, StageEnd::Duration(0.5));
+    }
 
     #[test]
     fn sweep_lists_parse_with_their_key() {

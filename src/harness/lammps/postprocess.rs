@@ -342,6 +342,8 @@ pub fn postprocess(
         packing: None,
         n_particles: n_final,
         n_particles_inserted: n_inserted,
+        n_particles_refilled: 0,
+        n_body_particles: 0,
         lost_particles: (n_inserted - n_final.min(n_inserted)) as u64,
         steps,
         dt_s: dt,
