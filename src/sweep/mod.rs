@@ -166,74 +166,19 @@ pub fn rpm_sweep(
                 scene.source.display()
             )
         })?;
-    let mut results = Vec::new();
-    let mut csv = String::from("rpm,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,drive_torque_nm,drive_power_w,wall_s\n");
-    for &rpm in speeds {
-        let s = at_speed(scene, &body, rpm);
-        let options = RunOptions {
-            out_dir: out.join(format!("rpm{rpm}")),
-            quiet,
-            force_dt,
-            keep_going,
-            ..Default::default()
-        };
-        let summary = run_or_reuse(&s, &options, reuse)?;
-        let wall = summary.wall_s;
-        let c = summary.conveying.as_ref();
-        let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-        csv += &format!(
-            "{rpm},{},{},{},{},{},{},{},{},{wall:.1}\n",
-            f(c.map(|c| c.mass_flow_kg_s)),
-            f(c.map(|c| c.mass_flow_std_error_kg_s)),
-            f(c.map(|c| c.fill_ratio)),
-            f(c.map(|c| c.bulk_density_kg_m3)),
-            f(c.map(|c| c.eq7_mass_flow_kg_s)),
-            f(c.map(|c| c.eq7_full_mass_flow_kg_s)),
-            f(c.map(|c| c.drive_torque_nm)),
-            f(c.map(|c| c.drive_power_w)),
-        );
-        write_atomic(&out.join("mass_flow_vs_rpm.csv"), csv.as_bytes()).map_err(|e| {
-            format!(
-                "cannot write {}: {e}",
-                out.join("mass_flow_vs_rpm.csv").display()
-            )
-        })?;
-        results.push((rpm, summary));
-    }
-    let points = |v: &dyn Fn(&crate::analysis::conveying::ConveyingSummary) -> Real| {
-        results
-            .iter()
-            .filter_map(|(rpm, s)| s.conveying.as_ref().map(|c| (*rpm, v(c))))
-            .collect::<Vec<_>>()
-    };
-    let measured = points(&|c| c.mass_flow_kg_s);
-    let errors: Vec<Real> = points(&|c| c.mass_flow_std_error_kg_s)
+    let variants = speeds
         .iter()
-        .map(|p| p.1)
+        .map(|&rpm| (rpm, at_speed(scene, &body, rpm)))
         .collect();
-    let fig = Figure::new(
-        "Screw feeder: mass flow vs speed",
-        "screw speed (rpm)",
-        "mass flow (kg/s)",
-    )
-    .with_series(
-        Series::new("DEM (SDF screw)", measured)
-            .style(SeriesStyle::Markers)
-            .y_err(errors),
-    )
-    .with_series(
-        Series::new(
-            "Eq. (7), measured a and bulk density",
-            points(&|c| c.eq7_mass_flow_kg_s),
-        )
-        .style(SeriesStyle::Line),
-    )
-    .with_series(
-        Series::new("Eq. (7), a = 1", points(&|c| c.eq7_full_mass_flow_kg_s))
-            .style(SeriesStyle::Dashed),
-    );
-    write_figure(out, "mass_flow_vs_rpm_plot", &fig).map_err(|e| e.to_string())?;
-    Ok(results)
+    let sweep = ConveyingSweep {
+        variable: "rpm",
+        run_prefix: "rpm",
+        name: "mass_flow_vs_rpm",
+        title: "Screw feeder: mass flow vs speed",
+        x_label: "screw speed (rpm)",
+        dem_label: "DEM (SDF screw)",
+    };
+    sweep.run(variants, out, quiet, force_dt, keep_going, reuse)
 }
 
 /// Runs a scene whose conveying body is built of particles once per r_s / r_p (the body's
@@ -272,72 +217,111 @@ pub fn screw_ratio_sweep(
         .find(|s| !s.frozen)
         .map(|s| s.diameter)
         .ok_or_else(|| format!("{file}: --sweep screw_ratio: no mobile species"))?;
-    let mut results = Vec::new();
-    let mut csv = String::from("screw_ratio,screw_particles,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,ratio_to_eq7,drive_torque_nm,wall_s\n");
-    for &ratio in ratios {
-        let mut s = scene.clone();
-        s.species[screw_species].diameter = ratio * grain;
-        let options = RunOptions {
-            out_dir: out.join(format!("ratio{ratio}")),
-            quiet,
-            force_dt,
-            keep_going,
-            ..Default::default()
-        };
-        let summary = run_or_reuse(&s, &options, reuse)?;
-        let wall = summary.wall_s;
-        let c = summary.conveying.as_ref();
-        let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-        csv += &format!(
-            "{ratio},{},{},{},{},{},{},{},{},{},{wall:.1}\n",
-            summary.n_body_particles,
-            f(c.map(|c| c.mass_flow_kg_s)),
-            f(c.map(|c| c.mass_flow_std_error_kg_s)),
-            f(c.map(|c| c.fill_ratio)),
-            f(c.map(|c| c.bulk_density_kg_m3)),
-            f(c.map(|c| c.eq7_mass_flow_kg_s)),
-            f(c.map(|c| c.eq7_full_mass_flow_kg_s)),
-            f(c.map(|c| c.ratio_to_eq7)),
-            f(c.map(|c| c.drive_torque_nm)),
-        );
-        let path = out.join("mass_flow_vs_screw_ratio.csv");
-        write_atomic(&path, csv.as_bytes())
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        results.push((ratio, summary));
-    }
-    let points = |v: &dyn Fn(&crate::analysis::conveying::ConveyingSummary) -> Real| {
-        results
-            .iter()
-            .filter_map(|(r, s)| s.conveying.as_ref().map(|c| (*r, v(c))))
-            .collect::<Vec<_>>()
-    };
-    let errors: Vec<Real> = points(&|c| c.mass_flow_std_error_kg_s)
+    let variants = ratios
         .iter()
-        .map(|p| p.1)
+        .map(|&ratio| {
+            let mut s = scene.clone();
+            s.species[screw_species].diameter = ratio * grain;
+            (ratio, s)
+        })
         .collect();
-    let fig = Figure::new(
-        "Particle-built screw at 100 rpm: mass flow vs screw-particle size",
-        "r_s / r_p",
-        "mass flow (kg/s)",
-    )
-    .with_series(
-        Series::new("DEM (particle screw)", points(&|c| c.mass_flow_kg_s))
-            .style(SeriesStyle::Markers)
-            .y_err(errors),
-    )
-    .with_series(
-        Series::new(
-            "Eq. (7), measured a and bulk density",
-            points(&|c| c.eq7_mass_flow_kg_s),
-        )
-        .style(SeriesStyle::Line),
-    )
-    .with_series(
-        Series::new("Eq. (7), a = 1", points(&|c| c.eq7_full_mass_flow_kg_s))
-            .style(SeriesStyle::Dashed),
-    );
-    write_figure(out, "mass_flow_vs_screw_ratio_plot", &fig).map_err(|e| e.to_string())?;
-    Ok(results)
+    let sweep = ConveyingSweep {
+        variable: "screw_ratio",
+        run_prefix: "ratio",
+        name: "mass_flow_vs_screw_ratio",
+        title: "Particle-built screw at 100 rpm: mass flow vs screw-particle size",
+        x_label: "r_s / r_p",
+        dem_label: "DEM (particle screw)",
+    };
+    sweep.run(variants, out, quiet, force_dt, keep_going, reuse)
+}
+
+/// A sweep of a conveying scene over one variable: one run per value into
+/// `out/<run_prefix><value>/`, the table `out/<name>.csv` (rewritten after every run, so an
+/// interrupted sweep keeps what it measured) and the plot `out/<name>_plot.png|svg|csv`
+/// against Eq. (7).
+struct ConveyingSweep {
+    /// The CSV's first column.
+    variable: &'static str,
+    run_prefix: &'static str,
+    name: &'static str,
+    title: &'static str,
+    x_label: &'static str,
+    dem_label: &'static str,
+}
+
+impl ConveyingSweep {
+    fn run(
+        &self,
+        variants: Vec<(Real, Scene)>,
+        out: &Path,
+        quiet: bool,
+        force_dt: bool,
+        keep_going: bool,
+        reuse: bool,
+    ) -> Result<Vec<(Real, RunSummary)>, String> {
+        let mut results = Vec::new();
+        let mut csv = format!("{},screw_particles,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,ratio_to_eq7,drive_torque_nm,drive_power_w,wall_s\n", self.variable);
+        let path = out.join(format!("{}.csv", self.name));
+        for (x, scene) in variants {
+            let options = RunOptions {
+                out_dir: out.join(format!("{}{x}", self.run_prefix)),
+                quiet,
+                force_dt,
+                keep_going,
+                ..Default::default()
+            };
+            let summary = run_or_reuse(&scene, &options, reuse)?;
+            let c = summary.conveying.as_ref();
+            let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+            csv += &format!(
+                "{x},{},{},{},{},{},{},{},{},{},{},{:.1}\n",
+                summary.n_body_particles,
+                f(c.map(|c| c.mass_flow_kg_s)),
+                f(c.map(|c| c.mass_flow_std_error_kg_s)),
+                f(c.map(|c| c.fill_ratio)),
+                f(c.map(|c| c.bulk_density_kg_m3)),
+                f(c.map(|c| c.eq7_mass_flow_kg_s)),
+                f(c.map(|c| c.eq7_full_mass_flow_kg_s)),
+                f(c.map(|c| c.ratio_to_eq7)),
+                f(c.map(|c| c.drive_torque_nm)),
+                f(c.map(|c| c.drive_power_w)),
+                summary.wall_s,
+            );
+            write_atomic(&path, csv.as_bytes())
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            results.push((x, summary));
+        }
+        let points = |v: &dyn Fn(&crate::analysis::conveying::ConveyingSummary) -> Real| {
+            results
+                .iter()
+                .filter_map(|(x, s)| s.conveying.as_ref().map(|c| (*x, v(c))))
+                .collect::<Vec<_>>()
+        };
+        let errors: Vec<Real> = points(&|c| c.mass_flow_std_error_kg_s)
+            .iter()
+            .map(|p| p.1)
+            .collect();
+        let fig = Figure::new(self.title, self.x_label, "mass flow (kg/s)")
+            .with_series(
+                Series::new(self.dem_label, points(&|c| c.mass_flow_kg_s))
+                    .style(SeriesStyle::Markers)
+                    .y_err(errors),
+            )
+            .with_series(
+                Series::new(
+                    "Eq. (7), measured a and bulk density",
+                    points(&|c| c.eq7_mass_flow_kg_s),
+                )
+                .style(SeriesStyle::Line),
+            )
+            .with_series(
+                Series::new("Eq. (7), a = 1", points(&|c| c.eq7_full_mass_flow_kg_s))
+                    .style(SeriesStyle::Dashed),
+            );
+        write_figure(out, &format!("{}_plot", self.name), &fig).map_err(|e| e.to_string())?;
+        Ok(results)
+    }
 }
 
 #[cfg(test)]
