@@ -13,7 +13,7 @@ use cgdem::contact::tangential::Mindlin;
 use cgdem::contact::{ContactLaw, PairLaw, SeedModel};
 use cgdem::domain::Domain;
 use cgdem::geometry::{sphere_mesh, SdfGrid};
-use cgdem::insertion::insert_random;
+use cgdem::insertion::insert_random_where;
 use cgdem::integrate::drift_kick;
 use cgdem::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem::particles::Particles;
@@ -35,31 +35,22 @@ fn packed_bed(rotation: bool) -> (Particles, Domain) {
     let mut particles = Particles::new(rotation);
     let mass = DENSITY * std::f64::consts::PI / 6.0 * DIAMETER.powi(3);
     let mut placed = Particles::new(rotation);
-    insert_random(
-        &mut placed,
-        0,
-        0.5 * DIAMETER,
-        mass,
-        domain.lo,
-        domain.hi,
-        4000,
-        7,
-    )
-    .unwrap();
-    // A second, denser pass: overlapping inserts stand in for a compressed bed.
-    cgdem::insertion::insert_random_where(
-        &mut placed,
-        0,
-        0.5 * DIAMETER,
-        mass,
-        domain.lo,
-        domain.hi,
-        4000,
-        8,
-        0.02,
-        |_| true,
-    )
-    .unwrap();
+    // Half without overlap, half overlapping by up to 2%: a compressed bed, many pairs touch.
+    for (seed, overlap) in [(7, 0.0), (8, 0.02)] {
+        insert_random_where(
+            &mut placed,
+            0,
+            0.5 * DIAMETER,
+            mass,
+            domain.lo,
+            domain.hi,
+            4000,
+            seed,
+            overlap,
+            |_| true,
+        )
+        .unwrap();
+    }
     for k in 0..placed.len() {
         particles.push(0, placed.position[k], 0.5 * DIAMETER, mass);
         particles.velocity[k] = Vec3::new(0.01, -0.02, 0.015) * ((k % 7) as Real - 3.0);

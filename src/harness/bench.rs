@@ -21,6 +21,7 @@ use std::time::Duration;
 use serde::Serialize;
 
 use crate::analysis::conical_heap::{conical_heap, ConicalHeap};
+use crate::harness::lammps::postprocess::log_timing;
 use crate::harness::lammps::runner::RunStatus;
 use crate::harness::lammps::{self, read_dump, RunnerOptions};
 use crate::harness::liggghts;
@@ -303,8 +304,8 @@ fn runner(threads: usize, options: &BenchOptions) -> RunnerOptions {
     }
 }
 
-/// One run of `code` on `scene` from the case's state in `dir`: (status, reason, particles,
-/// steps, loop seconds, memory MB), plus the final particles for cgdem.
+/// One run of `code` on `scene` from the case's state in `dir`, plus cgdem's summary (with
+/// its final particles).
 fn run_code(
     case: &PreparedCase,
     scene: &Scene,
@@ -422,7 +423,7 @@ fn finish_reference(
                     result.n_particles = t.atoms;
                     result.steps = t.steps;
                     result.loop_s = Some(t.loop_s);
-                    result.particle_steps = Some(t.atoms as u64 * t.steps);
+                    result.particle_steps = Some(t.particle_steps);
                     result.memory_mb = t.memory_mb;
                 }
                 None => {
@@ -455,68 +456,6 @@ fn finish_reference(
     }
 }
 
-/// The timing a LAMMPS or LIGGGHTS log reports for its (last) run.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LogTiming {
-    pub loop_s: Real,
-    pub ranks: usize,
-    pub steps: u64,
-    pub atoms: usize,
-    /// `Per MPI rank memory allocation (min/avg/max)`: average times ranks, MB.
-    pub memory_mb: Option<Real>,
-}
-
-/// Sums the `Loop time of T on P procs for N steps with M atoms` lines (a deck sets up with
-/// `run 0` and may run its stage in pieces) and reads the memory line; None if the log has
-/// no loop line with steps.
-pub fn log_timing(log: &str) -> Option<LogTiming> {
-    let mut memory_per_rank: Option<Real> = None;
-    let mut timing: Option<LogTiming> = None;
-    for line in log.lines() {
-        if line.starts_with("Memory usage per processor") || line.starts_with("Per MPI rank memory")
-        {
-            // LAMMPS: `... (min/avg/max) = a | b | c Mbytes`; LIGGGHTS: `Memory usage per
-            // processor = a Mbytes`.
-            let numbers: Vec<Real> = line
-                .split(['=', '|'])
-                .skip(1)
-                .filter_map(|f| f.split_whitespace().next()?.parse().ok())
-                .collect();
-            memory_per_rank = match numbers.as_slice() {
-                [one] => Some(*one),
-                [_, avg, _] => Some(*avg),
-                _ => memory_per_rank,
-            };
-        }
-        if let Some(rest) = line.strip_prefix("Loop time of ") {
-            let f: Vec<&str> = rest.split_whitespace().collect();
-            // T on P procs for N steps with M atoms
-            if let (Some(t), Some(p), Some(n), Some(m)) = (f.first(), f.get(2), f.get(5), f.get(8))
-            {
-                if let (Ok(t), Ok(p), Ok(n), Ok(m)) = (
-                    t.parse::<Real>(),
-                    p.parse::<usize>(),
-                    n.parse::<u64>(),
-                    m.parse::<usize>(),
-                ) {
-                    if n == 0 {
-                        continue;
-                    }
-                    let before = timing.map_or((0.0, 0), |t| (t.loop_s, t.steps));
-                    timing = Some(LogTiming {
-                        loop_s: before.0 + t,
-                        ranks: p,
-                        steps: before.1 + n,
-                        atoms: m,
-                        memory_mb: memory_per_rank.map(|mb| mb * p as Real),
-                    });
-                }
-            }
-        }
-    }
-    timing
-}
-
 fn timed_run(
     case: &PreparedCase,
     code: Code,
@@ -525,7 +464,7 @@ fn timed_run(
     dir: &Path,
     options: &BenchOptions,
 ) -> (BenchRun, Option<BenchMemory>) {
-    let (result, summary) = run_code(case, &case.timed, code, threads, dir, options);
+    let (result, _) = run_code(case, &case.timed, code, threads, dir, options);
     let per_s = match (result.particle_steps, result.loop_s) {
         (Some(ps), Some(s)) if s > 0.0 => Some(ps as Real / s),
         _ => None,
@@ -541,7 +480,6 @@ fn timed_run(
         .memory
         .map(|m| (m.particle_bytes + m.pair_bytes) as Real / 1e6)
         .or(result.memory_mb);
-    drop(summary);
     (
         BenchRun {
             case: case.name.clone(),
@@ -910,26 +848,6 @@ pub fn format_report(report: &BenchReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn reads_loop_time_and_memory_from_lammps_and_liggghts_logs() {
-        let lammps = "Per MPI rank memory allocation (min/avg/max) = 12.5 | 13.0 | 13.5 Mbytes\nLoop time of 1e-6 on 2 procs for 0 steps with 11103 atoms\nStep Atoms\nLoop time of 20.5 on 2 procs for 6000 steps with 11103 atoms\nLoop time of 10.5 on 2 procs for 4000 steps with 11103 atoms\n";
-        let t = log_timing(lammps).unwrap();
-        // The set-up `run 0` is left out; the pieces of the stage add up.
-        assert_eq!(
-            (t.loop_s, t.ranks, t.steps, t.atoms),
-            (31.0, 2, 10000, 11103)
-        );
-        assert_eq!(t.memory_mb, Some(26.0));
-        let liggghts = "Memory usage per processor = 9.5 Mbytes\nLoop time of 41 on 1 procs for 10000 steps with 11103 atoms\n";
-        let t = log_timing(liggghts).unwrap();
-        assert_eq!((t.loop_s, t.ranks, t.memory_mb), (41.0, 1, Some(9.5)));
-        // A truncated log (killed before the loop ended) has no timing.
-        assert!(
-            log_timing("Memory usage per processor = 9.5 Mbytes\nStep Atoms\n100 11103\n")
-                .is_none()
-        );
-    }
 
     #[test]
     fn ratios_pair_adjacent_runs_and_take_the_median() {

@@ -131,19 +131,71 @@ fn stage_marks(log: &str) -> Vec<StageMark> {
     marks
 }
 
-/// (particle-steps, seconds) summed over the `Loop time of T on P procs for N steps with M atoms` lines.
-fn loop_times(log: &str) -> (u64, Real) {
-    let (mut particle_steps, mut seconds) = (0u64, 0.0);
-    for line in log.lines().filter(|l| l.starts_with("Loop time of ")) {
-        let f: Vec<&str> = line.split_whitespace().collect();
-        if let (Some(t), Some(n), Some(m)) = (f.get(3), f.get(8), f.get(11)) {
-            if let (Ok(t), Ok(n), Ok(m)) = (t.parse::<Real>(), n.parse::<u64>(), m.parse::<u64>()) {
-                seconds += t;
-                particle_steps += n * m;
+/// The timing a LAMMPS or LIGGGHTS log reports, summed over its runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LogTiming {
+    pub loop_s: Real,
+    pub ranks: usize,
+    pub steps: u64,
+    /// Atoms in the last run.
+    pub atoms: usize,
+    /// Steps times atoms, run by run (the count changes when particles are deleted).
+    pub particle_steps: u64,
+    /// `Per MPI rank memory allocation (min/avg/max)`: average times ranks, MB.
+    pub memory_mb: Option<Real>,
+}
+
+/// Sums the `Loop time of T on P procs for N steps with M atoms` lines (a deck sets up with
+/// `run 0` and may run its stage in pieces) and reads the memory line; None if the log has
+/// no loop line with steps.
+pub fn log_timing(log: &str) -> Option<LogTiming> {
+    let mut memory_per_rank: Option<Real> = None;
+    let mut timing: Option<LogTiming> = None;
+    for line in log.lines() {
+        if line.starts_with("Memory usage per processor") || line.starts_with("Per MPI rank memory")
+        {
+            // LAMMPS: `... (min/avg/max) = a | b | c Mbytes`; LIGGGHTS: `Memory usage per
+            // processor = a Mbytes`.
+            let numbers: Vec<Real> = line
+                .split(['=', '|'])
+                .skip(1)
+                .filter_map(|f| f.split_whitespace().next()?.parse().ok())
+                .collect();
+            memory_per_rank = match numbers.as_slice() {
+                [one] => Some(*one),
+                [_, avg, _] => Some(*avg),
+                _ => memory_per_rank,
+            };
+        }
+        if let Some(rest) = line.strip_prefix("Loop time of ") {
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            // T on P procs for N steps with M atoms
+            if let (Some(t), Some(p), Some(n), Some(m)) = (f.first(), f.get(2), f.get(5), f.get(8))
+            {
+                if let (Ok(t), Ok(p), Ok(n), Ok(m)) = (
+                    t.parse::<Real>(),
+                    p.parse::<usize>(),
+                    n.parse::<u64>(),
+                    m.parse::<usize>(),
+                ) {
+                    if n == 0 {
+                        continue;
+                    }
+                    let before =
+                        timing.map_or((0.0, 0, 0), |t| (t.loop_s, t.steps, t.particle_steps));
+                    timing = Some(LogTiming {
+                        loop_s: before.0 + t,
+                        ranks: p,
+                        steps: before.1 + n,
+                        atoms: m,
+                        particle_steps: before.2 + n * m as u64,
+                        memory_mb: memory_per_rank.map(|mb| mb * p as Real),
+                    });
+                }
             }
         }
     }
-    (particle_steps, seconds)
+    timing
 }
 
 fn output_error(path: &Path, e: impl std::fmt::Display) -> PostprocessError {
@@ -327,7 +379,8 @@ pub fn postprocess(
     });
     let n_inserted = frames.first().map_or(0, Frame::len);
     let n_final = last_state.as_ref().map_or(0, |(_, p)| p.position.len());
-    let (particle_steps, loop_s) = loop_times(&log);
+    let (particle_steps, loop_s) =
+        log_timing(&log).map_or((0, 0.0), |t| (t.particle_steps, t.loop_s));
     let headline = headline_sample(&samples);
     Ok(RunSummary {
         case: scene.name.clone(),
@@ -387,6 +440,27 @@ mod tests {
         assert_eq!(marks.len(), 2);
         assert_eq!(marks[0].end, Some((400, "settled".into())));
         assert_eq!(marks[1].start, 400);
-        assert_eq!(loop_times(log), (1800, 4.0));
+        let t = log_timing(log).unwrap();
+        assert_eq!((t.particle_steps, t.loop_s), (1800, 4.0));
+    }
+
+    #[test]
+    fn reads_loop_time_and_memory_from_lammps_and_liggghts_logs() {
+        let lammps = "Per MPI rank memory allocation (min/avg/max) = 12.5 | 13.0 | 13.5 Mbytes\nLoop time of 1e-6 on 2 procs for 0 steps with 11103 atoms\nStep Atoms\nLoop time of 20.5 on 2 procs for 6000 steps with 11103 atoms\nLoop time of 10.5 on 2 procs for 4000 steps with 11103 atoms\n";
+        let t = log_timing(lammps).unwrap();
+        // The set-up `run 0` is left out; the pieces of the stage add up.
+        assert_eq!(
+            (t.loop_s, t.ranks, t.steps, t.atoms),
+            (31.0, 2, 10000, 11103)
+        );
+        assert_eq!(t.memory_mb, Some(26.0));
+        let liggghts = "Memory usage per processor = 9.5 Mbytes\nLoop time of 41 on 1 procs for 10000 steps with 11103 atoms\n";
+        let t = log_timing(liggghts).unwrap();
+        assert_eq!((t.loop_s, t.ranks, t.memory_mb), (41.0, 1, Some(9.5)));
+        // A truncated log (killed before the loop ended) has no timing.
+        assert!(
+            log_timing("Memory usage per processor = 9.5 Mbytes\nStep Atoms\n100 11103\n")
+                .is_none()
+        );
     }
 }
