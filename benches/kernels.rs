@@ -153,14 +153,18 @@ fn force_loop(c: &mut Criterion) {
 
 fn integrator(c: &mut Criterion) {
     let n = 100_000;
-    let force: Vec<Vec3> = (0..n).map(|k| Vec3::splat(k as Real * 1e-6)).collect();
-    let inv_mass = vec![1e4; n];
-    c.bench_function("drift_kick_100k", |b| {
+    let mut particles = Particles::new(true);
+    for k in 0..n {
+        particles.push(0, Vec3::ZERO, 1e-3, 1e-4);
+        particles.velocity[k] = Vec3::X;
+        particles.force[k] = Vec3::splat(k as Real * 1e-6);
+    }
+    c.bench_function("drift_kick_100k_spinning", |b| {
         b.iter_batched(
-            || (vec![Vec3::ZERO; n], vec![Vec3::X; n]),
-            |(mut x, mut v)| {
-                drift_kick(&mut x, &mut v, &force, &inv_mass, 1e-5);
-                black_box((x, v))
+            || particles.clone(),
+            |mut p| {
+                drift_kick(&mut p, 1e-5, None);
+                black_box(p)
             },
             BatchSize::LargeInput,
         )

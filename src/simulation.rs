@@ -385,27 +385,23 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// One velocity-Verlet step.
     fn step_verlet(&mut self) {
         let dt = self.dt;
-        let p = &mut self.particles;
-        drift_kick(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
-        if Self::ROTATES {
-            if let Some(a) = &mut p.angular {
-                kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
-            }
-        }
-        self.drive_kinematic_particles(self.time + dt);
-        if self.list.needs_rebuild(&self.particles.position) || self.any_in_delete_region() {
+        // The list's displacement test runs inside the drift, unless bodies built of
+        // particles move some particles after it.
+        let check = self.list.displacement_check(self.particles.len());
+        let must_rebuild = check.is_none();
+        let moved_far = drift_kick(&mut self.particles, dt, check);
+        let rebuild = if self.kinematic.is_empty() {
+            must_rebuild || moved_far
+        } else {
+            self.drive_kinematic_particles(self.time + dt);
+            self.list.needs_rebuild(&self.particles.position)
+        };
+        if rebuild || self.any_in_delete_region() {
             self.rebuild();
         }
         self.pose_bodies_at(self.time + dt);
         self.compute_forces();
-        let p = &mut self.particles;
-        let mut finite = kick(&mut p.velocity, &p.force, &p.inv_mass, dt);
-        if Self::ROTATES {
-            if let Some(a) = &mut p.angular {
-                finite &= kick(&mut a.omega, &a.torque, &a.inv_inertia, dt);
-            }
-        }
-        self.guard.finite = finite;
+        self.guard.finite = kick(&mut self.particles, dt);
     }
 
     /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list

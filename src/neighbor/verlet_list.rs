@@ -50,6 +50,14 @@ impl PairHistory for Real {
     }
 }
 
+/// The list's rebuild criterion, for the integrator to test as it moves the particles:
+/// has some particle moved farther than `sqrt(limit_sq)` from its `reference` position?
+#[derive(Clone, Copy, Debug)]
+pub struct DisplacementCheck<'a> {
+    pub reference: &'a [Vec3],
+    pub limit_sq: Real,
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct VerletList {
     pub pairs: Vec<Pair>,
@@ -75,14 +83,23 @@ impl VerletList {
     /// True when some particle moved more than half the skin since the last build, or the
     /// particle count changed.
     pub fn needs_rebuild(&self, positions: &[Vec3]) -> bool {
-        if positions.len() != self.reference.len() || self.builds == 0 {
+        let Some(check) = self.displacement_check(positions.len()) else {
             return true;
-        }
-        let limit = 0.25 * self.skin * self.skin;
+        };
         positions
             .par_iter()
-            .zip(&self.reference)
-            .any(|(p, r)| (*p - *r).length_squared() > limit)
+            .zip(check.reference)
+            .any(|(p, r)| (*p - *r).length_squared() > check.limit_sq)
+    }
+
+    /// The displacement test for `n` particles (half the skin from the positions at the
+    /// last build), for the integrator to apply as it moves them; None when the list must
+    /// be rebuilt anyway (never built, or the particle count changed).
+    pub fn displacement_check(&self, n: usize) -> Option<DisplacementCheck<'_>> {
+        (n == self.reference.len() && self.builds > 0).then_some(DisplacementCheck {
+            reference: &self.reference,
+            limit_sq: 0.25 * self.skin * self.skin,
+        })
     }
 
     /// Rebuilds the list. Wraps periodic positions into the box first. When `resort` is set

@@ -124,7 +124,13 @@ impl WallSet {
                 force += f;
                 torque += t;
             }
-            None => history[k] = W::History::default(),
+            // Most particles are far from most walls: testing costs a read, an
+            // unconditional reset a write of every particle's history every step.
+            None => {
+                if history[k] != W::History::default() {
+                    history[k] = W::History::default();
+                }
+            }
         });
         (force, torque, overlap)
     }
