@@ -1167,6 +1167,25 @@ mod tests {
     }
 
     #[test]
+    fn shipped_suites_parse_and_every_accuracy_point_is_a_valid_scene() {
+        for entry in std::fs::read_dir("validation/suites").unwrap() {
+            let path = entry.unwrap().path();
+            let suite = Suite::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            for sweep in &suite.accuracy {
+                for s in &sweep.series {
+                    for &v in &s.values {
+                        let mut knobs = sweep.reference.clone();
+                        knobs.insert(s.knob.clone(), v);
+                        sweep.scene(&knobs, &path).unwrap_or_else(|e| {
+                            panic!("{}: {} = {v}: {e}", path.display(), s.knob.name())
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn a_sweep_needs_its_knobs_reference_values() {
         let suite = |series: &str| {
             format!(
