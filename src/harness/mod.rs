@@ -2,6 +2,7 @@
 //! outputs into cgdem's summary format, and runs suites of cases into compared reports.
 //! The solver core never imports this module.
 
+pub mod accuracy;
 pub mod bench;
 pub mod dynamics;
 pub mod history;

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use super::accuracy::{AccuracySweep, RawSweep};
 use crate::coarse_graining::CoarseGrainRule;
 use crate::scene::{Override, Scene, SceneError};
 
@@ -23,6 +24,13 @@ impl Code {
             Code::Lammps => "lammps",
             Code::Liggghts => "liggghts",
         }
+    }
+
+    /// The code a suite file names: "cgdem", "lammps" or "liggghts".
+    pub fn from_name(name: &str) -> Option<Code> {
+        [Code::Cgdem, Code::Lammps, Code::Liggghts]
+            .into_iter()
+            .find(|c| c.name() == name)
     }
 }
 
@@ -67,6 +75,8 @@ pub struct Suite {
     pub description: String,
     pub source: PathBuf,
     pub cases: Vec<SuiteCase>,
+    /// Error-against-run-time sweeps (`[[accuracy]]`).
+    pub accuracy: Vec<AccuracySweep>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -93,8 +103,10 @@ struct RawSuite {
     name: String,
     #[serde(default)]
     description: String,
-    #[serde(rename = "case")]
+    #[serde(rename = "case", default)]
     cases: Vec<RawCase>,
+    #[serde(default)]
+    accuracy: Vec<RawSweep>,
 }
 
 #[derive(Deserialize)]
@@ -140,15 +152,14 @@ impl Suite {
             let codes = c
                 .codes
                 .iter()
-                .map(|name| match name.as_str() {
-                    "cgdem" => Ok(Code::Cgdem),
-                    "lammps" => Ok(Code::Lammps),
-                    "liggghts" => Ok(Code::Liggghts),
-                    other => Err(invalid(
-                        format!("case[{k}].codes"),
-                        format!("\"{other}\""),
-                        "\"cgdem\", \"lammps\" or \"liggghts\"",
-                    )),
+                .map(|name| {
+                    Code::from_name(name).ok_or_else(|| {
+                        invalid(
+                            format!("case[{k}].codes"),
+                            format!("\"{name}\""),
+                            "\"cgdem\", \"lammps\" or \"liggghts\"",
+                        )
+                    })
                 })
                 .collect::<Result<Vec<_>, _>>()?;
             if codes.is_empty() {
@@ -258,11 +269,25 @@ impl Suite {
                 variant: c.variant,
             });
         }
+        let accuracy = raw
+            .accuracy
+            .into_iter()
+            .enumerate()
+            .map(|(k, a)| AccuracySweep::from_raw(a, k, path))
+            .collect::<Result<Vec<_>, _>>()?;
+        if cases.is_empty() && accuracy.is_empty() {
+            return Err(invalid(
+                "case".into(),
+                "(none)".into(),
+                "at least one [[case]] or [[accuracy]]",
+            ));
+        }
         Ok(Suite {
             name: raw.name,
             description: raw.description,
             source: path.to_path_buf(),
             cases,
+            accuracy,
         })
     }
 }

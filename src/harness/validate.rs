@@ -71,6 +71,9 @@ pub struct ValidationSummary {
     pub provenance: BTreeMap<String, String>,
     pub runs: Vec<RunRecord>,
     pub comparisons: Vec<Comparison>,
+    /// Error against run time (the suite's `[[accuracy]]` sweeps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<super::accuracy::AccuracySummary>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -83,7 +86,7 @@ pub enum ValidateError {
     Output { path: PathBuf, message: String },
 }
 
-fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateError {
+pub(super) fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateError {
     ValidateError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -141,11 +144,13 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         runs.extend(case_runs);
         comparisons.extend(case_comparisons);
     }
+    let accuracy = super::accuracy::run_sweeps(&suite, options, &mut report)?;
     let summary = ValidationSummary {
         suite: suite.name.clone(),
         provenance,
         runs,
         comparisons,
+        accuracy,
     };
     let intro = report.intro();
     intro.paragraph(format!(
@@ -384,13 +389,13 @@ fn run_case(
     Ok(records)
 }
 
-enum RunOutcome {
+pub(super) enum RunOutcome {
     Skipped(String),
     Failed(String),
 }
 
 /// Runs cgdem, or with `--reuse` takes the run already in `dir`; true when reused.
-fn run_cgdem(
+pub(super) fn run_cgdem(
     scene: &Scene,
     lambda: u32,
     rule: CoarseGrainRule,
@@ -424,7 +429,7 @@ fn finished_digest(dir: &Path) -> Option<String> {
 
 /// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
 /// reused. LIGGGHTS cannot express the seed's WCA model: its runs of such a case are skipped.
-fn run_reference_code(
+pub(super) fn run_reference_code(
     code: Code,
     scene: &Scene,
     lambda: u32,
@@ -493,7 +498,7 @@ fn run_reference_code(
     }
 }
 
-fn fill_from_summary(record: &mut RunRecord) {
+pub(super) fn fill_from_summary(record: &mut RunRecord) {
     let path = record.dir.join("summary.json");
     let value: serde_json::Value = match std::fs::read_to_string(&path)
         .map_err(|e| e.to_string())
