@@ -348,6 +348,12 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     if !dt.is_finite() || dt <= 0.0 {
         return Err(unsupported(format!("time step {dt} s")));
     }
+    // A deck without the scene's bodies or outlets would run another case under its name.
+    if !scene.bodies.is_empty() || !scene.deletions.is_empty() {
+        return Err(unsupported(
+            "LAMMPS seed-model decks take planar walls only (no [[body]], no [[delete]])".into(),
+        ));
+    }
     let rc = TWO_POW_ONE_SIXTH * sigma;
     let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
     let wall_mass = masses[0];
@@ -505,6 +511,18 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
 mod tests {
     use super::*;
     use crate::coarse_graining::coarse_grain;
+
+    #[test]
+    fn a_seed_model_scene_with_bodies_is_refused_not_run_without_them() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("validation/cases/screw_feeder_nightly.toml");
+        let scene = Scene::load(&path).unwrap();
+        assert!(matches!(scene.contact, ContactSettings::Wca { .. }));
+        let err = write_deck(&scene, &Particles::new(false), 1e-6).unwrap_err();
+        let message = err.to_string();
+        assert!(message.contains("[[body]]"), "{message}");
+        assert!(message.contains("screw_feeder_nightly.toml"), "{message}");
+    }
 
     #[test]
     fn collapse_deck_has_removable_walls_settle_loop_and_repose_dumps() {
