@@ -67,6 +67,8 @@ pub struct Suite {
     pub description: String,
     pub source: PathBuf,
     pub cases: Vec<SuiteCase>,
+    /// `[[stability]]` cases (`harness::stability`).
+    pub stability: Vec<super::stability::StabilityCase>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -93,8 +95,10 @@ struct RawSuite {
     name: String,
     #[serde(default)]
     description: String,
-    #[serde(rename = "case")]
+    #[serde(default, rename = "case")]
     cases: Vec<RawCase>,
+    #[serde(default, rename = "stability")]
+    stability: Vec<super::stability::RawStabilityCase>,
 }
 
 #[derive(Deserialize)]
@@ -263,6 +267,7 @@ impl Suite {
             description: raw.description,
             source: path.to_path_buf(),
             cases,
+            stability: super::stability::parse_cases(raw.stability, path)?,
         })
     }
 }

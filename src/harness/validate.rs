@@ -71,6 +71,9 @@ pub struct ValidationSummary {
     pub provenance: BTreeMap<String, String>,
     pub runs: Vec<RunRecord>,
     pub comparisons: Vec<Comparison>,
+    /// The `[[stability]]` cases' verdicts, one per case and code.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stability: Vec<super::stability::StabilityRecord>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -141,11 +144,24 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         runs.extend(case_runs);
         comparisons.extend(case_comparisons);
     }
+    let stability = super::stability::run_stability(
+        &suite.stability,
+        &options.out,
+        options.quiet,
+        options.keep_going,
+        options.reference_timeout_s,
+        &mut report,
+    )
+    .map_err(|message| ValidateError::Case {
+        file: suite.source.clone(),
+        message,
+    })?;
     let summary = ValidationSummary {
         suite: suite.name.clone(),
         provenance,
         runs,
         comparisons,
+        stability,
     };
     let intro = report.intro();
     intro.paragraph(format!(
