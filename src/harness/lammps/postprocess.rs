@@ -216,10 +216,13 @@ pub fn postprocess(
     ranks: usize,
 ) -> Result<RunSummary, PostprocessError> {
     let log_path = dir.join(plan.log_file);
-    let log = std::fs::read_to_string(&log_path).map_err(|e| PostprocessError::Content {
-        file: log_path.clone(),
-        message: format!("cannot read: {e}"),
-    })?;
+    // Lossy: LIGGGHTS's "Lost atoms" error writes stray bytes after its message.
+    let log = std::fs::read(&log_path)
+        .map(|b| String::from_utf8_lossy(&b).into_owned())
+        .map_err(|e| PostprocessError::Content {
+            file: log_path.clone(),
+            message: format!("cannot read: {e}"),
+        })?;
     let marks = stage_marks(&log);
     let dt = plan.dt;
     let traj_path = dir.join(TRAJECTORY_FILE);
