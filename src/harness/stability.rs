@@ -72,6 +72,8 @@ pub struct StabilityCase {
     /// Largest overlap, as a fraction of the smaller radius (pairs) or the radius (walls).
     pub max_overlap: f64,
     pub overrides: Vec<Override>,
+    /// The overrides as written (`KEY = VALUE`), for the report.
+    pub set: Vec<String>,
     pub variant: Option<String>,
 }
 
@@ -164,6 +166,7 @@ pub(crate) fn parse_cases(
             energy_not_judged: c.energy_not_judged,
             max_overlap,
             overrides,
+            set: c.set,
             variant: c.variant,
         });
     }
@@ -255,7 +258,11 @@ pub fn run_stability(
         if case.lambda != 1 {
             label += &format!("-lambda{}", case.lambda);
         }
-        described.push((label.clone(), base.description.clone(), case.clone()));
+        let mut description = base.description.clone();
+        if let Some(v) = &case.variant {
+            description += &format!(" (variant `{v}`: {})", case.set.join(", "));
+        }
+        described.push((label.clone(), description, case.clone()));
         // A level cgdem refuses to build is its clear error; the reference codes get no scene.
         let scene = match coarse_grain(&base, case.lambda) {
             Ok(mut scene) => {
@@ -466,8 +473,13 @@ pub(crate) fn run_reference(
     if let Ok(summary) = &postprocessed {
         let _ = write_summary(summary, dir);
     }
-    let mut text = std::fs::read_to_string(dir.join(deck.plan.log_file)).unwrap_or_default();
-    text += &std::fs::read_to_string(dir.join("stdout.txt")).unwrap_or_default();
+    // Lossy: LIGGGHTS's "Lost atoms" error writes stray bytes after its message.
+    let read = |name: &str| {
+        std::fs::read(dir.join(name))
+            .map(|b| String::from_utf8_lossy(&b).into_owned())
+            .unwrap_or_default()
+    };
+    let text = read(deck.plan.log_file) + &read("stdout.txt");
     let log = LogFindings::of(&text);
     let particles = crate::run::initial_particles(scene, false, &[])
         .map(|p| p.len())
@@ -796,12 +808,24 @@ fn min_image(mut d: Vec3, periodic: [bool; 3], length: Vec3) -> Vec3 {
 }
 
 /// Largest overlap over the frames of a reference code's trajectory (pairs: of the smaller
-/// radius; planar walls: of the radius, a centre behind the wall counting as in cgdem).
+/// radius; planar walls: of the radius, a centre behind the wall counting as in cgdem; walls a
+/// stage removes are left out).
 /// `Err(true)` when a frame holds non-finite values.
 fn frame_overlap(scene: &Scene, trajectory: &Path) -> Result<Option<Real>, bool> {
     let frames = super::lammps::read_dump(trajectory).map_err(|_| false)?;
     let periodic = scene.domain.periodic;
     let length = scene.domain.hi - scene.domain.lo;
+    // Walls some stage removes are left out (their frames are not matched to stages here).
+    let walls: Vec<_> = scene
+        .walls
+        .iter()
+        .filter(|w| {
+            !scene
+                .stages
+                .iter()
+                .any(|s| s.remove_walls.contains(&w.name))
+        })
+        .collect();
     let mut largest: Option<Real> = None;
     for frame in &frames {
         let p = super::lammps::postprocess::frame_particles(frame, scene, trajectory)
@@ -819,7 +843,7 @@ fn frame_overlap(scene: &Scene, trajectory: &Path) -> Result<Option<Real>, bool>
                     worst = worst.max((ri + rj - d) / ri.min(rj));
                 }
             }
-            for w in &scene.walls {
+            for w in &walls {
                 let h = (p.position[i] - w.point).dot(w.normal.normalize());
                 worst = worst.max(overlap_fraction(h, ri));
             }
@@ -982,6 +1006,7 @@ mod tests {
             energy_not_judged: None,
             max_overlap: 0.25,
             overrides: Vec::new(),
+            set: Vec::new(),
             variant: None,
         }
     }
