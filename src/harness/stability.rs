@@ -239,7 +239,8 @@ pub struct StabilityRecord {
 }
 
 /// Runs every stability case of a suite in its codes under `out/runs/stability/`, adds the
-/// "Stability" section to `report` and writes `out/stability.csv`.
+/// "Stability" section to `report` and writes `out/stability.csv` (none of it for a suite
+/// without stability cases).
 pub fn run_stability(
     cases: &[StabilityCase],
     out: &Path,
@@ -248,6 +249,9 @@ pub fn run_stability(
     reference_timeout_s: u64,
     report: &mut Report,
 ) -> Result<Vec<StabilityRecord>, String> {
+    if cases.is_empty() {
+        return Ok(Vec::new());
+    }
     let mut records = Vec::new();
     let mut described = Vec::new();
     for case in cases {
@@ -993,6 +997,16 @@ mod tests {
         assert_eq!(liggghts.lost_atoms, 1);
         let clean = LogFindings::of("Step Time\n0 0 40 1.5 0.2\nLoop time of 1.0 on 1 procs\n");
         assert_eq!(clean, LogFindings::default());
+    }
+
+    #[test]
+    fn a_suite_without_stability_cases_adds_no_section_and_no_csv() {
+        let dir = std::env::temp_dir().join(format!("cgdem-stability-none-{}", std::process::id()));
+        let mut report = Report::new("t");
+        let records = run_stability(&[], &dir, true, false, 1, &mut report).unwrap();
+        assert!(records.is_empty());
+        assert!(!dir.join("stability.csv").exists());
+        assert!(!report.render(&dir).contains("Stability"));
     }
 
     fn case() -> StabilityCase {
