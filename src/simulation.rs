@@ -755,12 +755,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// The box corner lowest along gravity: gravitational energy is counted from it.
     fn potential_origin(&self) -> Vec3 {
-        let (g, lo, hi) = (self.gravity, self.domain.lo, self.domain.hi);
-        Vec3::new(
-            if g.x < 0.0 { lo.x } else { hi.x },
-            if g.y < 0.0 { lo.y } else { hi.y },
-            if g.z < 0.0 { lo.z } else { hi.z },
-        )
+        potential_origin(self.gravity, self.domain.lo, self.domain.hi)
     }
 
     /// Whether the energy guard applies: no attraction, no moving body doing work, and no
@@ -1282,4 +1277,14 @@ fn larger(a: Real, b: Real) -> Real {
     } else {
         a
     }
+}
+
+/// The corner of the box `lo..hi` lowest along `gravity`: gravitational energy `-m g.(x - o)`
+/// is counted from it (cgdem's energy guard, and the energy balance of every code's outputs).
+pub fn potential_origin(gravity: Vec3, lo: Vec3, hi: Vec3) -> Vec3 {
+    Vec3::new(
+        if gravity.x < 0.0 { lo.x } else { hi.x },
+        if gravity.y < 0.0 { lo.y } else { hi.y },
+        if gravity.z < 0.0 { lo.z } else { hi.z },
+    )
 }

@@ -8,5 +8,6 @@ pub mod dynamics;
 pub mod history;
 pub mod lammps;
 pub mod liggghts;
+pub mod stability;
 pub mod suite;
 pub mod validate;

@@ -77,6 +77,8 @@ pub struct Suite {
     pub cases: Vec<SuiteCase>,
     /// Error-against-run-time sweeps (`[[accuracy]]`).
     pub accuracy: Vec<AccuracySweep>,
+    /// `[[stability]]` cases (`harness::stability`).
+    pub stability: Vec<super::stability::StabilityCase>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -107,6 +109,8 @@ struct RawSuite {
     cases: Vec<RawCase>,
     #[serde(default)]
     accuracy: Vec<RawSweep>,
+    #[serde(default)]
+    stability: Vec<super::stability::RawStabilityCase>,
 }
 
 #[derive(Deserialize)]
@@ -275,11 +279,12 @@ impl Suite {
             .enumerate()
             .map(|(k, a)| AccuracySweep::from_raw(a, k, path))
             .collect::<Result<Vec<_>, _>>()?;
-        if cases.is_empty() && accuracy.is_empty() {
+        let stability = super::stability::parse_cases(raw.stability, path)?;
+        if cases.is_empty() && accuracy.is_empty() && stability.is_empty() {
             return Err(invalid(
                 "case".into(),
                 "(none)".into(),
-                "at least one [[case]] or [[accuracy]]",
+                "at least one [[case]], [[accuracy]] or [[stability]]",
             ));
         }
         Ok(Suite {
@@ -288,6 +293,7 @@ impl Suite {
             source: path.to_path_buf(),
             cases,
             accuracy,
+            stability,
         })
     }
 }

@@ -74,6 +74,9 @@ pub struct ValidationSummary {
     /// Error against run time (the suite's `[[accuracy]]` sweeps).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub accuracy: Option<super::accuracy::AccuracySummary>,
+    /// The `[[stability]]` cases' verdicts, one per case and code.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stability: Vec<super::stability::StabilityRecord>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -145,12 +148,25 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         comparisons.extend(case_comparisons);
     }
     let accuracy = super::accuracy::run_sweeps(&suite, options, &mut report)?;
+    let stability = super::stability::run_stability(
+        &suite.stability,
+        &options.out,
+        options.quiet,
+        options.keep_going,
+        options.reference_timeout_s,
+        &mut report,
+    )
+    .map_err(|message| ValidateError::Case {
+        file: suite.source.clone(),
+        message,
+    })?;
     let summary = ValidationSummary {
         suite: suite.name.clone(),
         provenance,
         runs,
         comparisons,
         accuracy,
+        stability,
     };
     let intro = report.intro();
     intro.paragraph(format!(

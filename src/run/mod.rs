@@ -639,7 +639,7 @@ fn execute<L: PairLaw, W: WallLaw>(
     let mut timeseries = std::io::BufWriter::new(
         std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?,
     );
-    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{}", if conveying_body.is_some() { ",fill_ratio,bulk_density_kg_m3" } else { "" }).map_err(|e| output_error(&timeseries_path, e))?;
+    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{},mechanical_energy_j", if conveying_body.is_some() { ",fill_ratio,bulk_density_kg_m3" } else { "" }).map_err(|e| output_error(&timeseries_path, e))?;
     let mut vtk = if scene.output.vtk_interval > 0.0 {
         Some(
             VtkSeries::new(&out.join("vtk"), "particles")
@@ -847,6 +847,8 @@ fn execute<L: PairLaw, W: WallLaw>(
                         conveying_samples.push(sample);
                     }
                 }
+                // Kinetic plus gravitational energy, for the stability suite's energy balance.
+                extra += &format!(",{:.9e}", world.mechanical_energy());
                 writeln!(
                     timeseries,
                     "{:.9e},{},{:.9e},{:.9e},{},{},{}{extra}",

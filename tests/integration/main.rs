@@ -9,3 +9,4 @@ mod guards;
 mod physics;
 mod reference_stages;
 mod scenes;
+mod stability;

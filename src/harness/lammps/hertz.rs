@@ -41,7 +41,7 @@ pub fn tsuji_polynomial(q: Real) -> Real {
 
 /// The `damping tsuji` number that reproduces LIGGGHTS's `model hertz` dashpot for
 /// restitution `e`: `P(q) = sqrt(5) |beta(e)|` (P decreases on [0, 1]); None below e ~ 0.114,
-/// where `sqrt(5) |beta| > P(0)`.
+/// where `sqrt(5) |beta| > P(0)`, and near e = 1, where it is below `P(1)`.
 pub fn tsuji_q(restitution: Real) -> Option<Real> {
     let target = 5.0_f64.sqrt() * restitution_beta(restitution).abs();
     if target > tsuji_polynomial(0.0) || target < tsuji_polynomial(1.0) {
@@ -148,9 +148,11 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     };
     let q_of = |e: Real| {
         tsuji_q(e).ok_or_else(|| {
-            unsupported(format!(
-                "restitution {e}: damping tsuji cannot reach LIGGGHTS's dashpot below e ~ 0.114"
-            ))
+            unsupported(if e < 0.5 {
+                format!("restitution {e}: damping tsuji cannot reach LIGGGHTS's dashpot below e ~ 0.114")
+            } else {
+                format!("restitution {e}: damping tsuji cannot damp as little as LIGGGHTS's dashpot does (its least damping, q = 1, is more)")
+            })
         })
     };
     let m = material(h);

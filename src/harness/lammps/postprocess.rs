@@ -216,10 +216,13 @@ pub fn postprocess(
     ranks: usize,
 ) -> Result<RunSummary, PostprocessError> {
     let log_path = dir.join(plan.log_file);
-    let log = std::fs::read_to_string(&log_path).map_err(|e| PostprocessError::Content {
-        file: log_path.clone(),
-        message: format!("cannot read: {e}"),
-    })?;
+    // Lossy: LIGGGHTS's "Lost atoms" error writes stray bytes after its message.
+    let log = std::fs::read(&log_path)
+        .map(|b| String::from_utf8_lossy(&b).into_owned())
+        .map_err(|e| PostprocessError::Content {
+            file: log_path.clone(),
+            message: format!("cannot read: {e}"),
+        })?;
     let marks = stage_marks(&log);
     let dt = plan.dt;
     let traj_path = dir.join(TRAJECTORY_FILE);
@@ -239,7 +242,9 @@ pub fn postprocess(
         })
     };
 
-    let mut csv = String::from("time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m\n");
+    let mut csv = String::from("time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,mechanical_energy_j\n");
+    let origin =
+        crate::simulation::potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
     let mut last_state = None;
     for frame in frames.iter().filter(|f| f.step > 0) {
         let p = frame_particles(frame, scene, &traj_path)?;
@@ -257,17 +262,25 @@ pub fn postprocess(
             .sum::<Real>()
             + p.rotational_energy;
         let mass: Real = p.mass.iter().sum();
+        // Kinetic plus gravitational energy, as cgdem's `World::mechanical_energy`.
+        let potential: Real = p
+            .position
+            .iter()
+            .zip(&p.mass)
+            .map(|(&x, &m)| -m * scene.gravity.dot(x - origin))
+            .sum();
         let profile = heap_profile(&p);
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
         csv += &format!(
-            "{:.9e},{},{:.9e},{:.9e},{},{},{}\n",
+            "{:.9e},{},{:.9e},{:.9e},{},{},{},{:.9e}\n",
             frame.step as Real * dt,
             stage,
             ke,
             ke / mass.max(Real::MIN_POSITIVE),
             p.position.len(),
             opt(profile.as_ref().map(|p| p.front(2.0 * max_diameter))),
-            opt(profile.as_ref().map(|p| p.wall_height()))
+            opt(profile.as_ref().map(|p| p.wall_height())),
+            ke + potential
         );
         last_state = Some((frame.step, p));
     }

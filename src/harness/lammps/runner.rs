@@ -77,8 +77,12 @@ pub fn log_tail(dir: &Path, lines: usize) -> String {
 
 /// Last `lines` lines of `dir/log_file` (or of stdout if there is no log).
 pub fn log_tail_of(dir: &Path, log_file: &str, lines: usize) -> String {
-    let text = std::fs::read_to_string(dir.join(log_file))
-        .or_else(|_| std::fs::read_to_string(dir.join("stdout.txt")))
+    // Lossy: LIGGGHTS's "Lost atoms" error writes stray bytes after its message.
+    let read = |name: &str| {
+        std::fs::read(dir.join(name)).map(|b| String::from_utf8_lossy(&b).into_owned())
+    };
+    let text = read(log_file)
+        .or_else(|_| read("stdout.txt"))
         .unwrap_or_default();
     let all: Vec<&str> = text.lines().collect();
     all[all.len().saturating_sub(lines)..].join("\n")

@@ -96,6 +96,10 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     d += "neigh_modify    delay 0\n";
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
+    // LIGGGHTS refuses E > 1e9 Pa in SI units unless told the particles are hard (steel).
+    if m.youngs_modulus.max(wm.youngs_modulus) > 1e9 {
+        d += "hard_particles  yes\n";
+    }
     let _ = writeln!(
         d,
         "fix             m1 all property/global youngsModulus peratomtype {}",
