@@ -446,8 +446,30 @@ fn main() -> ExitCode {
                 Ok(summary) => {
                     let failed = summary.comparisons.iter().filter(|c| !c.pass).count();
                     let runs_failed = summary.runs.iter().filter(|r| r.status == "failed").count();
+                    let mut extra = String::new();
+                    if let Some(accuracy) = &summary.accuracy {
+                        extra += &format!(", {} accuracy points", accuracy.points.len());
+                    }
+                    if !summary.stability.is_empty() {
+                        use cgdem::harness::{stability::Verdict, suite::Code};
+                        let failed = |cgdem: bool| {
+                            summary
+                                .stability
+                                .iter()
+                                .filter(|r| {
+                                    r.verdict == Verdict::Failed && (r.code == Code::Cgdem) == cgdem
+                                })
+                                .count()
+                        };
+                        extra += &format!(
+                            ", {} stability runs (failed: {} in cgdem, {} in the reference codes)",
+                            summary.stability.len(),
+                            failed(true),
+                            failed(false)
+                        );
+                    }
                     println!(
-                        "suite {}: {} runs ({} failed, {} skipped), {} comparisons ({} outside tolerance); report in {}",
+                        "suite {}: {} runs ({} failed, {} skipped), {} comparisons ({} outside tolerance){extra}; report in {}",
                         summary.suite,
                         summary.runs.len(),
                         runs_failed,
