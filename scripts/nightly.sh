@@ -35,6 +35,15 @@ started=$(date +%s)
 echo "bench: $(( $(date +%s) - started )) s wall time"
 find "$night/bench" -type f \( -name '*.dump' -o -name 'particles.data' -o -name 'timeseries.csv' \) -delete 2>/dev/null || true
 
+# The stability suite (about a minute): a verdict per code and case; a cgdem "failed" fails
+# the night (issue 6: cgdem must stop with a clear message or stay stable).
+started=$(date +%s)
+"$cgdem" validate --suite stability --out "$night/stability" --reuse --quiet \
+    || echo "note: the stability suite did not finish"
+echo "stability suite: $(( $(date +%s) - started )) s wall time"
+find "$night/stability/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete 2>/dev/null || true
+stability_failed=$(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print(sum(r['code']=='cgdem' and r['verdict']=='failed' for r in s.get('stability', [])))" "$night/stability/summary.json" 2>/dev/null || echo 1)
+
 # Keep the night small: run directories hold dumps and VTK files; the report needs only
 # its summaries, CSV and figures.
 find "$night/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete
@@ -42,6 +51,9 @@ find "$night/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -
 flags=$("$cgdem" history reports/nightly --add "$night" --date "$date" --commit "$commit")
 echo "$flags"
 failed=$(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print(sum(r['status']=='failed' for r in s['runs']))" "$night/summary.json")
-if [ "$failed" != 0 ] || grep -q '^flag:' <<<"$flags"; then
+if [ "$stability_failed" != 0 ]; then
+    echo "flag: stability: $stability_failed cgdem run(s) failed (see $night/stability/index.html)"
+fi
+if [ "$failed" != 0 ] || [ "$stability_failed" != 0 ] || grep -q '^flag:' <<<"$flags"; then
     exit 1
 fi
