@@ -225,8 +225,13 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
             ),
         ]);
     }
-    intro.table(table);
-    intro.table(run_table);
+    // A suite of only accuracy sweeps or stability cases has neither: its sections say it all.
+    if !summary.comparisons.is_empty() {
+        intro.table(table);
+    }
+    if !summary.runs.is_empty() {
+        intro.table(run_table);
+    }
     intro.key_values(
         Some("Provenance"),
         summary
