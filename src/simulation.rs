@@ -386,13 +386,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     fn step_verlet(&mut self) {
         let dt = self.dt;
         // The list's displacement test runs inside the drift, unless bodies built of
-        // particles move some particles after it.
-        let check = self.list.displacement_check(self.particles.len());
-        let must_rebuild = check.is_none();
-        let moved_far = drift_kick(&mut self.particles, dt, check);
+        // particles move some particles after it: then it runs once they have moved.
         let rebuild = if self.kinematic.is_empty() {
-            must_rebuild || moved_far
+            let check = self.list.displacement_check(self.particles.len());
+            let must_rebuild = check.is_none();
+            drift_kick(&mut self.particles, dt, check) || must_rebuild
         } else {
+            drift_kick(&mut self.particles, dt, None);
             self.drive_kinematic_particles(self.time + dt);
             self.list.needs_rebuild(&self.particles.position)
         };

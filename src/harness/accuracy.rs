@@ -16,11 +16,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::suite::{Code, Suite, SuiteError};
-use super::validate::{
-    fill_from_summary, output_error, run_cgdem, run_reference_code, RunOutcome, RunRecord,
-    ValidateError, ValidateOptions,
-};
+use super::suite::{parse_codes, parse_variant, Code, Suite, SuiteError};
+use super::validate::{output_error, run_one, ValidateError, ValidateOptions};
 use crate::coarse_graining::CoarseGrainRule;
 use crate::io::write_atomic;
 use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
@@ -134,24 +131,13 @@ impl AccuracySweep {
             value,
             allowed: allowed.into(),
         };
-        let name_ok = !raw.variant.is_empty()
-            && raw
-                .variant
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
-        if !name_ok {
-            return Err(invalid(
-                "variant",
-                format!("\"{}\"", raw.variant),
-                "a name of letters, digits, `-` and `_`",
-            ));
-        }
-        let overrides = raw
-            .set
-            .iter()
-            .map(|o| Override::parse(o, path))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| invalid("set", format!("{:?}", raw.set), &e.to_string()))?;
+        // An accuracy sweep always names its variant: its runs sit beside the case's own.
+        let overrides = parse_variant(
+            &raw.set,
+            Some(&raw.variant),
+            &format!("accuracy[{k}]"),
+            path,
+        )?;
         let lambda_ok = |v: f64| v >= 1.0 && v.fract() == 0.0 && (v as u32).is_power_of_two();
         let mut reference = BTreeMap::new();
         for (key, value) in &raw.reference {
@@ -200,18 +186,9 @@ impl AccuracySweep {
                 })?;
             let codes = match s.codes {
                 None => vec![Code::Cgdem],
-                Some(names) => names
-                    .iter()
-                    .map(|n| {
-                        Code::from_name(n).ok_or_else(|| {
-                            invalid(
-                                &format!("series[{j}].codes"),
-                                format!("\"{n}\""),
-                                "\"cgdem\", \"lammps\" or \"liggghts\"",
-                            )
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()?,
+                Some(names) => {
+                    parse_codes(&names, &format!("accuracy[{k}].series[{j}].codes"), path)?
+                }
             };
             series.push(KnobSeries {
                 knob,
@@ -610,43 +587,7 @@ fn run_point(
     options: &ValidateOptions,
 ) -> AccuracyPoint {
     let rule = CoarseGrainRule::Seed;
-    let mut record = RunRecord {
-        case: scene.name.clone(),
-        code,
-        lambda,
-        cg_rule: rule,
-        seed,
-        status: "ok".into(),
-        reason: None,
-        dir: dir.to_path_buf(),
-        n_particles: None,
-        steps: None,
-        wall_s: None,
-        particle_steps_per_s: None,
-        repose_angle_deg: None,
-        repose_fit_r2: None,
-        runout_m: None,
-        reused: false,
-        partial: false,
-    };
-    let outcome = match code {
-        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
-        _ => run_reference_code(code, scene, lambda, rule, seed, dir, options),
-    };
-    match outcome {
-        Ok(reused) => {
-            record.reused = reused;
-            fill_from_summary(&mut record);
-        }
-        Err(RunOutcome::Skipped(reason)) => {
-            record.status = "skipped".into();
-            record.reason = Some(reason);
-        }
-        Err(RunOutcome::Failed(reason)) => {
-            record.status = "failed".into();
-            record.reason = Some(reason);
-        }
-    }
+    let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
     // A run that stopped early (a guard, a time limit) measured nothing comparable.
     if record.partial {
         record.status = "failed".into();

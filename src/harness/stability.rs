@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::lammps::runner::{log_tail_of, RunStatus, RunnerOptions};
-use super::suite::{Code, SuiteError};
+use super::suite::{parse_codes, parse_variant, Code, SuiteError};
 use crate::coarse_graining::coarse_grain;
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
@@ -79,11 +79,7 @@ pub struct StabilityCase {
 
 impl StabilityCase {
     pub fn load_scene(&self) -> Result<Scene, SceneError> {
-        let mut scene = Scene::load_with_overrides(&self.file, &self.overrides)?;
-        if let Some(v) = &self.variant {
-            scene.name = format!("{}-{v}", scene.name);
-        }
-        Ok(scene)
+        super::suite::load_variant(&self.file, &self.overrides, self.variant.as_deref())
     }
 }
 
@@ -102,19 +98,7 @@ pub(crate) fn parse_cases(
         let codes = if c.codes.is_empty() {
             vec![Code::Cgdem, Code::Lammps, Code::Liggghts]
         } else {
-            c.codes
-                .iter()
-                .map(|name| match name.as_str() {
-                    "cgdem" => Ok(Code::Cgdem),
-                    "lammps" => Ok(Code::Lammps),
-                    "liggghts" => Ok(Code::Liggghts),
-                    other => Err(invalid(
-                        format!("stability[{k}].codes"),
-                        format!("\"{other}\""),
-                        "\"cgdem\", \"lammps\" or \"liggghts\"",
-                    )),
-                })
-                .collect::<Result<Vec<_>, _>>()?
+            parse_codes(&c.codes, &format!("stability[{k}].codes"), path)?
         };
         let lambda = c.lambda.unwrap_or(1);
         if !lambda.is_power_of_two() {
@@ -137,25 +121,12 @@ pub(crate) fn parse_cases(
         };
         let energy_tolerance = fraction("energy_tolerance", c.energy_tolerance.unwrap_or(0.05))?;
         let max_overlap = fraction("max_overlap", c.max_overlap.unwrap_or(0.25))?;
-        let overrides = c
-            .set
-            .iter()
-            .map(|o| Override::parse(o, path))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| {
-                invalid(
-                    format!("stability[{k}].set"),
-                    format!("{:?}", c.set),
-                    &e.to_string(),
-                )
-            })?;
-        if !overrides.is_empty() && c.variant.is_none() {
-            return Err(invalid(
-                format!("stability[{k}].variant"),
-                "(missing)".into(),
-                "a name for the variant that `set` makes",
-            ));
-        }
+        let overrides = parse_variant(
+            &c.set,
+            c.variant.as_deref(),
+            &format!("stability[{k}]"),
+            path,
+        )?;
         out.push(StabilityCase {
             file: c.file,
             codes,

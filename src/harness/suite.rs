@@ -34,6 +34,79 @@ impl Code {
     }
 }
 
+/// The scene of a suite entry: its file with the overrides applied, named after the
+/// variant (`aor_collapse-smooth-walls`) when there is one.
+pub(crate) fn load_variant(
+    file: &Path,
+    overrides: &[Override],
+    variant: Option<&str>,
+) -> Result<Scene, SceneError> {
+    let mut scene = Scene::load_with_overrides(file, overrides)?;
+    if let Some(v) = variant {
+        scene.name = format!("{}-{v}", scene.name);
+    }
+    Ok(scene)
+}
+
+/// A suite entry's `set` overrides, checked with its `variant` name: a name of letters,
+/// digits, `-` and `_`, required when `set` changes the scene. `entry` names the entry in
+/// messages (`case[2]`).
+pub(crate) fn parse_variant(
+    set: &[String],
+    variant: Option<&str>,
+    entry: &str,
+    path: &Path,
+) -> Result<Vec<Override>, SuiteError> {
+    let invalid = |field: &str, value: String, allowed: String| SuiteError::Invalid {
+        file: path.to_path_buf(),
+        field: format!("{entry}.{field}"),
+        value,
+        allowed,
+    };
+    let overrides = set
+        .iter()
+        .map(|o| Override::parse(o, path))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| invalid("set", format!("{set:?}"), e.to_string()))?;
+    let name_ok = |v: &str| {
+        !v.is_empty()
+            && v.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+    };
+    match variant {
+        Some(v) if !name_ok(v) => Err(invalid(
+            "variant",
+            format!("\"{v}\""),
+            "a name of letters, digits, `-` and `_`".into(),
+        )),
+        None if !overrides.is_empty() => Err(invalid(
+            "variant",
+            "(missing)".into(),
+            "a name for the variant that `set` makes, e.g. variant = \"smooth-walls\"".into(),
+        )),
+        _ => Ok(overrides),
+    }
+}
+
+/// A suite entry's `codes`, by name; `field` names the list in messages.
+pub(crate) fn parse_codes(
+    names: &[String],
+    field: &str,
+    path: &Path,
+) -> Result<Vec<Code>, SuiteError> {
+    names
+        .iter()
+        .map(|name| {
+            Code::from_name(name).ok_or_else(|| SuiteError::Invalid {
+                file: path.to_path_buf(),
+                field: field.into(),
+                value: format!("\"{name}\""),
+                allowed: "\"cgdem\", \"lammps\" or \"liggghts\"".into(),
+            })
+        })
+        .collect()
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct SuiteCase {
     /// The scene file, relative to the repository root (the working directory).
@@ -61,11 +134,7 @@ pub struct SuiteCase {
 impl SuiteCase {
     /// The case's scene: its file with the overrides applied, named after the variant.
     pub fn load_scene(&self) -> Result<Scene, SceneError> {
-        let mut scene = Scene::load_with_overrides(&self.file, &self.overrides)?;
-        if let Some(v) = &self.variant {
-            scene.name = format!("{}-{v}", scene.name);
-        }
-        Ok(scene)
+        load_variant(&self.file, &self.overrides, self.variant.as_deref())
     }
 }
 
@@ -153,19 +222,7 @@ impl Suite {
         };
         let mut cases = Vec::new();
         for (k, c) in raw.cases.into_iter().enumerate() {
-            let codes = c
-                .codes
-                .iter()
-                .map(|name| {
-                    Code::from_name(name).ok_or_else(|| {
-                        invalid(
-                            format!("case[{k}].codes"),
-                            format!("\"{name}\""),
-                            "\"cgdem\", \"lammps\" or \"liggghts\"",
-                        )
-                    })
-                })
-                .collect::<Result<Vec<_>, _>>()?;
+            let codes = parse_codes(&c.codes, &format!("case[{k}].codes"), path)?;
             if codes.is_empty() {
                 return Err(invalid(
                     format!("case[{k}].codes"),
@@ -226,40 +283,8 @@ impl Suite {
             let time_ratio_tolerance =
                 fraction("time_ratio_tolerance", c.time_ratio_tolerance, 0.10)?;
             let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
-            let overrides = c
-                .set
-                .iter()
-                .map(|o| Override::parse(o, path))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| {
-                    invalid(
-                        format!("case[{k}].set"),
-                        format!("{:?}", c.set),
-                        &e.to_string(),
-                    )
-                })?;
-            let variant_ok = |v: &str| {
-                !v.is_empty()
-                    && v.chars()
-                        .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-            };
-            match &c.variant {
-                Some(v) if !variant_ok(v) => {
-                    return Err(invalid(
-                        format!("case[{k}].variant"),
-                        format!("\"{v}\""),
-                        "a name of letters, digits, `-` and `_`",
-                    ))
-                }
-                None if !overrides.is_empty() => {
-                    return Err(invalid(
-                        format!("case[{k}].variant"),
-                        "(missing)".into(),
-                        "a name for the variant that `set` makes, e.g. variant = \"smooth-walls\"",
-                    ))
-                }
-                _ => {}
-            }
+            let overrides =
+                parse_variant(&c.set, c.variant.as_deref(), &format!("case[{k}]"), path)?;
             cases.push(SuiteCase {
                 file: c.file,
                 codes,

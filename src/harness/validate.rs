@@ -351,44 +351,7 @@ fn run_case(
                 // Alternate the codes within each seed, so machine drift hits all alike.
                 for &code in &case.codes {
                     let dir = run_dir(&options.out, scene, code, lambda, rule, seed);
-                    let mut record = RunRecord {
-                        case: scene.name.clone(),
-                        code,
-                        lambda,
-                        cg_rule: rule,
-                        seed,
-                        status: "ok".into(),
-                        reason: None,
-                        dir: dir.clone(),
-                        n_particles: None,
-                        steps: None,
-                        wall_s: None,
-                        particle_steps_per_s: None,
-                        repose_angle_deg: None,
-                        repose_fit_r2: None,
-                        runout_m: None,
-                        reused: false,
-                        partial: false,
-                    };
-                    let outcome = match code {
-                        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, &dir, options)
-                            .map(|reused| record.reused = reused),
-                        Code::Lammps | Code::Liggghts => {
-                            run_reference_code(code, scene, lambda, rule, seed, &dir, options)
-                                .map(|reused| record.reused = reused)
-                        }
-                    };
-                    match outcome {
-                        Ok(()) => fill_from_summary(&mut record),
-                        Err(RunOutcome::Skipped(reason)) => {
-                            record.status = "skipped".into();
-                            record.reason = Some(reason);
-                        }
-                        Err(RunOutcome::Failed(reason)) => {
-                            record.status = "failed".into();
-                            record.reason = Some(reason);
-                        }
-                    }
+                    let record = run_one(scene, code, lambda, rule, seed, &dir, options);
                     if !options.quiet {
                         eprintln!(
                             "{} {} lambda={lambda} rule={} seed={seed}: {}{}",
@@ -410,13 +373,66 @@ fn run_case(
     Ok(records)
 }
 
-pub(super) enum RunOutcome {
+/// Runs one code on one setting (or, with `--reuse`, takes the run already in `dir`) and
+/// reads what it measured; a run that could not be made is recorded as skipped or failed.
+pub(super) fn run_one(
+    scene: &Scene,
+    code: Code,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    options: &ValidateOptions,
+) -> RunRecord {
+    let mut record = RunRecord {
+        case: scene.name.clone(),
+        code,
+        lambda,
+        cg_rule: rule,
+        seed,
+        status: "ok".into(),
+        reason: None,
+        dir: dir.to_path_buf(),
+        n_particles: None,
+        steps: None,
+        wall_s: None,
+        particle_steps_per_s: None,
+        repose_angle_deg: None,
+        repose_fit_r2: None,
+        runout_m: None,
+        reused: false,
+        partial: false,
+    };
+    let outcome = match code {
+        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
+        Code::Lammps | Code::Liggghts => {
+            run_reference_code(code, scene, lambda, rule, seed, dir, options)
+        }
+    };
+    match outcome {
+        Ok(reused) => {
+            record.reused = reused;
+            fill_from_summary(&mut record);
+        }
+        Err(RunOutcome::Skipped(reason)) => {
+            record.status = "skipped".into();
+            record.reason = Some(reason);
+        }
+        Err(RunOutcome::Failed(reason)) => {
+            record.status = "failed".into();
+            record.reason = Some(reason);
+        }
+    }
+    record
+}
+
+enum RunOutcome {
     Skipped(String),
     Failed(String),
 }
 
 /// Runs cgdem, or with `--reuse` takes the run already in `dir`; true when reused.
-pub(super) fn run_cgdem(
+fn run_cgdem(
     scene: &Scene,
     lambda: u32,
     rule: CoarseGrainRule,
@@ -450,7 +466,7 @@ fn finished_digest(dir: &Path) -> Option<String> {
 
 /// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
 /// reused. LIGGGHTS cannot express the seed's WCA model: its runs of such a case are skipped.
-pub(super) fn run_reference_code(
+fn run_reference_code(
     code: Code,
     scene: &Scene,
     lambda: u32,
@@ -519,7 +535,7 @@ pub(super) fn run_reference_code(
     }
 }
 
-pub(super) fn fill_from_summary(record: &mut RunRecord) {
+fn fill_from_summary(record: &mut RunRecord) {
     let path = record.dir.join("summary.json");
     let value: serde_json::Value = match std::fs::read_to_string(&path)
         .map_err(|e| e.to_string())
