@@ -111,6 +111,10 @@ enum Command {
         /// cgdem runs warn instead of stopping when a guard fires.
         #[arg(long)]
         keep_going: bool,
+        /// Runs of a case made at the same time, each with threads / jobs of the threads
+        /// (2 on 2 cores keeps both busy with small single-threaded runs).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: u16,
     },
     /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
     /// starts from one state that cgdem prepares, runs the same steps, alternating (A B C,
@@ -424,6 +428,7 @@ fn main() -> ExitCode {
             quiet,
             reuse,
             keep_going,
+            jobs,
         } => {
             let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
                 PathBuf::from(&suite)
@@ -441,6 +446,7 @@ fn main() -> ExitCode {
                 reference_timeout_s: reference_timeout,
                 reuse,
                 keep_going,
+                jobs: usize::from(jobs),
             };
             match pool.install(|| cgdem::harness::validate::validate(&options)) {
                 Ok(summary) => {

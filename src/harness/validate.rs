@@ -109,6 +109,8 @@ pub struct ValidateOptions {
     pub reuse: bool,
     /// cgdem's guards only warn instead of stopping a run (`--keep-going`).
     pub keep_going: bool,
+    /// Runs of a case made at the same time (`--jobs`), sharing the threads.
+    pub jobs: usize,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -282,6 +284,7 @@ fn provenance(suite: &Suite, options: &ValidateOptions) -> BTreeMap<String, Stri
     let mut p = machine_provenance();
     p.insert("suite file".into(), suite.source.display().to_string());
     p.insert("output".into(), options.out.display().to_string());
+    p.insert("concurrent runs (jobs)".into(), options.jobs.to_string());
     p
 }
 
@@ -344,33 +347,80 @@ fn run_case(
     case: &SuiteCase,
     options: &ValidateOptions,
 ) -> Result<Vec<RunRecord>, ValidateError> {
-    let mut records = Vec::new();
+    // Alternate the codes within each seed, so machine drift hits all alike.
+    let mut settings = Vec::new();
     for &rule in &case.cg_rules {
         for &lambda in &case.lambdas {
             for &seed in &case.seeds {
-                // Alternate the codes within each seed, so machine drift hits all alike.
                 for &code in &case.codes {
-                    let dir = run_dir(&options.out, scene, code, lambda, rule, seed);
-                    let record = run_one(scene, code, lambda, rule, seed, &dir, options);
-                    if !options.quiet {
-                        eprintln!(
-                            "{} {} lambda={lambda} rule={} seed={seed}: {}{}",
-                            scene.name,
-                            code.name(),
-                            rule_name(rule),
-                            record.status,
-                            record
-                                .reason
-                                .as_deref()
-                                .map_or(String::new(), |r| format!(" ({r})"))
-                        );
-                    }
-                    records.push(record);
+                    settings.push((rule, lambda, seed, code));
                 }
             }
         }
     }
+    let records = run_concurrently(&settings, options.jobs, |&(rule, lambda, seed, code)| {
+        let dir = run_dir(&options.out, scene, code, lambda, rule, seed);
+        let record = run_one(scene, code, lambda, rule, seed, &dir, options);
+        if !options.quiet {
+            eprintln!(
+                "{} {} lambda={lambda} rule={} seed={seed}: {}{}",
+                scene.name,
+                code.name(),
+                rule_name(rule),
+                record.status,
+                record
+                    .reason
+                    .as_deref()
+                    .map_or(String::new(), |r| format!(" ({r})"))
+            );
+        }
+        record
+    });
     Ok(records)
+}
+
+/// `run` applied to every item, `jobs` at a time, results in the items' order. With more
+/// than one job, the cores of the calling rayon pool are shared out: each job runs in a pool
+/// of its own with `threads / jobs` threads (at least one), so cgdem runs do not oversubscribe
+/// the machine; a reference code runs as one process per job.
+pub(super) fn run_concurrently<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    run: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    if jobs <= 1 || items.len() <= 1 {
+        return items.iter().map(&run).collect();
+    }
+    let threads_per_job = (rayon::current_num_threads() / jobs).max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<std::sync::Mutex<Option<R>>> =
+        items.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.min(items.len()) {
+            scope.spawn(|| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads_per_job)
+                    .build();
+                loop {
+                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some(item) = items.get(k) else { break };
+                    let result = match &pool {
+                        Ok(pool) => pool.install(|| run(item)),
+                        Err(_) => run(item), // no pool of its own: the global one
+                    };
+                    *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+                }
+            });
+        }
+    });
+    results
+        .into_iter()
+        .map(|r| {
+            r.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .expect("every item is taken by exactly one job")
+        })
+        .collect()
 }
 
 /// Runs one code on one setting (or, with `--reuse`, takes the run already in `dir`) and
@@ -1120,4 +1170,30 @@ fn fixed_time_angles(dir: &Path) -> Vec<(f64, f64)> {
                 .collect()
         })
         .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::run_concurrently;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn concurrent_runs_take_every_item_once_and_keep_the_order() {
+        let items: Vec<u32> = (0..17).collect();
+        for jobs in [1, 2, 3, 40] {
+            let calls = AtomicUsize::new(0);
+            let out = run_concurrently(&items, jobs, |&k| {
+                calls.fetch_add(1, Ordering::Relaxed);
+                (k * k, rayon::current_num_threads())
+            });
+            assert_eq!(calls.load(Ordering::Relaxed), items.len(), "jobs {jobs}");
+            let squares: Vec<u32> = out.iter().map(|o| o.0).collect();
+            assert_eq!(squares, items.iter().map(|k| k * k).collect::<Vec<_>>());
+            if jobs > 1 {
+                // Each job's pool holds its share of the threads, at least one.
+                let share = (rayon::current_num_threads() / jobs).max(1);
+                assert!(out.iter().all(|o| o.1 == share), "jobs {jobs}: {out:?}");
+            }
+        }
+    }
 }
