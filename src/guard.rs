@@ -16,9 +16,15 @@
 //!   repel and dissipate can store energy but not create it, so `E` may not exceed the
 //!   reference by more than [`GuardSettings::energy_growth`] of `max(E_ref, M e_floor)`.
 //!   The check is off while a moving body does work and for cohesive laws (binding energy
-//!   turns into kinetic energy legitimately).
+//!   turns into kinetic energy legitimately). The reference includes the elastic energy
+//!   stored in overlapping pairs, which particles placed overlapping may turn into motion.
+//! - **Lost particles** (unless the scene says `[domain] lost = "warn"`): the list rebuild
+//!   finds particles that left the box through a bounded face; as in LAMMPS (`thermo_modify
+//!   lost error`), that stops the run, since the box no longer holds what is simulated, but
+//!   the particles stay in the outputs. With `lost = "warn"` (or `--keep-going`) they are
+//!   removed with a warning.
 
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 
 /// Thresholds of the guards. The defaults are what `cgdem run` uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +45,8 @@ pub struct GuardSettings {
     pub energy_every: u64,
     /// The scene's stable time-step limit, s (for messages; NaN when unknown).
     pub stable_dt: Real,
+    /// Whether a particle leaving the box through a bounded face stops the run.
+    pub stop_on_lost: bool,
 }
 
 impl Default for GuardSettings {
@@ -49,6 +57,7 @@ impl Default for GuardSettings {
             energy_floor_per_mass: 1e-3,
             energy_every: 16,
             stable_dt: Real::NAN,
+            stop_on_lost: true,
         }
     }
 }
@@ -59,6 +68,7 @@ pub enum GuardKind {
     NonFinite,
     Overlap,
     EnergyGrowth,
+    LostParticles,
 }
 
 impl GuardKind {
@@ -67,6 +77,7 @@ impl GuardKind {
             GuardKind::NonFinite => "non-finite state",
             GuardKind::Overlap => "overlap",
             GuardKind::EnergyGrowth => "energy growth",
+            GuardKind::LostParticles => "lost particles",
         }
     }
 }
@@ -142,6 +153,9 @@ pub(crate) struct GuardState {
     pub removed_energy: Real,
     /// Ids of particles that the list rebuild found at a non-finite position.
     pub removed_non_finite: Vec<u32>,
+    /// Particles the list rebuild found outside the box's bounded faces since the last
+    /// check (kept in place: the run stops): id, position and velocity.
+    pub left_box: Vec<(u32, Vec3, Vec3)>,
     pub trip: Option<GuardTrip>,
     pub peaks: GuardPeaks,
 }

@@ -418,12 +418,18 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         });
         let deleted_before = self.deleted;
         let mut remap: Option<Vec<u32>> = None;
-        let mut keep: Vec<bool> = self
-            .particles
-            .position
-            .iter()
-            .map(|&x| x.is_finite() && self.domain.contains_bounded(x))
-            .collect();
+        // A particle that left through a bounded face is removed, unless that stops the run:
+        // then it stays where it is, so the outputs hold it, and the guard names it.
+        let stop_on_lost = self.guard.settings.stop_on_lost;
+        let mut keep: Vec<bool> = Vec::with_capacity(old_count);
+        for (k, &x) in self.particles.position.iter().enumerate() {
+            let inside = self.domain.contains_bounded(x);
+            if stop_on_lost && x.is_finite() && !inside && self.guard.trip.is_none() {
+                let p = &self.particles;
+                self.guard.left_box.push((p.id[k], x, p.velocity[k]));
+            }
+            keep.push(x.is_finite() && (inside || stop_on_lost));
+        }
         if !self.delete_regions.is_empty() {
             for (k, &x) in self.particles.position.iter().enumerate() {
                 if keep[k] && self.in_delete_region(x) {
@@ -721,10 +727,31 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     /// The energy guard takes the present state as its reference (call when walls are
-    /// removed or bodies start: both change what is stored or supplied).
+    /// removed or bodies start: both change what is stored or supplied): kinetic plus
+    /// gravitational energy, plus the elastic energy stored in overlapping pairs, which may
+    /// turn into motion (particles placed overlapping push apart).
     pub fn reset_energy_reference(&mut self) {
-        self.guard.energy_reference = Some(self.mechanical_energy());
+        self.guard.energy_reference = Some(self.mechanical_energy() + self.pair_elastic_energy());
         self.guard.removed_energy = 0.0;
+    }
+
+    /// Elastic energy stored in the listed pairs (the normal law's potential); walls and
+    /// bodies are not counted. The list must be current (as after a rebuild).
+    pub fn pair_elastic_energy(&self) -> Real {
+        let p = &self.particles;
+        let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
+        self.list
+            .pairs
+            .iter()
+            .map(|pair| {
+                let (i, j) = (pair.i as usize, pair.j as usize);
+                let distance =
+                    (p.position[i] - (p.position[j] + images[pair.image as usize])).length();
+                let species_pair = p.species[i] as usize * self.n_species + p.species[j] as usize;
+                self.law
+                    .elastic_energy(species_pair, p.radius[i], p.radius[j], distance)
+            })
+            .sum()
     }
 
     /// The largest overlap of the last force evaluation, as a fraction of the smaller radius
@@ -780,6 +807,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             Some(self.diagnose_non_finite())
         } else if self.max_overlap_fraction() > s.max_overlap_fraction {
             Some(self.diagnose_overlap())
+        } else if !self.guard.left_box.is_empty() {
+            let left = std::mem::take(&mut self.guard.left_box);
+            s.stop_on_lost.then(|| self.diagnose_lost(&left))
         } else if s.energy_every > 0
             && self.steps.is_multiple_of(s.energy_every)
             && self.energy_guard_applies()
@@ -1003,6 +1033,50 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         trip
     }
 
+    fn diagnose_lost(&self, left: &[(u32, Vec3, Vec3)]) -> GuardTrip {
+        let (id, x, v) = left
+            .iter()
+            .copied()
+            .max_by(|a, b| a.2.length_squared().total_cmp(&b.2.length_squared()))
+            .expect("called with at least one particle");
+        let (lo, hi) = (self.domain.lo, self.domain.hi);
+        let face = (0..3)
+            .find_map(|a| {
+                if self.domain.periodic[a] {
+                    None
+                } else if x[a] < lo[a] {
+                    Some(format!("{}lo", ["x", "y", "z"][a]))
+                } else if x[a] > hi[a] {
+                    Some(format!("{}hi", ["x", "y", "z"][a]))
+                } else {
+                    None
+                }
+            })
+            .unwrap_or_else(|| "a bounded face".into());
+        let initial = self.guard.initial_overlap.unwrap_or(0.0);
+        let cause = if let Some(forced) = forced_step_cause(self.dt, self.guard.settings.stable_dt)
+        {
+            forced
+        } else if initial > 0.01 && self.time < 0.1 {
+            format!("the particles were placed overlapping (largest overlap {:.0}% of the radius before the first step) and the elastic energy released threw them out", 100.0 * initial)
+        } else {
+            "the box does not hold the motion: enlarge it, close it with walls, or catch such particles with a [[delete]] region (or set [domain] lost = \"warn\" to remove them with a warning)".into()
+        };
+        self.trip(
+            GuardKind::LostParticles,
+            left.iter().map(|l| l.0).collect(),
+            format!(
+                "{} particle(s) left the box through a bounded face; the fastest, id {id}, crossed {face} at ({:.4e}, {:.4e}, {:.4e}) m moving at {:.3} m/s",
+                left.len(),
+                x.x,
+                x.y,
+                x.z,
+                v.length()
+            ),
+            cause,
+        )
+    }
+
     fn diagnose_energy(&self, energy: Real, reference: Real) -> GuardTrip {
         let p = &self.particles;
         let s = self.guard.settings;
@@ -1022,7 +1096,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             GuardKind::EnergyGrowth,
             by_energy.iter().take(3).map(|e| e.1).collect(),
             format!(
-                "kinetic plus gravitational energy rose to {energy:.4e} J from {reference:.4e} J at the start of the run or stage (allowed: +{:.0}%) with no work done on the particles; the particles named move fastest",
+                "kinetic plus gravitational energy rose to {energy:.4e} J, above the {reference:.4e} J held at the start of the run or stage (kinetic, gravitational and elastic in overlapping pairs; allowed: +{:.0}%), with no work done on the particles; the particles named move fastest",
                 100.0 * s.energy_growth
             ),
             cause,

@@ -70,6 +70,14 @@ pub trait NormalModel: Send + Sync {
         radius_j: Real,
         m_eff: Real,
     ) -> Real;
+    /// Elastic energy stored in the pair at centre distance `distance` (zero when apart).
+    fn elastic_energy(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        distance: Real,
+    ) -> Real;
 }
 
 pub trait DampingModel: Send + Sync {
@@ -144,6 +152,15 @@ pub trait PairLaw: Send + Sync {
         radius_j: Real,
         m_eff: Real,
     ) -> (Real, Real);
+    /// Elastic energy of the repulsion stored at centre distance `distance` (the energy
+    /// guard counts it, so that particles placed overlapping may push apart).
+    fn elastic_energy(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        distance: Real,
+    ) -> Real;
 }
 
 /// A contact law assembled from five slots.
@@ -247,6 +264,17 @@ where
             .linear_stiffness(species_pair, radius_i, radius_j, m_eff);
         let gamma = self.damping.linear_coefficient(species_pair, k, m_eff);
         (k, gamma)
+    }
+
+    fn elastic_energy(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        distance: Real,
+    ) -> Real {
+        self.normal
+            .elastic_energy(species_pair, radius_i, radius_j, distance)
     }
 }
 

@@ -604,6 +604,8 @@ fn execute<L: PairLaw, W: WallLaw>(
     .with_integrator(scene.integrator);
     world.set_guard_settings(GuardSettings {
         stable_dt: scales.stable_limit,
+        // With --keep-going guards only warn: lost particles are removed, as with "warn".
+        stop_on_lost: scene.stop_on_lost && !options.keep_going,
         ..GuardSettings::default()
     });
     let mut guard_counts: Vec<(GuardKind, u64)> = Vec::new();

@@ -325,6 +325,10 @@ pub struct Scene {
     pub description: String,
     pub source: PathBuf,
     pub domain: Domain,
+    /// Whether a particle leaving the box through a bounded face stops the run
+    /// (`[domain] lost = "error"`, the default, as LAMMPS's `thermo_modify lost error`) or is
+    /// removed with a warning (`lost = "warn"`).
+    pub stop_on_lost: bool,
     pub species: Vec<Species>,
     pub contact: ContactSettings,
     pub wall_contact: WallContactSettings,

@@ -96,6 +96,8 @@ pub struct RawDomain {
     pub hi: [f64; 3],
     #[serde(default)]
     pub periodic: [bool; 3],
+    /// "error" (default) or "warn": what a particle leaving through a bounded face does.
+    pub lost: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -77,6 +77,17 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         hi,
         periodic: raw.domain.periodic,
     };
+    let stop_on_lost = match raw.domain.lost.as_deref() {
+        None | Some("error") => true,
+        Some("warn") => false,
+        Some(other) => {
+            return Err(c.invalid(
+                "domain.lost",
+                format!("\"{other}\""),
+                "\"error\" (a particle leaving through a bounded face stops the run) or \"warn\" (it is removed with a warning)",
+            ))
+        }
+    };
     let shortest_side = (0..3).map(|a| hi[a] - lo[a]).fold(f64::INFINITY, f64::min);
 
     if raw.species.is_empty() {
@@ -757,6 +768,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         bodies,
         deletions,
         conveying,
+        stop_on_lost,
         name: raw.name,
         description: raw.description,
         source: file.to_path_buf(),

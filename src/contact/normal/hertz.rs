@@ -82,6 +82,22 @@ impl NormalModel for Hertz {
         let delta = Hertz::max_overlap(y, r_eff, m_eff, self.characteristic_velocity);
         2.0 * y * (r_eff * delta).sqrt()
     }
+
+    /// `(8/15) Y_eff sqrt(R_eff) delta^(5/2)`, the integral of the force over the overlap.
+    fn elastic_energy(
+        &self,
+        species_pair: usize,
+        radius_i: Real,
+        radius_j: Real,
+        distance: Real,
+    ) -> Real {
+        let overlap = radius_i + radius_j - distance;
+        if overlap <= 0.0 {
+            return 0.0;
+        }
+        let r_eff = radius_i * radius_j / (radius_i + radius_j);
+        8.0 / 15.0 * self.y_eff[species_pair] * r_eff.sqrt() * overlap.powf(2.5)
+    }
 }
 
 #[cfg(test)]

@@ -76,6 +76,10 @@ impl NormalModel for Wca {
     fn linear_stiffness(&self, species_pair: usize, _: Real, _: Real, _: Real) -> Real {
         self.table[species_pair].contact_stiffness()
     }
+
+    fn elastic_energy(&self, species_pair: usize, _: Real, _: Real, distance: Real) -> Real {
+        self.table[species_pair].potential(distance)
+    }
 }
 
 #[cfg(test)]
