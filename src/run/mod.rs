@@ -567,12 +567,6 @@ fn execute<L: PairLaw, W: WallLaw>(
     }
 
     let (bodies, body_sites) = build_bodies(scene, &wall_law)?;
-    if !bodies.is_empty() && (L::NEEDS_ROTATION || W::NEEDS_ROTATION) {
-        return Err(RunError::NotAvailable(format!(
-            "{}: bodies (SDF walls) are implemented for the seed's model only so far; this scene's contact law rotates the particles",
-            scene.source.display()
-        )));
-    }
     let (particles, kinematic) = match &options.initial_state {
         // A given state carries no particle-built bodies (the bench's heap has none).
         Some(_) if !body_sites.is_empty() => {
