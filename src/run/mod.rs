@@ -327,6 +327,19 @@ pub fn initial_particles(
     initial_particles_with_bodies(scene, rotation, bodies, &[]).map(|(p, _)| p)
 }
 
+/// [`initial_particles`] clear of the scene's SDF bodies, as a run of the scene starts: what
+/// the reference codes start from.
+pub fn initial_particles_clear_of_bodies(scene: &Scene) -> Result<Particles, RunError> {
+    if scene.bodies.is_empty() {
+        return initial_particles(scene, false, &[]);
+    }
+    let (bodies, _) = match &scene.contact {
+        ContactSettings::Wca { .. } => build_bodies(scene, &seed_laws(scene).1)?,
+        ContactSettings::Hertz(h) => build_bodies(scene, &hertz::hertz_wall(scene, h))?,
+    };
+    initial_particles(scene, false, &bodies)
+}
+
 /// As [`initial_particles`], with the particles of bodies built of particles first (`sites`:
 /// per such body, its index in `bodies` and its lattice sites), frozen, and the record that
 /// moves them with their bodies.

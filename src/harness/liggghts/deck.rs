@@ -35,9 +35,10 @@ pub const MIN_YOUNGS_MODULUS: Real = 5e6;
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
 pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
-    let h = hertz_settings(scene, "LIGGGHTS")?;
+    let h = hertz_settings(scene, "LIGGGHTS", true)?;
     let n = scene.species.len();
-    let has_walls = !scene.walls.is_empty();
+    // Planar walls and meshes share one atom type, whose material is `[wall_contact]`.
+    let has_walls = !scene.walls.is_empty() || !scene.bodies.is_empty();
     let n_types = n + usize::from(has_walls);
     let (m, wm) = (material(h), wall_material(scene, h));
     for (what, e) in [
@@ -160,6 +161,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             g(at)
         );
     }
+    let meshes = mesh_lines(scene, n + 1, rolling)?;
+    d += &meshes.setup;
     d += &kinetic_energy_lines(dump_every, true);
     // LIGGGHTS's dump_modify format is one C format for the whole line (default: 6 digits).
     let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
@@ -172,22 +175,170 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         columns: HERTZ_COLUMNS,
         modify: &modify,
     };
-    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &dumps, |name| {
-        format!("unfix           w_{name}\n")
-    });
+    let begin = |stage: &str| stage_start_lines(scene, stage, dt);
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &dumps,
+        |name| format!("unfix           w_{name}\n"),
+        begin,
+    );
     Ok(Deck {
         input: d,
         data,
         plan: DeckPlan {
             code: "liggghts",
             log_file: LOG_FILE,
-            notes: Vec::new(),
+            notes: meshes.notes,
             dt,
             dump_every,
             repose_dumps,
         },
+        files: meshes.files,
     })
 }
+
+/// The deck lines of the scene's bodies: one `fix mesh/surface` per body from an ASCII STL
+/// of the same triangles cgdem builds its SDF from (metres), all in one `fix wall/gran ...
+/// mesh`; the STL files; and notes on what differs from cgdem.
+struct MeshLines {
+    setup: String,
+    files: Vec<(String, Vec<u8>)>,
+    notes: Vec<String>,
+}
+
+fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLines, DeckError> {
+    let unsupported = |reason: String| DeckError::Unsupported {
+        file: scene.source.display().to_string(),
+        reason,
+    };
+    let mut out = MeshLines {
+        setup: String::new(),
+        files: Vec::new(),
+        notes: Vec::new(),
+    };
+    if scene.bodies.is_empty() {
+        return Ok(out);
+    }
+    for (k, b) in scene.bodies.iter().enumerate() {
+        if b.particles.is_some() {
+            return Err(unsupported(format!(
+                "body[{k}] `{}` is built of particles; LIGGGHTS decks take mesh bodies",
+                b.name
+            )));
+        }
+        if b.velocity.length() > 0.0 {
+            return Err(unsupported(format!(
+                "body[{k}] `{}` translates; LIGGGHTS decks rotate bodies only",
+                b.name
+            )));
+        }
+        let mesh = b.mesh.load().map_err(|e| unsupported(format!("body[{k}].mesh: {e}")))?;
+        let file = format!("{}.stl", b.name);
+        out.files.push((file.clone(), crate::geometry::stl::stl_ascii(&mesh, &b.name).into_bytes()));
+        let _ = writeln!(
+            out.setup,
+            "fix             b_{} all mesh/surface file {file} type {wall_type} curvature 1e-5",
+            b.name
+        );
+        if b.start_stage.is_none() {
+            out.setup += &move_line(b);
+        }
+    }
+    let names: Vec<String> = scene.bodies.iter().map(|b| format!("b_{}", b.name)).collect();
+    let _ = writeln!(
+        out.setup,
+        "fix             bodies all wall/gran model hertz tangential history{rolling} mesh n_meshes {} meshes {}",
+        names.len(),
+        names.join(" ")
+    );
+    if !scene.deletions.is_empty() {
+        out.notes.push("LIGGGHTS 3.8 has no `fix evaporate`: grains in a [[delete]] box are not deleted there; they fall on and leave through the box's lower face (`thermo_modify lost ignore`), which changes nothing upstream of the box".into());
+    }
+    Ok(out)
+}
+
+/// `fix move/mesh ... rotate`: LIGGGHTS turns counter-clockwise about `axis` once per
+/// `period`; a negative rpm turns about the reversed axis.
+fn move_line(b: &crate::scene::BodySettings) -> String {
+    let axis = if b.rpm < 0.0 { -b.axis } else { b.axis };
+    if b.rpm == 0.0 {
+        return String::new();
+    }
+    format!(
+        "fix             move_{} all move/mesh mesh b_{} rotate origin {} {} {} axis {} {} {} period {}\n",
+        b.name,
+        b.name,
+        g(b.point.x),
+        g(b.point.y),
+        g(b.point.z),
+        g(axis.x),
+        g(axis.y),
+        g(axis.z),
+        g(60.0 / b.rpm.abs())
+    )
+}
+
+/// What starts with `stage`: the motion of the bodies that start then, and the top-ups of the
+/// insertions refilled during it (`fix insert/pack ... particles_in_region N`, N the count in
+/// the insertion box when the stage begins, first after one interval, as cgdem does). A
+/// `run 0` sets the new fixes up.
+fn stage_start_lines(scene: &Scene, stage: &str, dt: Real) -> String {
+    let mut d = String::new();
+    for b in scene
+        .bodies
+        .iter()
+        .filter(|b| b.start_stage.as_deref() == Some(stage))
+    {
+        d += &move_line(b);
+    }
+    for (k, ins) in scene.insertions.iter().enumerate() {
+        let Some(refill) = ins.refill.as_ref().filter(|r| r.stage == stage) else {
+            continue;
+        };
+        let species = &scene.species[ins.species];
+        let every = ((refill.interval / dt).round() as u64).max(1);
+        let _ = writeln!(
+            d,
+            "region          top_{k} block {} {} {} {} {} {}",
+            g(ins.lo.x),
+            g(ins.hi.x),
+            g(ins.lo.y),
+            g(ins.hi.y),
+            g(ins.lo.z),
+            g(ins.hi.z)
+        );
+        let _ = writeln!(
+            d,
+            "fix             pts_{k} all particletemplate/sphere {} atom_type {} density constant {} radius constant {}",
+            PRIMES[(2 * k) % PRIMES.len()],
+            ins.species + 1,
+            g(species.density),
+            g(species.radius())
+        );
+        let _ = writeln!(
+            d,
+            "fix             pdd_{k} all particledistribution/discrete {} 1 pts_{k} 1.0",
+            PRIMES[(2 * k + 1) % PRIMES.len()]
+        );
+        let _ = writeln!(d, "variable        top_n_{k} equal count(all,top_{k})");
+        let _ = writeln!(
+            d,
+            "fix             top_{k} all insert/pack seed {} distributiontemplate pdd_{k} maxattempt 200 insert_every {every} start $(step+{every}) overlapcheck yes all_in no particles_in_region ${{top_n_{k}}} region top_{k}",
+            PRIMES[(2 * k + 2) % PRIMES.len()]
+        );
+    }
+    if !d.is_empty() {
+        d += "run             0 post no\n";
+    }
+    d
+}
+
+/// Primes above 10000 for LIGGGHTS's random seeds.
+const PRIMES: [u64; 6] = [15485863, 32452843, 49979687, 67867967, 86028121, 104395301];
+
 
 /// The trajectory file of a run directory.
 pub fn trajectory(dir: &Path) -> std::path::PathBuf {
