@@ -1,5 +1,5 @@
-//! Screw-conveyor measurements (paper A sec. 4 and 6, Eq. 7): outlet mass flow from the
-//! deleted mass with block-average standard error, fill ratio in the screw section, bulk
+//! Screw-conveyor measurements (paper A sec. 4 and 6, Eq. 7): mass flow through a plane
+//! across the screw section (or at the outlet) with block-average standard error, fill ratio in the screw section, bulk
 //! density, drive torque, and the theoretical rate `Q = a (pi/4)(Ds^2 - ds^2) ps ns rho_b`.
 
 use serde::Serialize;
@@ -33,6 +33,39 @@ pub fn swept_area(c: &ConveyingSettings) -> Real {
     0.25 * std::f64::consts::PI * (c.outer_diameter.powi(2) - c.shaft_diameter.powi(2))
 }
 
+/// Mass that has passed the flow plane: the deleted mass plus the mass of the grains whose
+/// centres lie beyond the plane `flow_x` along the axis (without a plane, the deleted mass).
+/// Its slope is the flow through the plane. Counting the grains beyond the plane, rather than
+/// only those deleted below the outlet, takes out the outlet's once-per-turn discharge pulse:
+/// the grains between the plane and the outlet are counted as they cross the plane.
+pub fn passed_mass(
+    c: &ConveyingSettings,
+    axis: Vec3,
+    point: Vec3,
+    position: &[Vec3],
+    mass: &[Real],
+    deleted_mass: Real,
+) -> Real {
+    let Some(plane) = c.flow_x else {
+        return deleted_mass;
+    };
+    let beyond: Real = position
+        .iter()
+        .zip(mass)
+        .filter(|(&p, _)| (p - point).dot(axis) > plane)
+        .map(|(_, m)| m)
+        .sum();
+    deleted_mass + beyond
+}
+
+/// Where the flow is measured, in words for the summary.
+pub fn flow_rule(c: &ConveyingSettings) -> String {
+    match c.flow_x {
+        Some(x) => format!("through the plane at {x} m along the screw axis: slope of the deleted mass plus the mass of the grains with centres beyond the plane"),
+        None => "at the outlet: slope of the mass deleted below it".into(),
+    }
+}
+
 /// Mass of the particles whose centres lie in the bulk box over its volume.
 pub fn bulk_density(c: &ConveyingSettings, position: &[Vec3], mass: &[Real]) -> Real {
     let inside: Real = position
@@ -48,7 +81,8 @@ pub fn bulk_density(c: &ConveyingSettings, position: &[Vec3], mass: &[Real]) -> 
 #[derive(Clone, Copy, Debug)]
 pub struct ConveyingSample {
     pub time: Real,
-    pub deleted_mass: Real,
+    /// See [`passed_mass`].
+    pub passed_mass: Real,
     pub fill_ratio: Real,
     pub bulk_density: Real,
 }
@@ -62,6 +96,8 @@ pub struct ConveyingSummary {
     pub block_mass_flow_kg_s: Vec<Real>,
     pub mass_flow_kg_s: Real,
     pub mass_flow_std_error_kg_s: Real,
+    #[serde(default)]
+    pub flow_rule: String,
     /// Solid volume in the screw section over the swept volume (mean over the window).
     pub fill_ratio: Real,
     pub fill_rule: String,
@@ -111,7 +147,7 @@ pub fn summarize(
         .windows(2)
         .map(|e| {
             let (a, b) = (window[e[0]], window[e[1]]);
-            (b.deleted_mass - a.deleted_mass) / (b.time - a.time)
+            (b.passed_mass - a.passed_mass) / (b.time - a.time)
         })
         .collect();
     let mean = flows.iter().sum::<Real>() / blocks as Real;
@@ -131,6 +167,7 @@ pub fn summarize(
         block_mass_flow_kg_s: flows,
         mass_flow_kg_s: mean,
         mass_flow_std_error_kg_s: (var / blocks as Real).sqrt(),
+        flow_rule: flow_rule(c),
         fill_ratio: fill,
         fill_rule: format!(
             "solid volume of particles with centres in the bore (r < {} m) for {} <= x < {} m along the screw axis, over (pi/4)(Ds^2 - ds^2) times that length; mean of the samples in the window",
@@ -169,13 +206,14 @@ mod tests {
             pitch: 0.15,
             bore_radius: 0.1148,
             fill_x: [0.0, 0.1],
+            flow_x: None,
             bulk_lo: Vec3::ZERO,
             bulk_hi: Vec3::ONE,
         };
         let samples: Vec<ConveyingSample> = (0..=40)
             .map(|k| ConveyingSample {
                 time: k as Real * 0.05,
-                deleted_mass: 2.0 * k as Real * 0.05,
+                passed_mass: 2.0 * k as Real * 0.05,
                 fill_ratio: 0.5,
                 bulk_density: 800.0,
             })
@@ -189,5 +227,44 @@ mod tests {
         assert!((s.fill_ratio_bulk - 1.0).abs() < 1e-12);
         assert!((s.eq7_mass_flow_kg_s - 0.5 * 4.595e-3 * 1600.0).abs() < 1e-2);
         assert!((s.eq7_full_mass_flow_kg_s - 4.595e-3 * 800.0).abs() < 1e-2);
+    }
+
+    #[test]
+    fn passed_mass_counts_a_grain_once_whether_beyond_the_plane_or_deleted() {
+        let mut c = settings_for_plane(Some(0.5));
+        let axis = Vec3::X;
+        let point = Vec3::new(0.1, 0.0, 0.0);
+        let mass = [1.0, 2.0];
+        // Grain 1 upstream, grain 2 at axial 0.45 (x = 0.55): not yet past the plane.
+        let before = [Vec3::new(0.2, 0.0, 0.0), Vec3::new(0.55, 0.0, 0.0)];
+        assert_eq!(passed_mass(&c, axis, point, &before, &mass, 0.0), 0.0);
+        // Grain 2 crosses the plane (axial 0.7).
+        let crossed = [Vec3::new(0.2, 0.0, 0.0), Vec3::new(0.8, 0.0, 0.0)];
+        assert_eq!(passed_mass(&c, axis, point, &crossed, &mass, 0.0), 2.0);
+        // Grain 2 is deleted below the outlet: still counted once.
+        assert_eq!(
+            passed_mass(&c, axis, point, &crossed[..1], &mass[..1], 2.0),
+            2.0
+        );
+        // Without a plane only the deleted mass counts.
+        c.flow_x = None;
+        assert_eq!(passed_mass(&c, axis, point, &crossed, &mass, 0.5), 0.5);
+    }
+
+    fn settings_for_plane(flow_x: Option<Real>) -> ConveyingSettings {
+        ConveyingSettings {
+            stage: "convey".into(),
+            body: "screw".into(),
+            discard: 0.0,
+            blocks: 2,
+            outer_diameter: 0.205,
+            shaft_diameter: 0.055,
+            pitch: 0.15,
+            bore_radius: 0.1148,
+            fill_x: [0.0, 0.1],
+            flow_x,
+            bulk_lo: Vec3::ZERO,
+            bulk_hi: Vec3::ONE,
+        }
     }
 }

@@ -646,7 +646,7 @@ fn execute<L: PairLaw, W: WallLaw>(
     let mut timeseries = std::io::BufWriter::new(
         std::fs::File::create(&timeseries_path).map_err(|e| output_error(&timeseries_path, e))?,
     );
-    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{},mechanical_energy_j", if conveying_body.is_some() { ",fill_ratio,bulk_density_kg_m3" } else { "" }).map_err(|e| output_error(&timeseries_path, e))?;
+    writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{},mechanical_energy_j", if conveying_body.is_some() { ",fill_ratio,bulk_density_kg_m3,passed_mass_kg" } else { "" }).map_err(|e| output_error(&timeseries_path, e))?;
     let mut vtk = if scene.output.vtk_interval > 0.0 {
         Some(
             VtkSeries::new(&out.join("vtk"), "particles")
@@ -839,7 +839,14 @@ fn execute<L: PairLaw, W: WallLaw>(
                     let mass: Vec<Real> = mobile.iter().map(|&k| p.mass[k]).collect();
                     let sample = ConveyingSample {
                         time: world.time,
-                        deleted_mass: world.deleted_mass,
+                        passed_mass: conveying::passed_mass(
+                            c,
+                            body.motion.axis,
+                            body.motion.point,
+                            &position,
+                            &mass,
+                            world.deleted_mass,
+                        ),
                         fill_ratio: conveying::fill_ratio(
                             c,
                             body.motion.axis,
@@ -849,7 +856,10 @@ fn execute<L: PairLaw, W: WallLaw>(
                         ),
                         bulk_density: conveying::bulk_density(c, &position, &mass),
                     };
-                    extra += &format!(",{:.6e},{:.6e}", sample.fill_ratio, sample.bulk_density);
+                    extra += &format!(
+                        ",{:.6e},{:.6e},{:.9e}",
+                        sample.fill_ratio, sample.bulk_density, sample.passed_mass
+                    );
                     if measuring.is_some() {
                         conveying_samples.push(sample);
                     }

@@ -254,6 +254,9 @@ pub struct ConveyingSettings {
     pub bore_radius: Real,
     /// Axial range (along x, the screw axis) where the fill ratio is measured.
     pub fill_x: [Real; 2],
+    /// Axial position of the plane the mass flow is measured through (inside the screw
+    /// section, downstream of the inlet); `None`: at the outlet, from the deleted mass alone.
+    pub flow_x: Option<Real>,
     /// Box where the bulk density is measured (centres inside count).
     pub bulk_lo: Vec3,
     pub bulk_hi: Vec3,

@@ -84,6 +84,7 @@ pub struct RawConveying {
     pub pitch: f64,
     pub bore_radius: f64,
     pub fill_x: [f64; 2],
+    pub flow_x: Option<f64>,
     pub bulk_lo: [f64; 3],
     pub bulk_hi: [f64; 3],
 }

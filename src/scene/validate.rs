@@ -718,6 +718,9 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                     "an increasing range [x0, x1]",
                 ));
             }
+            if let Some(x) = cv.flow_x.filter(|x| !x.is_finite()) {
+                return Err(c.invalid("conveying.flow_x", x, "a finite axial position in m"));
+            }
             let bulk_lo = c.vector("conveying.bulk_lo", cv.bulk_lo)?;
             let bulk_hi = c.vector("conveying.bulk_hi", cv.bulk_hi)?;
             if bulk_lo.cmpge(bulk_hi).any() {
@@ -737,6 +740,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
                 pitch: c.positive("conveying.pitch", cv.pitch)?,
                 bore_radius: c.positive("conveying.bore_radius", cv.bore_radius)?,
                 fill_x: cv.fill_x,
+                flow_x: cv.flow_x,
                 bulk_lo,
                 bulk_hi,
             })
