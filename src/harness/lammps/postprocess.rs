@@ -7,11 +7,12 @@ use std::path::{Path, PathBuf};
 
 use super::deck::{DeckPlan, TRAJECTORY_FILE};
 use super::dump::{read_dump, DumpError, Frame};
+use crate::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
 use crate::analysis::heap::{self, HeapProfile};
 use crate::io::write_atomic;
 use crate::math::{Real, Vec3};
 use crate::run::{headline_sample, profile_csv, repose_csv, ReposeSample, RunSummary, StageRecord};
-use crate::scene::Scene;
+use crate::scene::{ConveyingSettings, Scene};
 use crate::timestep::Timescales;
 
 #[derive(Debug, thiserror::Error)]
@@ -98,7 +99,7 @@ pub fn frame_particles(
 
 /// One `CGDEM_STAGE` boundary printed by the deck.
 #[derive(Clone, Debug, PartialEq)]
-struct StageMark {
+pub(crate) struct StageMark {
     name: String,
     start: u64,
     end: Option<(u64, String)>,
@@ -395,6 +396,7 @@ pub fn postprocess(
     let (particle_steps, loop_s) =
         log_timing(&log).map_or((0, 0.0), |t| (t.particle_steps, t.loop_s));
     let headline = headline_sample(&samples);
+    let conveying = conveying_summary(scene, &marks, &frames, dt, &traj_path, &mut warnings)?;
     Ok(RunSummary {
         case: scene.name.clone(),
         code: plan.code.into(),
@@ -402,7 +404,7 @@ pub fn postprocess(
         cg_rule: scene.cg_rule,
         deleted_particles: 0,
         deleted_mass_kg: 0.0,
-        conveying: None,
+        conveying,
         stopped_by: None,
         guard_peaks: None,
         packing: None,
@@ -433,6 +435,114 @@ pub fn postprocess(
         final_state: None,
         memory: None,
     })
+}
+
+/// The conveying measurement of `analysis::conveying` from the trajectory frames of the
+/// conveying stage, as cgdem measures it from its state: per frame the passed mass (the mass
+/// of the grains that have vanished so far, each with the mass it had, plus the mass beyond
+/// the flow plane), the fill ratio and the bulk density; then the same block average. Grains
+/// of frozen species (a particle-built screw) do not count. The drive torque is not in the
+/// dumps (NaN).
+pub(crate) fn conveying_summary(
+    scene: &Scene,
+    marks: &[StageMark],
+    frames: &[Frame],
+    dt: Real,
+    file: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<Option<ConveyingSummary>, PostprocessError> {
+    let Some(c) = scene.conveying.as_ref() else {
+        return Ok(None);
+    };
+    let Some(body) = scene.bodies.iter().find(|b| b.name == c.body) else {
+        return Ok(None);
+    };
+    let Some(mark) = marks.iter().find(|m| m.name == c.stage) else {
+        warnings.push(format!(
+            "conveying: stage `{}` never started; no mass flow",
+            c.stage
+        ));
+        return Ok(None);
+    };
+    let end = mark.end.as_ref().map_or(u64::MAX, |(end, _)| *end);
+    let samples = conveying_samples(scene, c, body.axis, body.point, frames, dt, mark.start, end, file)?;
+    let (t0, t1) = (
+        mark.start as Real * dt + c.discard,
+        samples.last().map_or(0.0, |s| s.time),
+    );
+    let summary = conveying::summarize(
+        c,
+        body.rpm,
+        scene.species[0].density,
+        &samples,
+        t0,
+        t1,
+        Real::NAN,
+        Real::NAN,
+    );
+    if summary.is_none() {
+        warnings.push(format!("conveying: too few frames after the discarded {} s for {} blocks; shorten output.timeseries_interval or run longer", c.discard, c.blocks));
+    }
+    Ok(summary)
+}
+
+/// One `ConveyingSample` per frame in `(start, end]` (steps). A grain that was in an earlier
+/// frame (from the first frame of the run on) and is missing now counts as deleted, with its
+/// mass.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn conveying_samples(
+    scene: &Scene,
+    c: &ConveyingSettings,
+    axis: Vec3,
+    point: Vec3,
+    frames: &[Frame],
+    dt: Real,
+    start: u64,
+    end: u64,
+    file: &Path,
+) -> Result<Vec<ConveyingSample>, PostprocessError> {
+    let mut seen: std::collections::HashMap<i64, Real> = std::collections::HashMap::new();
+    let mut samples = Vec::new();
+    for frame in frames.iter().filter(|f| f.step <= end) {
+        let p = frame_particles(frame, scene, file)?;
+        let ids = frame.column("id").ok_or_else(|| PostprocessError::Content {
+            file: file.to_path_buf(),
+            message: format!("step {}: no column `id`", frame.step),
+        })?;
+        let types = frame.column("type").unwrap_or_default();
+        let mut present = std::collections::HashSet::new();
+        let (mut position, mut radius, mut mass) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..p.position.len() {
+            let frozen = types
+                .get(k)
+                .and_then(|&t| scene.species.get((t as usize).wrapping_sub(1)))
+                .is_some_and(|s| s.frozen);
+            if frozen {
+                continue;
+            }
+            let id = ids[k] as i64;
+            seen.insert(id, p.mass[k]);
+            present.insert(id);
+            position.push(p.position[k]);
+            radius.push(p.radius[k]);
+            mass.push(p.mass[k]);
+        }
+        if frame.step < start {
+            continue;
+        }
+        let deleted: Real = seen
+            .iter()
+            .filter(|(id, _)| !present.contains(id))
+            .map(|(_, m)| m)
+            .sum();
+        samples.push(ConveyingSample {
+            time: frame.step as Real * dt,
+            passed_mass: conveying::passed_mass(c, axis, point, &position, &mass, deleted),
+            fill_ratio: conveying::fill_ratio(c, axis, point, &position, &radius),
+            bulk_density: conveying::bulk_density(c, &position, &mass),
+        });
+    }
+    Ok(samples)
 }
 
 /// Writes the summary as `summary.json` in `dir`.

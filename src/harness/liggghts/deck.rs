@@ -175,7 +175,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         columns: HERTZ_COLUMNS,
         modify: &modify,
     };
-    let begin = |stage: &str| stage_start_lines(scene, stage, dt);
+    let begin = |stage: &str| stage_start_lines(scene, &meshes.pieces, stage, dt);
     let repose_dumps = stage_lines(
         &mut d,
         scene,
@@ -196,7 +196,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             dump_every,
             repose_dumps,
         },
-        files: meshes.files,
+        files: meshes.files.clone(),
     })
 }
 
@@ -205,6 +205,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
 /// mesh`; the STL files; and notes on what differs from cgdem.
 struct MeshLines {
     setup: String,
+    /// Per body, the names of its pieces (`b_NAME` is the mesh fix).
+    pieces: Vec<Vec<String>>,
     files: Vec<(String, Vec<u8>)>,
     notes: Vec<String>,
 }
@@ -216,13 +218,17 @@ fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLine
     };
     let mut out = MeshLines {
         setup: String::new(),
+        pieces: Vec::new(),
         files: Vec::new(),
         notes: Vec::new(),
     };
     if scene.bodies.is_empty() {
         return Ok(out);
     }
+    let mut names = Vec::new();
+    let mut body_pieces = Vec::new();
     for (k, b) in scene.bodies.iter().enumerate() {
+        let mut pieces = Vec::new();
         if b.particles.is_some() {
             return Err(unsupported(format!(
                 "body[{k}] `{}` is built of particles; LIGGGHTS decks take mesh bodies",
@@ -235,19 +241,39 @@ fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLine
                 b.name
             )));
         }
-        let mesh = b.mesh.load().map_err(|e| unsupported(format!("body[{k}].mesh: {e}")))?;
-        let file = format!("{}.stl", b.name);
-        out.files.push((file.clone(), crate::geometry::stl::stl_ascii(&mesh, &b.name).into_bytes()));
-        let _ = writeln!(
-            out.setup,
-            "fix             b_{} all mesh/surface file {file} type {wall_type} curvature 1e-5",
-            b.name
-        );
+        let mesh = b
+            .mesh
+            .load()
+            .map_err(|e| unsupported(format!("body[{k}].mesh: {e}")))?;
+        // One mesh fix per separate solid of the body (see `TriMesh::components`).
+        for (j, piece) in mesh.components().into_iter().enumerate() {
+            let (piece, dropped, area) = without_slivers(piece);
+            if dropped > 0 {
+                out.notes.push(format!(
+                    "body `{}` piece {j}: {dropped} sliver triangle(s) (smallest angle < {SLIVER_ANGLE_DEG} deg, {area:.1e} m2 in all) left out of the LIGGGHTS mesh, which refuses them",
+                    b.name
+                ));
+            }
+            let piece = &piece;
+            let name = format!("{}_{j}", b.name);
+            let file = format!("{name}.stl");
+            let text = crate::geometry::stl::stl_ascii(piece, &name);
+            out.files.push((file.clone(), text.into_bytes()));
+            let _ = writeln!(
+                out.setup,
+                "fix             b_{name} all mesh/surface file {file} type {wall_type} curvature 1e-5"
+            );
+            names.push(format!("b_{name}"));
+            pieces.push(name);
+        }
+        body_pieces.push(pieces);
+    }
+    for (b, pieces) in scene.bodies.iter().zip(&body_pieces) {
         if b.start_stage.is_none() {
-            out.setup += &move_line(b);
+            out.setup += &move_lines(b, pieces);
         }
     }
-    let names: Vec<String> = scene.bodies.iter().map(|b| format!("b_{}", b.name)).collect();
+    out.pieces = body_pieces;
     let _ = writeln!(
         out.setup,
         "fix             bodies all wall/gran model hertz tangential history{rolling} mesh n_meshes {} meshes {}",
@@ -260,39 +286,77 @@ fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLine
     Ok(out)
 }
 
-/// `fix move/mesh ... rotate`: LIGGGHTS turns counter-clockwise about `axis` once per
-/// `period`; a negative rpm turns about the reversed axis.
-fn move_line(b: &crate::scene::BodySettings) -> String {
-    let axis = if b.rpm < 0.0 { -b.axis } else { b.axis };
+/// `fix move/mesh ... rotate` for each piece of a turning body: LIGGGHTS turns
+/// counter-clockwise about `axis` once per `period`; a negative rpm turns about the reversed
+/// axis.
+fn move_lines(b: &crate::scene::BodySettings, pieces: &[String]) -> String {
     if b.rpm == 0.0 {
         return String::new();
     }
-    format!(
-        "fix             move_{} all move/mesh mesh b_{} rotate origin {} {} {} axis {} {} {} period {}\n",
-        b.name,
-        b.name,
-        g(b.point.x),
-        g(b.point.y),
-        g(b.point.z),
-        g(axis.x),
-        g(axis.y),
-        g(axis.z),
-        g(60.0 / b.rpm.abs())
-    )
+    let axis = if b.rpm < 0.0 { -b.axis } else { b.axis };
+    let mut d = String::new();
+    for name in pieces {
+        let _ = writeln!(
+            d,
+            "fix             move_{name} all move/mesh mesh b_{name} rotate origin {} {} {} axis {} {} {} period {}",
+            g(b.point.x),
+            g(b.point.y),
+            g(b.point.z),
+            g(axis.x),
+            g(axis.y),
+            g(axis.z),
+            g(60.0 / b.rpm.abs())
+        );
+    }
+    d
+}
+
+/// LIGGGHTS 3.8 aborts on a mesh element whose smallest angle is below about 0.01 deg
+/// (measured: the casing's gables, fan-triangulated, have two at 0.0093 deg).
+const SLIVER_ANGLE_DEG: Real = 0.02;
+
+/// The mesh without its sliver triangles: the mesh, how many were dropped and their area (a
+/// sliver's area is tiny, so the surface grains meet is the same).
+fn without_slivers(
+    mut mesh: crate::geometry::TriMesh,
+) -> (crate::geometry::TriMesh, usize, Real) {
+    let smallest_angle = |[a, b, c]: [crate::math::Vec3; 3]| {
+        [(a, b, c), (b, c, a), (c, a, b)]
+            .iter()
+            .map(|&(p, q, r)| (q - p).angle_between(r - p))
+            .fold(Real::INFINITY, Real::min)
+    };
+    let n = mesh.triangles.len();
+    let mut area = 0.0;
+    let keep: Vec<bool> = (0..n)
+        .map(|t| {
+            let tri = mesh.triangle(t);
+            let sliver = smallest_angle(tri).to_degrees() < SLIVER_ANGLE_DEG;
+            if sliver {
+                area += 0.5 * (tri[1] - tri[0]).cross(tri[2] - tri[0]).length();
+            }
+            !sliver
+        })
+        .collect();
+    let mut k = 0;
+    mesh.triangles.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    let dropped = n - mesh.triangles.len();
+    (mesh, dropped, area)
 }
 
 /// What starts with `stage`: the motion of the bodies that start then, and the top-ups of the
 /// insertions refilled during it (`fix insert/pack ... particles_in_region N`, N the count in
 /// the insertion box when the stage begins, first after one interval, as cgdem does). A
 /// `run 0` sets the new fixes up.
-fn stage_start_lines(scene: &Scene, stage: &str, dt: Real) -> String {
+fn stage_start_lines(scene: &Scene, pieces: &[Vec<String>], stage: &str, dt: Real) -> String {
     let mut d = String::new();
-    for b in scene
-        .bodies
-        .iter()
-        .filter(|b| b.start_stage.as_deref() == Some(stage))
-    {
-        d += &move_line(b);
+    for (b, pieces) in scene.bodies.iter().zip(pieces) {
+        if b.start_stage.as_deref() == Some(stage) {
+            d += &move_lines(b, pieces);
+        }
     }
     for (k, ins) in scene.insertions.iter().enumerate() {
         let Some(refill) = ins.refill.as_ref().filter(|r| r.stage == stage) else {
