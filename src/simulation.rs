@@ -657,8 +657,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let bodies = &self.bodies;
         // One load slot per body (one unused slot without bodies, so chunks exist).
         let body_slots = bodies.len().max(1);
-        self.body_loads
-            .resize(n * body_slots, BodyLoad::default());
+        self.body_loads.resize(n * body_slots, BodyLoad::default());
         let body_loads = &mut self.body_loads;
         let (list, dt) = (&self.list, self.dt);
         let (own_force, own_torque) = (&self.own_force, &self.own_torque);

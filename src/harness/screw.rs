@@ -43,9 +43,8 @@ pub fn points_by_code(runs: &[RunRecord]) -> Vec<(Code, Vec<SpeedPoint>)> {
                 continue;
             }
             let n = at.len() as f64;
-            let mean = |f: fn(&RunRecord) -> Option<f64>| {
-                at.iter().filter_map(|r| f(r)).sum::<f64>() / n
-            };
+            let mean =
+                |f: fn(&RunRecord) -> Option<f64>| at.iter().filter_map(|r| f(r)).sum::<f64>() / n;
             let se2: f64 = at
                 .iter()
                 .filter_map(|r| r.mass_flow_std_error_kg_s)
@@ -108,14 +107,17 @@ pub fn write_screw_section(
             .with_series(
                 Series::new(
                     format!("Eq. (7), {} fill", code.name()),
-                    points.iter().map(|p| (p.rpm, p.eq7_mass_flow_kg_s)).collect(),
+                    points
+                        .iter()
+                        .map(|p| (p.rpm, p.eq7_mass_flow_kg_s))
+                        .collect(),
                 )
                 .style(SeriesStyle::Dashed),
             );
     }
     if !figure.series.is_empty() {
-        let files = write_figure(&dir, "mass_flow_vs_rpm", &figure)
-            .map_err(|e| output_error(&dir, e))?;
+        let files =
+            write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;
         section
             .figure(
                 &files,

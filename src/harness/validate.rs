@@ -377,39 +377,39 @@ fn run_case(
         for &lambda in &case.lambdas {
             for &seed in &case.seeds {
                 for &rpm in &speeds {
-                // Alternate the codes within each seed, so machine drift hits all alike.
-                for &code in &case.codes {
-                    let mut dir = run_dir(&options.out, scene, code, lambda, rule, seed);
-                    let at_speed;
-                    let scene = match (rpm, &scene.conveying) {
-                        (Some(rpm), Some(c)) => {
-                            dir.set_file_name(format!(
-                                "{}-rpm{rpm}",
-                                dir.file_name().unwrap_or_default().to_string_lossy()
-                            ));
-                            at_speed = crate::sweep::at_speed(scene, &c.body, rpm);
-                            &at_speed
+                    // Alternate the codes within each seed, so machine drift hits all alike.
+                    for &code in &case.codes {
+                        let mut dir = run_dir(&options.out, scene, code, lambda, rule, seed);
+                        let at_speed;
+                        let scene = match (rpm, &scene.conveying) {
+                            (Some(rpm), Some(c)) => {
+                                dir.set_file_name(format!(
+                                    "{}-rpm{rpm}",
+                                    dir.file_name().unwrap_or_default().to_string_lossy()
+                                ));
+                                at_speed = crate::sweep::at_speed(scene, &c.body, rpm);
+                                &at_speed
+                            }
+                            _ => scene,
+                        };
+                        let mut record = run_one(scene, code, lambda, rule, seed, &dir, options);
+                        record.rpm = rpm;
+                        if !options.quiet {
+                            eprintln!(
+                                "{} {} lambda={lambda} rule={} seed={seed}{}: {}{}",
+                                scene.name,
+                                code.name(),
+                                rule_name(rule),
+                                rpm.map_or(String::new(), |r| format!(" rpm={r}")),
+                                record.status,
+                                record
+                                    .reason
+                                    .as_deref()
+                                    .map_or(String::new(), |r| format!(" ({r})"))
+                            );
                         }
-                        _ => scene,
-                    };
-                    let mut record = run_one(scene, code, lambda, rule, seed, &dir, options);
-                    record.rpm = rpm;
-                    if !options.quiet {
-                        eprintln!(
-                            "{} {} lambda={lambda} rule={} seed={seed}{}: {}{}",
-                            scene.name,
-                            code.name(),
-                            rule_name(rule),
-                            rpm.map_or(String::new(), |r| format!(" rpm={r}")),
-                            record.status,
-                            record
-                                .reason
-                                .as_deref()
-                                .map_or(String::new(), |r| format!(" ({r})"))
-                        );
+                        records.push(record);
                     }
-                    records.push(record);
-                }
                 }
             }
         }

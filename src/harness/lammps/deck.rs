@@ -498,9 +498,15 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         columns: WCA_COLUMNS,
         modify: "format float %.16g sort id",
     };
-    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &stages, |name| {
-        format!("unfix           wlj_{name}\nunfix           wgran_{name}\n")
-    }, |_| String::new());
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &stages,
+        |name| format!("unfix           wlj_{name}\nunfix           wgran_{name}\n"),
+        |_| String::new(),
+    );
     Ok(Deck {
         input: d,
         data,

@@ -92,7 +92,7 @@ pub(crate) fn hertz_settings<'a>(
     }
     if !meshes && (!scene.bodies.is_empty() || !scene.deletions.is_empty()) {
         return Err(unsupported(format!(
-            "{code} Hertz decks take planar walls only (no [[body]], no [[delete]])"
+            "{code} Hertz decks take planar walls only (no [[body]], no [[delete]]): LAMMPS has no mesh walls, and the deck with a particle-built screw is not written yet"
         )));
     }
     Ok(h)
@@ -290,9 +290,15 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         columns: HERTZ_COLUMNS,
         modify: "format float %.17g sort id",
     };
-    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &dumps, |name| {
-        format!("unfix           w_{name}\n")
-    }, |_| String::new());
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &dumps,
+        |name| format!("unfix           w_{name}\n"),
+        |_| String::new(),
+    );
     let mut notes = Vec::new();
     if h.rolling == RollingKind::Epsd2 {
         notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));

@@ -317,9 +317,7 @@ const SLIVER_ANGLE_DEG: Real = 0.02;
 
 /// The mesh without its sliver triangles: the mesh, how many were dropped and their area (a
 /// sliver's area is tiny, so the surface grains meet is the same).
-fn without_slivers(
-    mut mesh: crate::geometry::TriMesh,
-) -> (crate::geometry::TriMesh, usize, Real) {
+fn without_slivers(mut mesh: crate::geometry::TriMesh) -> (crate::geometry::TriMesh, usize, Real) {
     let smallest_angle = |[a, b, c]: [crate::math::Vec3; 3]| {
         [(a, b, c), (b, c, a), (c, a, b)]
             .iter()
@@ -403,7 +401,6 @@ fn stage_start_lines(scene: &Scene, pieces: &[Vec<String>], stage: &str, dt: Rea
 /// Primes above 10000 for LIGGGHTS's random seeds.
 const PRIMES: [u64; 6] = [15485863, 32452843, 49979687, 67867967, 86028121, 104395301];
 
-
 /// The trajectory file of a run directory.
 pub fn trajectory(dir: &Path) -> std::path::PathBuf {
     dir.join(TRAJECTORY_FILE)
@@ -434,6 +431,39 @@ mod tests {
         let sample = at(d, &format!("if              \"${{chunk1}} == 25\" then \"write_dump all custom repose_0.dump id type x y z vx vy vz omegax omegay omegaz radius modify sort id {format}\""));
         assert!(collapse < sample);
         assert_eq!(deck.plan.repose_dumps.len(), 3);
+    }
+
+    #[test]
+    fn screw_deck_turns_the_screw_mesh_from_the_conveying_stage_and_tops_up_the_hopper() {
+        let scene = Scene::load(std::path::Path::new(
+            "validation/cases/screw_feeder_hertz.toml",
+        ))
+        .unwrap();
+        let deck = write_deck(&scene, &Particles::new(true), 6e-5).unwrap();
+        let d = &deck.input;
+        // Meshes of the same triangles cgdem builds its SDF from, one fix per solid, as walls.
+        at(
+            d,
+            "fix             b_screw_0 all mesh/surface file screw_0.stl type 2",
+        );
+        at(
+            d,
+            "fix             b_hopper_0 all mesh/surface file hopper_0.stl type 2",
+        );
+        let walls = at(d, "fix             bodies all wall/gran model hertz tangential history mesh n_meshes 12 meshes b_screw_0 b_screw_1 b_casing_0");
+        assert!(deck.files.iter().any(|(name, text)| name == "casing_0.stl"
+            && String::from_utf8_lossy(text).starts_with("solid casing_0")));
+        // rpm -100 about +x: counter-clockwise about -x, 0.6 s per turn, from `convey` on.
+        let settle = at(d, "CGDEM_STAGE settle start");
+        let turn = at(d, "fix             move_screw_0 all move/mesh mesh b_screw_0 rotate origin 0.00000000000000000e0 0.00000000000000000e0 0.00000000000000000e0 axis -1.00000000000000000e0");
+        assert!(d[turn..].contains("period 5.99999999999999978e-1"));
+        let top_up = at(d, "fix             top_0 all insert/pack seed");
+        assert!(d[top_up..].contains("insert_every 1667 start $(step+1667) overlapcheck yes all_in no particles_in_region ${top_n_0} region top_0"));
+        let convey = at(d, "CGDEM_STAGE convey start");
+        assert!(walls < settle && settle < turn && turn < top_up && top_up < convey);
+        assert!(!d.contains("move_casing"));
+        at(d, "dump            traj all custom");
+        assert!(deck.plan.notes.iter().any(|n| n.contains("fix evaporate")));
     }
 
     #[test]
