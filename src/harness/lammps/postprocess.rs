@@ -516,7 +516,7 @@ pub(crate) fn conveying_samples(
         let types = frame.column("type").unwrap_or_default();
         let mut present = std::collections::HashSet::new();
         let (mut position, mut radius, mut mass) = (Vec::new(), Vec::new(), Vec::new());
-        for k in 0..p.position.len() {
+        for (k, &id) in ids.iter().enumerate() {
             let frozen = types
                 .get(k)
                 .and_then(|&t| scene.species.get((t as usize).wrapping_sub(1)))
@@ -524,7 +524,7 @@ pub(crate) fn conveying_samples(
             if frozen {
                 continue;
             }
-            let id = ids[k] as i64;
+            let id = id as i64;
             seen.insert(id, p.mass[k]);
             present.insert(id);
             position.push(p.position[k]);
