@@ -196,7 +196,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             dump_every,
             repose_dumps,
         },
-        files: meshes.files.clone(),
+        files: meshes.files,
     })
 }
 
