@@ -154,6 +154,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Replaces the bodies (posed at the current time) and re-evaluates the forces.
     pub fn set_bodies(&mut self, bodies: Vec<Body>) {
         self.bodies = bodies;
+        // Bodies take history slots after the planar walls': start them empty.
+        self.wall_history.clear();
         let time = self.time;
         for body in &mut self.bodies {
             body.set_time(time);
@@ -627,7 +629,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 overlap
             })
             .reduce(|| 0.0, larger);
-        // Fixed-order reduction: bitwise identical for any thread count.
+        self.reduce_body_loads();
+    }
+
+    /// Sums the per-particle body loads into the bodies, in a fixed order: bitwise identical
+    /// for any thread count.
+    fn reduce_body_loads(&mut self) {
+        let n_bodies = self.bodies.len();
         for (b, body) in self.bodies.iter_mut().enumerate() {
             let mut total = BodyLoad::default();
             for loads in self.body_loads.chunks_exact(n_bodies) {
@@ -637,9 +645,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
     }
 
-    /// History entries per particle: one per planar wall (at least one, so chunks exist).
+    /// History entries per particle: one per planar wall, then one per body (at least one,
+    /// so chunks exist).
     fn wall_slots(&self) -> usize {
-        self.walls.walls.len().max(1)
+        (self.walls.walls.len() + self.bodies.len()).max(1)
     }
 
     /// The gather for spinning particles: forces and torques of pairs, walls and gravity.
@@ -650,6 +659,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.wall_history.resize(n * slots, W::History::default());
         }
         let wall_history = &mut self.wall_history;
+        let n_walls = self.walls.walls.len();
+        let bodies = &self.bodies;
+        // One load slot per body (one unused slot without bodies, so chunks exist).
+        let body_slots = bodies.len().max(1);
+        self.body_loads.resize(n * body_slots, BodyLoad::default());
+        let body_loads = &mut self.body_loads;
         let (list, dt) = (&self.list, self.dt);
         let (own_force, own_torque) = (&self.own_force, &self.own_torque);
         let reaction = &self.reaction_spin;
@@ -672,9 +687,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .par_iter_mut()
             .zip(a.torque.par_iter_mut())
             .zip(wall_history.par_chunks_mut(slots))
+            .zip(body_loads.par_chunks_mut(body_slots))
             .enumerate()
             .with_min_len(CHUNK)
-            .map(|(i, ((force, torque), wall_history))| {
+            .map(|(i, (((force, torque), wall_history), loads))| {
                 let mut f = own_force[i] + mass[i] * gravity;
                 let particle = WallParticle {
                     species: species[i] as usize,
@@ -684,7 +700,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     mass: mass[i],
                 };
                 let mut t = own_torque[i];
-                let overlap = if W::NEEDS_ROTATION {
+                let (wall_history, body_history) = wall_history.split_at_mut(n_walls);
+                let mut overlap = if W::NEEDS_ROTATION {
                     let (wf, wt, overlap) =
                         walls.force_and_torque_on(wall_law, &particle, omega[i], wall_history, dt);
                     f += wf;
@@ -695,6 +712,15 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     f += wf;
                     overlap
                 };
+                for ((body, load), history) in bodies.iter().zip(loads.iter_mut()).zip(body_history)
+                {
+                    let (bf, bt, l, o) =
+                        body_force_and_torque(body, wall_law, &particle, omega[i], history, dt);
+                    f += bf;
+                    t += bt;
+                    *load = l;
+                    overlap = larger(overlap, o);
+                }
                 for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
                     let [rf, rt] = reaction[k as usize];
                     f += rf;
@@ -705,6 +731,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 overlap
             })
             .reduce(|| 0.0, larger);
+        if !self.bodies.is_empty() {
+            self.reduce_body_loads();
+        }
     }
 
     pub fn kinetic_energy(&self) -> Real {
@@ -1340,6 +1369,54 @@ fn body_force<W: WallLaw>(
         torque: (contact_point - body.center()).cross(-force),
     };
     (force, load, overlap)
+}
+
+/// `body_force` for spinning particles: the wall law's force and torque with the contact's
+/// history (tangential and rolling springs kept per particle per body, as for planar walls,
+/// and reset when they part). The body's own motion enters through the surface velocity at
+/// the contact point.
+fn body_force_and_torque<W: WallLaw>(
+    body: &Body,
+    law: &W,
+    particle: &WallParticle,
+    omega: Vec3,
+    history: &mut W::History,
+    dt: Real,
+) -> (Vec3, Vec3, BodyLoad, Real) {
+    let reach = law.reach(particle.species, particle.radius);
+    let reset = |history: &mut W::History| {
+        if *history != W::History::default() {
+            *history = W::History::default();
+        }
+    };
+    let Some((distance, normal)) = body.query(particle.position, reach) else {
+        reset(history);
+        return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), 0.0);
+    };
+    let overlap = overlap_fraction(distance, particle.radius);
+    if distance <= 0.0 || distance >= reach {
+        reset(history);
+        return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), overlap);
+    }
+    let contact_point = particle.position - distance * normal;
+    let contact = WallContact {
+        species: particle.species,
+        normal,
+        distance,
+        relative_velocity: particle.velocity - body.surface_velocity(contact_point),
+        radius: particle.radius,
+        mass: particle.mass,
+    };
+    let (force, torque) = if W::NEEDS_ROTATION {
+        law.force_and_torque_with_history(&contact, omega, history, dt)
+    } else {
+        (law.force(&contact, dt), Vec3::ZERO)
+    };
+    let load = BodyLoad {
+        force: -force,
+        torque: (contact_point - body.center()).cross(-force),
+    };
+    (force, torque, load, overlap)
 }
 
 /// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN

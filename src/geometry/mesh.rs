@@ -154,6 +154,48 @@ impl TriMesh {
         }
     }
 
+    /// The pieces that share no vertex (by index), each with its own vertices, in order of
+    /// their first triangle. A mesh assembled from separate closed solids (the screw feeder's
+    /// casing: prisms touching along faces) splits into those solids; LIGGGHTS refuses their
+    /// union, whose seam edges belong to four triangles.
+    pub fn components(&self) -> Vec<TriMesh> {
+        let mut parent: Vec<u32> = (0..self.vertices.len() as u32).collect();
+        fn root(parent: &mut [u32], mut v: u32) -> u32 {
+            while parent[v as usize] != v {
+                parent[v as usize] = parent[parent[v as usize] as usize];
+                v = parent[v as usize];
+            }
+            v
+        }
+        for t in &self.triangles {
+            for &v in &t[1..] {
+                let (a, b) = (root(&mut parent, t[0]), root(&mut parent, v));
+                parent[a as usize] = b;
+            }
+        }
+        let mut piece_of_root: Vec<Option<usize>> = vec![None; self.vertices.len()];
+        let mut pieces: Vec<(TriMesh, Vec<Option<u32>>)> = Vec::new();
+        for t in &self.triangles {
+            let r = root(&mut parent, t[0]) as usize;
+            let k = *piece_of_root[r].get_or_insert_with(|| {
+                pieces.push((
+                    TriMesh::new(Vec::new(), Vec::new()),
+                    vec![None; self.vertices.len()],
+                ));
+                pieces.len() - 1
+            });
+            let (mesh, index) = &mut pieces[k];
+            let tri = t.map(|v| {
+                *index[v as usize].get_or_insert_with(|| {
+                    mesh.vertices.push(self.vertices[v as usize]);
+                    mesh.vertices.len() as u32 - 1
+                })
+            });
+            mesh.triangles.push(tri);
+        }
+        pieces.into_iter().map(|(mesh, _)| mesh).collect()
+    }
+
     /// Finds every open, non-manifold and inconsistently oriented edge.
     pub fn check_topology(&self) -> TopologyReport {
         // (lower vertex, higher vertex, triangle, forward?) sorted so uses of an edge are adjacent.
@@ -189,6 +231,28 @@ impl TriMesh {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    #[test]
+    fn components_split_solids_that_share_no_vertex_and_keep_their_triangles() {
+        let tet = |o: Vec3| {
+            TriMesh::new(
+                vec![o, o + Vec3::X, o + Vec3::Y, o + Vec3::Z],
+                vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            )
+        };
+        let mut two = tet(Vec3::ZERO);
+        crate::geometry::mesh_builder::append(&mut two, tet(Vec3::X)); // touching, not welded
+        let pieces = two.components();
+        assert_eq!(pieces.len(), 2);
+        // The same triangles, in order (vertices renumbered in order of first use).
+        for (piece, o) in pieces.iter().zip([Vec3::ZERO, Vec3::X]) {
+            let whole = tet(o);
+            assert_eq!(piece.triangles.len(), 4);
+            for t in 0..4 {
+                assert_eq!(piece.triangle(t), whole.triangle(t));
+            }
+        }
+    }
 
     /// Unit cube [0,1]^3 as a triangle soup, outward oriented, 12 triangles (2 per face).
     pub(crate) fn unit_cube_soup() -> Vec<[Vec3; 3]> {

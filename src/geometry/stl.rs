@@ -3,7 +3,7 @@
 //! inside is undefined.
 
 use std::fmt::Write as _;
-use std::io::{BufWriter, Cursor, Write};
+use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use super::mesh::{EdgeDefect, TopologyReport, TriMesh};
@@ -178,28 +178,29 @@ pub fn write_stl_binary(path: &Path, mesh: &TriMesh) -> Result<(), StlError> {
 /// ASCII STL with f32-exact coordinates (9 significant digits), so a round trip through
 /// binary or ASCII gives the same mesh.
 pub fn write_stl_ascii(path: &Path, mesh: &TriMesh, solid_name: &str) -> Result<(), StlError> {
-    let unwritable = |source| StlError::Unwritable {
+    std::fs::write(path, stl_ascii(mesh, solid_name)).map_err(|source| StlError::Unwritable {
         path: path.to_path_buf(),
         source,
-    };
-    let file = std::fs::File::create(path).map_err(unwritable)?;
-    let mut w = BufWriter::new(file);
-    let write = |w: &mut BufWriter<std::fs::File>| -> std::io::Result<()> {
-        writeln!(w, "solid {solid_name}")?;
-        for t in to_stl_triangles(mesh) {
-            let [nx, ny, nz] = t.normal.0;
-            writeln!(w, "  facet normal {nx:.8e} {ny:.8e} {nz:.8e}")?;
-            writeln!(w, "    outer loop")?;
-            for v in t.vertices {
-                writeln!(w, "      vertex {:.8e} {:.8e} {:.8e}", v[0], v[1], v[2])?;
-            }
-            writeln!(w, "    endloop")?;
-            writeln!(w, "  endfacet")?;
+    })
+}
+
+/// The text of [`write_stl_ascii`] (LIGGGHTS 3.8 reads ASCII STL only).
+pub fn stl_ascii(mesh: &TriMesh, solid_name: &str) -> String {
+    use std::fmt::Write as _;
+    let mut w = String::new();
+    let _ = writeln!(w, "solid {solid_name}");
+    for t in to_stl_triangles(mesh) {
+        let [nx, ny, nz] = t.normal.0;
+        let _ = writeln!(w, "  facet normal {nx:.8e} {ny:.8e} {nz:.8e}");
+        let _ = writeln!(w, "    outer loop");
+        for v in t.vertices {
+            let _ = writeln!(w, "      vertex {:.8e} {:.8e} {:.8e}", v[0], v[1], v[2]);
         }
-        writeln!(w, "endsolid {solid_name}")?;
-        w.flush()
-    };
-    write(&mut w).map_err(unwritable)
+        let _ = writeln!(w, "    endloop");
+        let _ = writeln!(w, "  endfacet");
+    }
+    let _ = writeln!(w, "endsolid {solid_name}");
+    w
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ pub mod dynamics;
 pub mod history;
 pub mod lammps;
 pub mod liggghts;
+pub mod screw;
 pub mod stability;
 pub mod suite;
 pub mod validate;

@@ -129,6 +129,9 @@ pub struct SuiteCase {
     /// The variant's name, appended to the scene's name (`aor_collapse-smooth-walls`) in run
     /// directories and the report; required with `set`.
     pub variant: Option<String>,
+    /// Screw speeds (rev/min) for a scene with `[conveying]`: one run per speed, the stage
+    /// scaled to the same number of turns (`sweep::at_speed`); empty: the scene's own speed.
+    pub rpms: Vec<f64>,
 }
 
 impl SuiteCase {
@@ -197,6 +200,8 @@ struct RawCase {
     #[serde(default)]
     set: Vec<String>,
     variant: Option<String>,
+    #[serde(default)]
+    rpms: Vec<f64>,
 }
 
 impl Suite {
@@ -285,6 +290,13 @@ impl Suite {
             let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
             let overrides =
                 parse_variant(&c.set, c.variant.as_deref(), &format!("case[{k}]"), path)?;
+            if let Some(bad) = c.rpms.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+                return Err(invalid(
+                    format!("case[{k}].rpms"),
+                    bad.to_string(),
+                    "screw speeds in rev/min, finite and > 0",
+                ));
+            }
             cases.push(SuiteCase {
                 file: c.file,
                 codes,
@@ -296,6 +308,7 @@ impl Suite {
                 front_tolerance,
                 overrides,
                 variant: c.variant,
+                rpms: c.rpms,
             });
         }
         let accuracy = raw

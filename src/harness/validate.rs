@@ -43,6 +43,23 @@ pub struct RunRecord {
     /// The run stopped before its last stage ended (time limit, killed, stopped by a
     /// guard): its fixed-time samples and histories count, its final state does not.
     pub partial: bool,
+    /// Screw speed of a conveying case run at a suite's `rpms`, rev/min.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rpm: Option<f64>,
+    /// The conveying measurement (`analysis::conveying`) of a screw case.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_flow_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_flow_std_error_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fill_ratio: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bulk_density_kg_m3: Option<f64>,
+    /// Eq. (7) with the measured fill ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eq7_mass_flow_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio_to_eq7: Option<f64>,
 }
 
 /// One judged comparison.
@@ -137,6 +154,12 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         }
     }
     for (scene, case, case_runs) in scenes {
+        if scene.conveying.is_some() {
+            // A screw case is judged by its mass flow against Eq. (7), code by code.
+            super::screw::write_screw_section(&mut report, &scene, case, &case_runs, &options.out)?;
+            runs.extend(case_runs);
+            continue;
+        }
         let case_comparisons = compare(&scene, case, &case_runs);
         write_case_section(
             &mut report,
@@ -347,35 +370,60 @@ fn run_case(
     case: &SuiteCase,
     options: &ValidateOptions,
 ) -> Result<Vec<RunRecord>, ValidateError> {
-    // Alternate the codes within each seed, so machine drift hits all alike.
+    // A conveying case runs once per listed screw speed, the scene at its own otherwise.
+    let speeds: Vec<Option<f64>> = match &scene.conveying {
+        Some(_) if !case.rpms.is_empty() => case.rpms.iter().map(|&r| Some(r)).collect(),
+        _ => vec![None],
+    };
+    // Alternate the codes within each seed and speed, so machine drift hits all alike.
     let mut settings = Vec::new();
     for &rule in &case.cg_rules {
         for &lambda in &case.lambdas {
             for &seed in &case.seeds {
-                for &code in &case.codes {
-                    settings.push((rule, lambda, seed, code));
+                for &rpm in &speeds {
+                    for &code in &case.codes {
+                        settings.push((rule, lambda, seed, rpm, code));
+                    }
                 }
             }
         }
     }
-    let records = run_concurrently(&settings, options.jobs, |&(rule, lambda, seed, code)| {
-        let dir = run_dir(&options.out, scene, code, lambda, rule, seed);
-        let record = run_one(scene, code, lambda, rule, seed, &dir, options);
-        if !options.quiet {
-            eprintln!(
-                "{} {} lambda={lambda} rule={} seed={seed}: {}{}",
-                scene.name,
-                code.name(),
-                rule_name(rule),
-                record.status,
-                record
-                    .reason
-                    .as_deref()
-                    .map_or(String::new(), |r| format!(" ({r})"))
-            );
-        }
-        record
-    });
+    let records = run_concurrently(
+        &settings,
+        options.jobs,
+        |&(rule, lambda, seed, rpm, code)| {
+            let mut dir = run_dir(&options.out, scene, code, lambda, rule, seed);
+            let at_speed;
+            let scene = match (rpm, &scene.conveying) {
+                (Some(rpm), Some(c)) => {
+                    dir.set_file_name(format!(
+                        "{}-rpm{rpm}",
+                        dir.file_name().unwrap_or_default().to_string_lossy()
+                    ));
+                    at_speed = crate::sweep::at_speed(scene, &c.body, rpm);
+                    &at_speed
+                }
+                _ => scene,
+            };
+            let mut record = run_one(scene, code, lambda, rule, seed, &dir, options);
+            record.rpm = rpm;
+            if !options.quiet {
+                eprintln!(
+                    "{} {} lambda={lambda} rule={} seed={seed}{}: {}{}",
+                    scene.name,
+                    code.name(),
+                    rule_name(rule),
+                    rpm.map_or(String::new(), |r| format!(" rpm={r}")),
+                    record.status,
+                    record
+                        .reason
+                        .as_deref()
+                        .map_or(String::new(), |r| format!(" ({r})"))
+                );
+            }
+            record
+        },
+    );
     Ok(records)
 }
 
@@ -452,6 +500,13 @@ pub(super) fn run_one(
         runout_m: None,
         reused: false,
         partial: false,
+        rpm: None,
+        mass_flow_kg_s: None,
+        mass_flow_std_error_kg_s: None,
+        fill_ratio: None,
+        bulk_density_kg_m3: None,
+        eq7_mass_flow_kg_s: None,
+        ratio_to_eq7: None,
     };
     let outcome = match code {
         Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
@@ -606,6 +661,13 @@ fn fill_from_summary(record: &mut RunRecord) {
     record.repose_angle_deg = f("repose_angle_deg");
     record.repose_fit_r2 = f("repose_fit_r2");
     record.runout_m = f("runout_m");
+    let conveying = |key: &str| value["conveying"][key].as_f64();
+    record.mass_flow_kg_s = conveying("mass_flow_kg_s");
+    record.mass_flow_std_error_kg_s = conveying("mass_flow_std_error_kg_s");
+    record.fill_ratio = conveying("fill_ratio");
+    record.bulk_density_kg_m3 = conveying("bulk_density_kg_m3");
+    record.eq7_mass_flow_kg_s = conveying("eq7_mass_flow_kg_s");
+    record.ratio_to_eq7 = conveying("ratio_to_eq7");
     let unfinished = value["stages"].as_array().and_then(|stages| {
         stages.iter().find(|st| {
             let how = st["ended_by"].as_str().unwrap_or("");

@@ -327,6 +327,19 @@ pub fn initial_particles(
     initial_particles_with_bodies(scene, rotation, bodies, &[]).map(|(p, _)| p)
 }
 
+/// [`initial_particles`] clear of the scene's SDF bodies, as a run of the scene starts: what
+/// the reference codes start from.
+pub fn initial_particles_clear_of_bodies(scene: &Scene) -> Result<Particles, RunError> {
+    if scene.bodies.is_empty() {
+        return initial_particles(scene, false, &[]);
+    }
+    let (bodies, _) = match &scene.contact {
+        ContactSettings::Wca { .. } => build_bodies(scene, &seed_laws(scene).1)?,
+        ContactSettings::Hertz(h) => build_bodies(scene, &hertz::hertz_wall(scene, h))?,
+    };
+    initial_particles(scene, false, &bodies)
+}
+
 /// As [`initial_particles`], with the particles of bodies built of particles first (`sites`:
 /// per such body, its index in `bodies` and its lattice sites), frozen, and the record that
 /// moves them with their bodies.
@@ -567,12 +580,6 @@ fn execute<L: PairLaw, W: WallLaw>(
     }
 
     let (bodies, body_sites) = build_bodies(scene, &wall_law)?;
-    if !bodies.is_empty() && (L::NEEDS_ROTATION || W::NEEDS_ROTATION) {
-        return Err(RunError::NotAvailable(format!(
-            "{}: bodies (SDF walls) are implemented for the seed's model only so far; this scene's contact law rotates the particles",
-            scene.source.display()
-        )));
-    }
     let (particles, kinematic) = match &options.initial_state {
         // A given state carries no particle-built bodies (the bench's heap has none).
         Some(_) if !body_sites.is_empty() => {

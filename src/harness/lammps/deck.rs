@@ -61,6 +61,8 @@ pub struct Deck {
     pub input: String,
     pub data: String,
     pub plan: DeckPlan,
+    /// Further files the deck reads (name in the run directory, content): LIGGGHTS's meshes.
+    pub files: Vec<(String, Vec<u8>)>,
 }
 
 impl Deck {
@@ -68,6 +70,9 @@ impl Deck {
     pub fn write_to(&self, dir: &std::path::Path) -> std::io::Result<()> {
         std::fs::create_dir_all(dir)?;
         std::fs::write(dir.join(DECK_FILE), &self.input)?;
+        for (name, content) in &self.files {
+            std::fs::write(dir.join(name), content)?;
+        }
         std::fs::write(dir.join(DATA_FILE), &self.data)
     }
 }
@@ -209,7 +214,8 @@ pub(crate) fn kinetic_energy_lines(dump_every: u64, rotation: bool) -> String {
 /// stored coefficient in every setup (measured: a second setup turned the wall restitution
 /// 0.49998 into 0.60055, a third into 0.49247; `reference/HERTZ_COLLAPSE.md`), and the LAMMPS
 /// decks pad their fix list for the `unfix` that follows ([`removal_pads`]). A stage first
-/// removes its walls (`unfix(name)` gives the lines), prints
+/// removes its walls (`unfix(name)` gives the lines), adds what starts with it (`begin(stage)`:
+/// a body's motion, a top-up), prints
 /// `CGDEM_STAGE name start STEP`, then either runs its duration, stopping at each repose time
 /// for a `write_dump`, or runs in chunks of one output interval until the first chunk end
 /// after `min_duration` with `v_kepm` below the threshold (at most `max_duration`), and prints
@@ -221,6 +227,7 @@ pub(crate) fn stage_lines(
     dump_every: u64,
     dumps: &StageDumps,
     unfix: impl Fn(&str) -> String,
+    begin: impl Fn(&str) -> String,
 ) -> Vec<(String, Real, String)> {
     let write_dump = |file: &str| {
         format!(
@@ -235,6 +242,7 @@ pub(crate) fn stage_lines(
         for name in &stage.remove_walls {
             *d += &unfix(name);
         }
+        *d += &begin(&stage.name);
         let _ = writeln!(
             d,
             "print           \"CGDEM_STAGE {} start $(step)\"",
@@ -490,12 +498,19 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         columns: WCA_COLUMNS,
         modify: "format float %.16g sort id",
     };
-    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &stages, |name| {
-        format!("unfix           wlj_{name}\nunfix           wgran_{name}\n")
-    });
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &stages,
+        |name| format!("unfix           wlj_{name}\nunfix           wgran_{name}\n"),
+        |_| String::new(),
+    );
     Ok(Deck {
         input: d,
         data,
+        files: Vec::new(),
         plan: DeckPlan {
             code: "lammps",
             log_file: super::runner::LOG_FILE,

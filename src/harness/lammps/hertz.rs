@@ -66,9 +66,11 @@ pub fn tangential_damping_ratio(y_eff: Real, g_eff: Real) -> Real {
 }
 
 /// The Hertz settings a reference deck can express, or why not.
+/// `meshes`: the code takes the scene's bodies as meshes and its `[[delete]]` boxes (LIGGGHTS).
 pub(crate) fn hertz_settings<'a>(
     scene: &'a Scene,
     code: &str,
+    meshes: bool,
 ) -> Result<&'a HertzSettings, DeckError> {
     let unsupported = |reason: String| DeckError::Unsupported {
         file: scene.source.display().to_string(),
@@ -88,9 +90,9 @@ pub(crate) fn hertz_settings<'a>(
             "{code} decks are written for damping = \"hertz\", tangential = \"history\", rolling = \"none\" or \"epsd2\", cohesion = \"none\" only"
         )));
     }
-    if !scene.bodies.is_empty() || !scene.deletions.is_empty() {
+    if !meshes && (!scene.bodies.is_empty() || !scene.deletions.is_empty()) {
         return Err(unsupported(format!(
-            "{code} Hertz decks take planar walls only (no [[body]], no [[delete]])"
+            "{code} Hertz decks take planar walls only (no [[body]], no [[delete]]): LAMMPS has no mesh walls, and the deck with a particle-built screw is not written yet"
         )));
     }
     Ok(h)
@@ -141,7 +143,7 @@ pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: 
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
-    let h = hertz_settings(scene, "LAMMPS")?;
+    let h = hertz_settings(scene, "LAMMPS", false)?;
     let unsupported = |reason: String| DeckError::Unsupported {
         file: scene.source.display().to_string(),
         reason,
@@ -288,9 +290,15 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         columns: HERTZ_COLUMNS,
         modify: "format float %.17g sort id",
     };
-    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &dumps, |name| {
-        format!("unfix           w_{name}\n")
-    });
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &dumps,
+        |name| format!("unfix           w_{name}\n"),
+        |_| String::new(),
+    );
     let mut notes = Vec::new();
     if h.rolling == RollingKind::Epsd2 {
         notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
@@ -299,6 +307,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     Ok(Deck {
         input: d,
         data,
+        files: Vec::new(),
         plan: DeckPlan {
             code: "lammps",
             log_file: super::runner::LOG_FILE,

@@ -75,7 +75,8 @@ pub fn run_reference(
 ) -> Result<ReferenceRun, String> {
     let (dt, scales, dt_warning) =
         crate::run::time_step(scene, options.force_dt).map_err(|e| e.to_string())?;
-    let particles = crate::run::initial_particles(scene, false, &[]).map_err(|e| e.to_string())?;
+    let particles =
+        crate::run::initial_particles_clear_of_bodies(scene).map_err(|e| e.to_string())?;
     let deck = match options.code {
         ReferenceCode::Lammps => write_deck(scene, &particles, dt),
         ReferenceCode::Liggghts => crate::harness::liggghts::write_deck(scene, &particles, dt),

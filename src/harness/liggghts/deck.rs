@@ -35,9 +35,10 @@ pub const MIN_YOUNGS_MODULUS: Real = 5e6;
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
 pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
-    let h = hertz_settings(scene, "LIGGGHTS")?;
+    let h = hertz_settings(scene, "LIGGGHTS", true)?;
     let n = scene.species.len();
-    let has_walls = !scene.walls.is_empty();
+    // Planar walls and meshes share one atom type, whose material is `[wall_contact]`.
+    let has_walls = !scene.walls.is_empty() || !scene.bodies.is_empty();
     let n_types = n + usize::from(has_walls);
     let (m, wm) = (material(h), wall_material(scene, h));
     for (what, e) in [
@@ -160,6 +161,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             g(at)
         );
     }
+    let meshes = mesh_lines(scene, n + 1, rolling)?;
+    d += &meshes.setup;
     d += &kinetic_energy_lines(dump_every, true);
     // LIGGGHTS's dump_modify format is one C format for the whole line (default: 6 digits).
     let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
@@ -172,22 +175,231 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         columns: HERTZ_COLUMNS,
         modify: &modify,
     };
-    let repose_dumps = stage_lines(&mut d, scene, dt, dump_every, &dumps, |name| {
-        format!("unfix           w_{name}\n")
-    });
+    let begin = |stage: &str| stage_start_lines(scene, &meshes.pieces, stage, dt);
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &dumps,
+        |name| format!("unfix           w_{name}\n"),
+        begin,
+    );
     Ok(Deck {
         input: d,
         data,
         plan: DeckPlan {
             code: "liggghts",
             log_file: LOG_FILE,
-            notes: Vec::new(),
+            notes: meshes.notes,
             dt,
             dump_every,
             repose_dumps,
         },
+        files: meshes.files,
     })
 }
+
+/// The deck lines of the scene's bodies: one `fix mesh/surface` per body from an ASCII STL
+/// of the same triangles cgdem builds its SDF from (metres), all in one `fix wall/gran ...
+/// mesh`; the STL files; and notes on what differs from cgdem.
+struct MeshLines {
+    setup: String,
+    /// Per body, the names of its pieces (`b_NAME` is the mesh fix).
+    pieces: Vec<Vec<String>>,
+    files: Vec<(String, Vec<u8>)>,
+    notes: Vec<String>,
+}
+
+fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLines, DeckError> {
+    let unsupported = |reason: String| DeckError::Unsupported {
+        file: scene.source.display().to_string(),
+        reason,
+    };
+    let mut out = MeshLines {
+        setup: String::new(),
+        pieces: Vec::new(),
+        files: Vec::new(),
+        notes: Vec::new(),
+    };
+    if scene.bodies.is_empty() {
+        return Ok(out);
+    }
+    let mut names = Vec::new();
+    let mut body_pieces = Vec::new();
+    for (k, b) in scene.bodies.iter().enumerate() {
+        let mut pieces = Vec::new();
+        if b.particles.is_some() {
+            return Err(unsupported(format!(
+                "body[{k}] `{}` is built of particles; LIGGGHTS decks take mesh bodies",
+                b.name
+            )));
+        }
+        if b.velocity.length() > 0.0 {
+            return Err(unsupported(format!(
+                "body[{k}] `{}` translates; LIGGGHTS decks rotate bodies only",
+                b.name
+            )));
+        }
+        let mesh = b
+            .mesh
+            .load()
+            .map_err(|e| unsupported(format!("body[{k}].mesh: {e}")))?;
+        // One mesh fix per separate solid of the body (see `TriMesh::components`).
+        for (j, piece) in mesh.components().into_iter().enumerate() {
+            let (piece, dropped, area) = without_slivers(piece);
+            if dropped > 0 {
+                out.notes.push(format!(
+                    "body `{}` piece {j}: {dropped} sliver triangle(s) (smallest angle < {SLIVER_ANGLE_DEG} deg, {area:.1e} m2 in all) left out of the LIGGGHTS mesh, which refuses them",
+                    b.name
+                ));
+            }
+            let piece = &piece;
+            let name = format!("{}_{j}", b.name);
+            let file = format!("{name}.stl");
+            let text = crate::geometry::stl::stl_ascii(piece, &name);
+            out.files.push((file.clone(), text.into_bytes()));
+            let _ = writeln!(
+                out.setup,
+                "fix             b_{name} all mesh/surface file {file} type {wall_type} curvature 1e-5"
+            );
+            names.push(format!("b_{name}"));
+            pieces.push(name);
+        }
+        body_pieces.push(pieces);
+    }
+    for (b, pieces) in scene.bodies.iter().zip(&body_pieces) {
+        if b.start_stage.is_none() {
+            out.setup += &move_lines(b, pieces);
+        }
+    }
+    out.pieces = body_pieces;
+    let _ = writeln!(
+        out.setup,
+        "fix             bodies all wall/gran model hertz tangential history{rolling} mesh n_meshes {} meshes {}",
+        names.len(),
+        names.join(" ")
+    );
+    if !scene.deletions.is_empty() {
+        out.notes.push("LIGGGHTS 3.8 has no `fix evaporate`: grains in a [[delete]] box are not deleted there; they fall on and leave through the box's lower face (`thermo_modify lost ignore`), which changes nothing upstream of the box".into());
+    }
+    Ok(out)
+}
+
+/// `fix move/mesh ... rotate` for each piece of a turning body: LIGGGHTS turns
+/// counter-clockwise about `axis` once per `period`; a negative rpm turns about the reversed
+/// axis.
+fn move_lines(b: &crate::scene::BodySettings, pieces: &[String]) -> String {
+    if b.rpm == 0.0 {
+        return String::new();
+    }
+    let axis = if b.rpm < 0.0 { -b.axis } else { b.axis };
+    let mut d = String::new();
+    for name in pieces {
+        let _ = writeln!(
+            d,
+            "fix             move_{name} all move/mesh mesh b_{name} rotate origin {} {} {} axis {} {} {} period {}",
+            g(b.point.x),
+            g(b.point.y),
+            g(b.point.z),
+            g(axis.x),
+            g(axis.y),
+            g(axis.z),
+            g(60.0 / b.rpm.abs())
+        );
+    }
+    d
+}
+
+/// LIGGGHTS 3.8 aborts on a mesh element whose smallest angle is below about 0.01 deg
+/// (measured: the casing's gables, fan-triangulated, have two at 0.0093 deg).
+const SLIVER_ANGLE_DEG: Real = 0.02;
+
+/// The mesh without its sliver triangles: the mesh, how many were dropped and their area (a
+/// sliver's area is tiny, so the surface grains meet is the same).
+fn without_slivers(mut mesh: crate::geometry::TriMesh) -> (crate::geometry::TriMesh, usize, Real) {
+    let smallest_angle = |[a, b, c]: [crate::math::Vec3; 3]| {
+        [(a, b, c), (b, c, a), (c, a, b)]
+            .iter()
+            .map(|&(p, q, r)| (q - p).angle_between(r - p))
+            .fold(Real::INFINITY, Real::min)
+    };
+    let n = mesh.triangles.len();
+    let mut area = 0.0;
+    let keep: Vec<bool> = (0..n)
+        .map(|t| {
+            let tri = mesh.triangle(t);
+            let sliver = smallest_angle(tri).to_degrees() < SLIVER_ANGLE_DEG;
+            if sliver {
+                area += 0.5 * (tri[1] - tri[0]).cross(tri[2] - tri[0]).length();
+            }
+            !sliver
+        })
+        .collect();
+    let mut k = 0;
+    mesh.triangles.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    let dropped = n - mesh.triangles.len();
+    (mesh, dropped, area)
+}
+
+/// What starts with `stage`: the motion of the bodies that start then, and the top-ups of the
+/// insertions refilled during it (`fix insert/pack ... particles_in_region N`, N the count in
+/// the insertion box when the stage begins, first after one interval, as cgdem does). A
+/// `run 0` sets the new fixes up.
+fn stage_start_lines(scene: &Scene, pieces: &[Vec<String>], stage: &str, dt: Real) -> String {
+    let mut d = String::new();
+    for (b, pieces) in scene.bodies.iter().zip(pieces) {
+        if b.start_stage.as_deref() == Some(stage) {
+            d += &move_lines(b, pieces);
+        }
+    }
+    for (k, ins) in scene.insertions.iter().enumerate() {
+        let Some(refill) = ins.refill.as_ref().filter(|r| r.stage == stage) else {
+            continue;
+        };
+        let species = &scene.species[ins.species];
+        let every = ((refill.interval / dt).round() as u64).max(1);
+        let _ = writeln!(
+            d,
+            "region          top_{k} block {} {} {} {} {} {}",
+            g(ins.lo.x),
+            g(ins.hi.x),
+            g(ins.lo.y),
+            g(ins.hi.y),
+            g(ins.lo.z),
+            g(ins.hi.z)
+        );
+        let _ = writeln!(
+            d,
+            "fix             pts_{k} all particletemplate/sphere {} atom_type {} density constant {} radius constant {}",
+            PRIMES[(2 * k) % PRIMES.len()],
+            ins.species + 1,
+            g(species.density),
+            g(species.radius())
+        );
+        let _ = writeln!(
+            d,
+            "fix             pdd_{k} all particledistribution/discrete {} 1 pts_{k} 1.0",
+            PRIMES[(2 * k + 1) % PRIMES.len()]
+        );
+        let _ = writeln!(d, "variable        top_n_{k} equal count(all,top_{k})");
+        let _ = writeln!(
+            d,
+            "fix             top_{k} all insert/pack seed {} distributiontemplate pdd_{k} maxattempt 200 insert_every {every} start $(step+{every}) overlapcheck yes all_in no particles_in_region ${{top_n_{k}}} region top_{k}",
+            PRIMES[(2 * k + 2) % PRIMES.len()]
+        );
+    }
+    if !d.is_empty() {
+        d += "run             0 post no\n";
+    }
+    d
+}
+
+/// Primes above 10000 for LIGGGHTS's random seeds.
+const PRIMES: [u64; 6] = [15485863, 32452843, 49979687, 67867967, 86028121, 104395301];
 
 /// The trajectory file of a run directory.
 pub fn trajectory(dir: &Path) -> std::path::PathBuf {
@@ -219,6 +431,39 @@ mod tests {
         let sample = at(d, &format!("if              \"${{chunk1}} == 25\" then \"write_dump all custom repose_0.dump id type x y z vx vy vz omegax omegay omegaz radius modify sort id {format}\""));
         assert!(collapse < sample);
         assert_eq!(deck.plan.repose_dumps.len(), 3);
+    }
+
+    #[test]
+    fn screw_deck_turns_the_screw_mesh_from_the_conveying_stage_and_tops_up_the_hopper() {
+        let scene = Scene::load(std::path::Path::new(
+            "validation/cases/screw_feeder_hertz.toml",
+        ))
+        .unwrap();
+        let deck = write_deck(&scene, &Particles::new(true), 6e-5).unwrap();
+        let d = &deck.input;
+        // Meshes of the same triangles cgdem builds its SDF from, one fix per solid, as walls.
+        at(
+            d,
+            "fix             b_screw_0 all mesh/surface file screw_0.stl type 2",
+        );
+        at(
+            d,
+            "fix             b_hopper_0 all mesh/surface file hopper_0.stl type 2",
+        );
+        let walls = at(d, "fix             bodies all wall/gran model hertz tangential history mesh n_meshes 12 meshes b_screw_0 b_screw_1 b_casing_0");
+        assert!(deck.files.iter().any(|(name, text)| name == "casing_0.stl"
+            && String::from_utf8_lossy(text).starts_with("solid casing_0")));
+        // rpm -100 about +x: counter-clockwise about -x, 0.6 s per turn, from `convey` on.
+        let settle = at(d, "CGDEM_STAGE settle start");
+        let turn = at(d, "fix             move_screw_0 all move/mesh mesh b_screw_0 rotate origin 0.00000000000000000e0 0.00000000000000000e0 0.00000000000000000e0 axis -1.00000000000000000e0");
+        assert!(d[turn..].contains("period 5.99999999999999978e-1"));
+        let top_up = at(d, "fix             top_0 all insert/pack seed");
+        assert!(d[top_up..].contains("insert_every 1667 start $(step+1667) overlapcheck yes all_in no particles_in_region ${top_n_0} region top_0"));
+        let convey = at(d, "CGDEM_STAGE convey start");
+        assert!(walls < settle && settle < turn && turn < top_up && top_up < convey);
+        assert!(!d.contains("move_casing"));
+        at(d, "dump            traj all custom");
+        assert!(deck.plan.notes.iter().any(|n| n.contains("fix evaporate")));
     }
 
     #[test]
