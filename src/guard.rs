@@ -85,7 +85,7 @@ impl GuardKind {
 /// A guard that fired: when, what was measured, which particles, why, and a step that would
 /// be stable.
 #[derive(Clone, Debug, PartialEq, thiserror::Error, serde::Serialize, serde::Deserialize)]
-#[error("guard `{}` fired at step {step} (t = {time:.6e} s): {detail}; particles (id) {}; likely cause: {cause}; a stable time step: {}", kind.name(), format_ids(particles), format_stable(*stable_dt, *dt))]
+#[error("guard `{}` fired at step {step} (t = {time:.6e} s): {detail}; particles (id) {}; likely cause: {cause}{}", kind.name(), format_ids(particles), format_stable(*kind, *stable_dt, *dt))]
 pub struct GuardTrip {
     pub kind: GuardKind,
     pub step: u64,
@@ -109,11 +109,15 @@ fn format_ids(ids: &[u32]) -> String {
         .join(", ")
 }
 
-fn format_stable(stable_dt: Real, dt: Real) -> String {
-    if stable_dt.is_finite() {
-        format!("dt <= {stable_dt:.3e} s (this run: {dt:.3e} s)")
+/// The stable step, for the guards a smaller step can cure; a lost particle is a geometry
+/// or insertion matter, so its message does not send the user to the time step.
+fn format_stable(kind: GuardKind, stable_dt: Real, dt: Real) -> String {
+    if kind == GuardKind::LostParticles {
+        String::new()
+    } else if stable_dt.is_finite() {
+        format!("; a stable time step: dt <= {stable_dt:.3e} s (this run: {dt:.3e} s)")
     } else {
-        format!("unknown (this run: {dt:.3e} s)")
+        format!("; a stable time step: unknown (this run: {dt:.3e} s)")
     }
 }
 
