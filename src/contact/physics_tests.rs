@@ -275,6 +275,90 @@ fn sphere_on_an_incline_below_the_friction_angle_rolls_at_five_sevenths_g_sin_th
     assert!((acceleration / expected - 1.0).abs() < 2e-3);
 }
 
+/// A ball rolling without slip on a turntable (a turning SDF cylinder): the tangential spring
+/// of the body contact holds it, and its centre circles at `2/7` of the table's angular
+/// speed (uniform sphere, no rolling resistance), whatever its starting point: the velocity
+/// turns at `2 Omega / 7`.
+#[test]
+fn ball_on_a_turntable_body_circles_at_two_sevenths_of_the_table_speed() {
+    use crate::bodies::{Body, BodyShape, Motion};
+    use crate::geometry::Cylinder;
+    use crate::walls::HertzHistoryWall;
+    let (omega, r0, mu) = (3.0, 0.02, 0.5);
+    let moduli = [(
+        Material::y_eff(MATERIAL, MATERIAL),
+        Material::g_eff(MATERIAL, MATERIAL),
+    )];
+    let domain = Domain {
+        lo: Vec3::new(-0.1, -0.1, -0.005),
+        hi: Vec3::new(0.1, 0.1, 0.005),
+        periodic: [false; 3],
+    };
+    let dt = 2e-5;
+    // At rest in the lab, touching the table's top face (z = 0) at r0 from the axis.
+    let mut w = world(
+        hertz_law(0.5, mu, NoCohesion),
+        HertzHistoryWall::new(&moduli, 0.5, mu, 0.0, 1.0),
+        WallSet::default(),
+        domain,
+        &[(Vec3::new(r0, 0.0, RADIUS), Vec3::ZERO, RADIUS)],
+        Vec3::new(0.0, 0.0, -9.81),
+        dt,
+        0,
+    );
+    let table = Cylinder::new(Vec3::new(0.0, 0.0, -0.002), Vec3::Z, 0.09, 0.004);
+    let rpm = omega * 60.0 / (2.0 * PI);
+    let mut body = Body::new(
+        "table",
+        BodyShape::Cylinder(table),
+        Motion::rotation_rpm(Vec3::Z, Vec3::ZERO, rpm),
+    );
+    body.start(0.0);
+    w.set_bodies(vec![body]);
+    // Slip ends within (2/7) Omega r0 / (mu g) = 3.5 ms; measure from 0.1 s to 1.6 s.
+    let heading = |w: &World<_, _>| {
+        let v = w.particles.velocity[0];
+        v.y.atan2(v.x)
+    };
+    while w.time < 0.1 {
+        w.step();
+    }
+    let (t0, mut angle, mut last) = (w.time, 0.0, heading(&w));
+    let mut speeds = Vec::new();
+    while w.time < 1.6 {
+        w.step();
+        let now = heading(&w);
+        // Unwrapped: the heading changes by far less than pi per step.
+        let mut change = now - last;
+        if change > PI {
+            change -= 2.0 * PI;
+        } else if change < -PI {
+            change += 2.0 * PI;
+        }
+        angle += change;
+        last = now;
+        speeds.push(w.particles.velocity[0].length());
+    }
+    let rate = angle / (w.time - t0);
+    let expected = 2.0 / 7.0 * omega;
+    let (slowest, fastest) = speeds
+        .iter()
+        .fold((Real::MAX, 0.0 as Real), |(a, b), &v| (a.min(v), b.max(v)));
+    eprintln!(
+        "turntable: heading turns at {rate:.5} rad/s, 2/7 Omega = {expected:.5}; speed {slowest:.5} .. {fastest:.5} m/s"
+    );
+    assert!(
+        (rate / expected - 1.0).abs() < 0.01,
+        "rate {rate}, expected {expected}"
+    );
+    // Rolling on a circle: constant speed, and the ball stayed on the table.
+    assert!(
+        fastest / slowest - 1.0 < 0.01,
+        "speed {slowest} .. {fastest}"
+    );
+    assert!((w.particles.position[0].z / RADIUS - 1.0).abs() < 0.01);
+}
+
 #[test]
 fn van_der_waals_binds_touching_spheres_at_the_overlap_where_hertz_balances_f_at_h_min() {
     let (r, hamaker, h_min) = (5e-6, 6.5e-20, 4e-10);

@@ -16,8 +16,10 @@
 //!   `w = omega c/h` (its `cdata.wr`, the spin scaled by contact radius over distance), not
 //!   `omega`: kept here, since the keyword promises LIGGGHTS's model.
 //!
-//! Bodies (SDF) call the stateless `force`, which has no history: the normal force and the
-//! kinetic Coulomb friction of `HertzWall`.
+//! Bodies (SDF) use the same law with a history slot per particle per body, the relative
+//! velocity taken against the body's surface velocity at the contact point. The stateless
+//! `force` (the normal force and kinetic Coulomb friction of `HertzWall`) serves the time
+//! step and particles that do not spin.
 
 use super::{HertzWall, WallContact, WallLaw};
 use crate::contact::damping::liggghts_damping_factor;
