@@ -175,6 +175,7 @@ pub fn rpm_sweep(
         run_prefix: "rpm",
         name: "mass_flow_vs_rpm",
         title: "Screw feeder: mass flow vs speed",
+        ratio_title: "Screw feeder: mass flow over Eq. (7) (measured fill) vs speed",
         x_label: "screw speed (rpm)",
         dem_label: "DEM (SDF screw)",
     };
@@ -184,7 +185,8 @@ pub fn rpm_sweep(
 /// Runs a scene whose conveying body is built of particles once per r_s / r_p (the body's
 /// species diameter set to the ratio times the first mobile species' diameter) into
 /// `out/ratio<R>/`, then writes `out/mass_flow_vs_screw_ratio.csv` and the plot
-/// `out/mass_flow_vs_screw_ratio_plot.png|svg|csv` (paper A Fig. 4).
+/// `out/mass_flow_vs_screw_ratio_plot.png|svg|csv` and `..._ratio_plot` (DEM / Eq. (7), paper
+/// A Fig. 4).
 pub fn screw_ratio_sweep(
     scene: &Scene,
     ratios: &[Real],
@@ -230,6 +232,7 @@ pub fn screw_ratio_sweep(
         run_prefix: "ratio",
         name: "mass_flow_vs_screw_ratio",
         title: "Particle-built screw at 100 rpm: mass flow vs screw-particle size",
+        ratio_title: "Particle-built screw: mass flow over Eq. (7) (measured fill) vs r_s / r_p",
         x_label: "r_s / r_p",
         dem_label: "DEM (particle screw)",
     };
@@ -238,14 +241,16 @@ pub fn screw_ratio_sweep(
 
 /// A sweep of a conveying scene over one variable: one run per value into
 /// `out/<run_prefix><value>/`, the table `out/<name>.csv` (rewritten after every run, so an
-/// interrupted sweep keeps what it measured) and the plot `out/<name>_plot.png|svg|csv`
-/// against Eq. (7).
+/// interrupted sweep keeps what it measured), the plot `out/<name>_plot.png|svg|csv` against
+/// Eq. (7) and `out/<name>_ratio_plot.png|svg|csv` of DEM / Eq. (7).
 struct ConveyingSweep {
     /// The CSV's first column.
     variable: &'static str,
     run_prefix: &'static str,
     name: &'static str,
     title: &'static str,
+    /// Title of the DEM / Eq. (7) plot.
+    ratio_title: &'static str,
     x_label: &'static str,
     dem_label: &'static str,
 }
@@ -320,6 +325,33 @@ impl ConveyingSweep {
                     .style(SeriesStyle::Dashed),
             );
         write_figure(out, &format!("{}_plot", self.name), &fig).map_err(|e| e.to_string())?;
+        // The same runs as DEM / Eq. (7) with the measured fill ratio: each point carries
+        // its own fill, so this is the plot where a trend towards theory (1) shows.
+        let ratios = points(&|c| c.ratio_to_eq7);
+        let span = ratios
+            .iter()
+            .map(|p| p.0)
+            .fold(None, |acc: Option<(Real, Real)>, x| {
+                Some(acc.map_or((x, x), |(lo, hi)| (lo.min(x), hi.max(x))))
+            });
+        let ratio_errors: Vec<Real> =
+            points(&|c| c.mass_flow_std_error_kg_s / c.eq7_mass_flow_kg_s)
+                .iter()
+                .map(|p| p.1)
+                .collect();
+        let mut fig = Figure::new(self.ratio_title, self.x_label, "mass flow / Eq. (7)")
+            .with_series(
+                Series::new(self.dem_label, ratios)
+                    .style(SeriesStyle::Markers)
+                    .y_err(ratio_errors),
+            );
+        if let Some((lo, hi)) = span {
+            fig = fig.with_series(
+                Series::new("Eq. (7) (theory)", vec![(lo, 1.0), (hi, 1.0)])
+                    .style(SeriesStyle::Dashed),
+            );
+        }
+        write_figure(out, &format!("{}_ratio_plot", self.name), &fig).map_err(|e| e.to_string())?;
         Ok(results)
     }
 }
