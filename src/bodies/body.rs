@@ -135,6 +135,14 @@ impl Body {
         self.motion.velocity + self.motion.omega().cross(p - self.center)
     }
 
+    /// Angular velocity of the body's material (zero before the motion starts).
+    pub fn angular_velocity(&self) -> Vec3 {
+        if self.started_at.is_none() {
+            return Vec3::ZERO;
+        }
+        self.motion.omega()
+    }
+
     /// Torque of the particles about the axis, N m (component of `load.torque` along it).
     pub fn axial_torque(&self) -> Real {
         self.load.torque.dot(self.motion.axis)

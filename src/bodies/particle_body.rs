@@ -143,7 +143,15 @@ mod tests {
     /// A ring of `n` frozen particles (species 1) of radius `R` at distance 0.01 m from the z
     /// axis, moved by a body turning at `rpm` about z, then `grains` (species 0, radius R);
     /// no gravity, step `dt`.
-    fn ring_world(n: usize, rpm: Real, grains: &[Vec3], dt: Real) -> World<SeedModel, WcaWall> {
+    /// A ring of `n` body particles of radius `R` turning about z at `rpm`, and free `grains`;
+    /// `spin`: particles carry an angular velocity (as under Hertz-Mindlin).
+    fn ring_world(
+        n: usize,
+        rpm: Real,
+        grains: &[Vec3],
+        dt: Real,
+        spin: bool,
+    ) -> World<SeedModel, WcaWall> {
         let wca = WcaCoefficients {
             epsilon: 9.434e-2,
             sigma: 1.203e-3,
@@ -151,7 +159,7 @@ mod tests {
         let mass = 1370.0 * 4.0 / 3.0 * std::f64::consts::PI * R.powi(3);
         let law = SeedModel::seed(vec![wca; 4], vec![0.1257; 4], vec![0.1257; 4]);
         let wall = WcaWall::new(&[(wca, mass), (wca, mass)], 0.5, 0.4);
-        let mut particles = Particles::new(false);
+        let mut particles = Particles::new(spin);
         let reference: Vec<Vec3> = (0..n)
             .map(|k| {
                 let a = std::f64::consts::TAU * k as Real / n as Real;
@@ -209,7 +217,7 @@ mod tests {
         // 600 rpm = 20 pi rad/s; 20,000 steps of 1 us = 0.02 s = 0.2 turns, through many
         // list rebuilds and re-sorts (tip speed 0.63 m/s, skin 0.4 mm).
         let n = 12;
-        let mut world = ring_world(n, 600.0, &[], 1e-6);
+        let mut world = ring_world(n, 600.0, &[], 1e-6, true);
         let omega = 600.0 * std::f64::consts::TAU / 60.0;
         for _ in 0..20_000 {
             world.step();
@@ -225,6 +233,9 @@ mod tests {
             assert!((p.position[k] - expected).length() < 1e-12, "{id}");
             let v = Vec3::new(0.0, 0.0, omega).cross(expected);
             assert!((p.velocity[k] - v).length() < 1e-9, "{id}");
+            // The material turns with the body: a contact point moves as its surface does.
+            let spin = p.angular.as_ref().expect("spinning particles").omega[k];
+            assert_eq!(spin, Vec3::new(0.0, 0.0, omega), "{id}");
             assert!(p.is_frozen(k));
         }
         // Nothing pushed on the ring: no load, no kinetic energy counted for it.
@@ -236,7 +247,7 @@ mod tests {
     fn the_load_on_a_particle_body_is_the_reaction_to_the_grains_with_its_torque() {
         // A grain pressed tangentially against ring particle 0 (at (0.01, 0, 0)), from +y.
         let grain = Vec3::new(0.01, 2.0 * R * 0.99, 0.0);
-        let mut world = ring_world(6, 0.0, &[grain], 1e-9);
+        let mut world = ring_world(6, 0.0, &[grain], 1e-9, false);
         world.step();
         let p = &world.particles;
         let g = (0..p.len()).find(|&k| !p.is_frozen(k)).unwrap();
@@ -256,7 +267,7 @@ mod tests {
         let grains: Vec<Vec3> = (0..5)
             .map(|k| Vec3::new(-0.02 + 0.005 * k as Real, 0.02, 0.0))
             .collect();
-        let mut world = ring_world(6, 60.0, &grains, 1e-6);
+        let mut world = ring_world(6, 60.0, &grains, 1e-6, false);
         for _ in 0..50 {
             world.step();
         }
