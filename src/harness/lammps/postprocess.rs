@@ -393,6 +393,10 @@ pub fn postprocess(
     });
     let n_inserted = frames.first().map_or(0, Frame::len);
     let n_final = last_state.as_ref().map_or(0, |(_, p)| p.position.len());
+    let count = atom_count(scene, &frames);
+    if !scene.deletions.is_empty() {
+        warnings.push(format!("{}: deleted grains are those that vanished from the trajectory dump (deleted in a [[delete]] box or lost from the domain, not told apart)", plan.code));
+    }
     let (particle_steps, loop_s) =
         log_timing(&log).map_or((0, 0.0), |t| (t.particle_steps, t.loop_s));
     let headline = headline_sample(&samples);
@@ -402,17 +406,21 @@ pub fn postprocess(
         code: plan.code.into(),
         lambda: scene.lambda,
         cg_rule: scene.cg_rule,
-        deleted_particles: 0,
-        deleted_mass_kg: 0.0,
+        deleted_particles: count.vanished,
+        deleted_mass_kg: count.vanished_mass_kg,
         conveying,
         stopped_by: None,
         guard_peaks: None,
         packing: None,
         n_particles: n_final,
         n_particles_inserted: n_inserted,
-        n_particles_refilled: 0,
-        n_body_particles: 0,
-        lost_particles: (n_inserted - n_final.min(n_inserted)) as u64,
+        n_particles_refilled: count.added,
+        n_body_particles: count.frozen,
+        lost_particles: if scene.deletions.is_empty() {
+            (n_inserted - n_final.min(n_inserted)) as u64
+        } else {
+            0
+        },
         steps,
         dt_s: dt,
         contact_period_s: scales.shortest_period,
@@ -435,6 +443,53 @@ pub fn postprocess(
         final_state: None,
         memory: None,
     })
+}
+
+/// How the atoms of a trajectory came and went, counted by id from frame to frame.
+#[derive(Debug, Default, PartialEq)]
+pub(crate) struct AtomCount {
+    /// Atoms of frozen species (a particle-built body) in the last frame.
+    pub frozen: usize,
+    /// Atoms that appeared after the first frame (top-ups).
+    pub added: u64,
+    /// Mobile atoms present in one frame and missing from a later one, and their mass.
+    pub vanished: u64,
+    pub vanished_mass_kg: Real,
+}
+
+/// Counts atoms by id across `frames`: an atom deposited and deleted between two frames is
+/// not seen (the dumps are written as often as LAMMPS deletes, `fix evaporate`).
+pub(crate) fn atom_count(scene: &Scene, frames: &[Frame]) -> AtomCount {
+    let mut count = AtomCount::default();
+    let mut previous: std::collections::HashMap<i64, Real> = Default::default();
+    for (n, frame) in frames.iter().enumerate() {
+        let ids = frame.column("id").unwrap_or_default();
+        let types = frame.column("type").unwrap_or_default();
+        let mut current = std::collections::HashMap::with_capacity(ids.len());
+        let mut frozen = 0;
+        for (k, &id) in ids.iter().enumerate() {
+            let species = types
+                .get(k)
+                .and_then(|&t| scene.species.get((t as usize).wrapping_sub(1)));
+            if species.is_some_and(|s| s.frozen) {
+                frozen += 1;
+                continue;
+            }
+            current.insert(id as i64, species.map_or(Real::NAN, |s| s.mass()));
+            if n > 0 && !previous.contains_key(&(id as i64)) {
+                count.added += 1;
+            }
+        }
+        for (id, mass) in &previous {
+            if !current.contains_key(id) {
+                count.vanished += 1;
+                count.vanished_mass_kg += mass;
+            }
+        }
+        count.frozen = frozen;
+        previous = current;
+    }
+    count
 }
 
 /// The conveying measurement of `analysis::conveying` from the trajectory frames of the
@@ -620,6 +675,34 @@ mod tests {
         assert!(summary.mass_flow_std_error_kg_s < 1e-9 * flow);
         // Grains were deleted during the window: their mass kept counting.
         assert!(frames.last().unwrap().len() < frames[20].len());
+    }
+
+    /// Frames of the particle-screw case: two screw atoms (frozen type 2) throughout, grain 1
+    /// throughout, grain 2 deleted after the first frame, grain 3 deposited in the second.
+    #[test]
+    fn atoms_are_counted_as_frozen_added_and_vanished_by_id() {
+        let scene = Scene::load(Path::new(
+            "validation/cases/screw_feeder_hertz_particles.toml",
+        ))
+        .unwrap();
+        let frame = |step: u64, atoms: &[(Real, Real)]| Frame {
+            step,
+            boundary: "ff ff ff".into(),
+            bounds: [[-0.1, 1.0], [-0.3, 0.3], [-0.45, 1.0]],
+            columns: vec!["id".into(), "type".into()],
+            values: vec![
+                atoms.iter().map(|a| a.0).collect(),
+                atoms.iter().map(|a| a.1).collect(),
+            ],
+        };
+        let frames = [
+            frame(0, &[(1.0, 1.0), (2.0, 1.0), (10.0, 2.0), (11.0, 2.0)]),
+            frame(100, &[(1.0, 1.0), (10.0, 2.0), (11.0, 2.0), (3.0, 1.0)]),
+            frame(200, &[(1.0, 1.0), (3.0, 1.0), (10.0, 2.0), (11.0, 2.0)]),
+        ];
+        let count = atom_count(&scene, &frames);
+        assert_eq!((count.frozen, count.added, count.vanished), (2, 1, 1));
+        assert_eq!(count.vanished_mass_kg, scene.species[0].mass());
     }
 
     #[test]
