@@ -516,7 +516,7 @@ pub fn casing_mesh(spec: &ScrewFeederSpec) -> TriMesh {
 }
 
 /// Inner rectangle of the hopper at height `z` (linear between bottom and top openings).
-fn hopper_inner_rect(spec: &ScrewFeederSpec, z: Real) -> RectXY {
+pub(crate) fn hopper_inner_rect(spec: &ScrewFeederSpec, z: Real) -> RectXY {
     let l = spec.layout();
     let s = ((z - l.hopper_bottom_z) / spec.hopper_height).clamp(0.0, 1.0);
     let xc = 0.5 * (l.inlet_x[0] + l.inlet_x[1]);

@@ -327,17 +327,17 @@ pub fn initial_particles(
     initial_particles_with_bodies(scene, rotation, bodies, &[]).map(|(p, _)| p)
 }
 
-/// [`initial_particles`] clear of the scene's SDF bodies, as a run of the scene starts: what
-/// the reference codes start from.
+/// The particles a run of the scene starts with, clear of its SDF bodies and with the
+/// particles of bodies built of particles first (frozen): what the reference codes start from.
 pub fn initial_particles_clear_of_bodies(scene: &Scene) -> Result<Particles, RunError> {
     if scene.bodies.is_empty() {
         return initial_particles(scene, false, &[]);
     }
-    let (bodies, _) = match &scene.contact {
+    let (bodies, sites) = match &scene.contact {
         ContactSettings::Wca { .. } => build_bodies(scene, &seed_laws(scene).1)?,
         ContactSettings::Hertz(h) => build_bodies(scene, &hertz::hertz_wall(scene, h))?,
     };
-    initial_particles(scene, false, &bodies)
+    initial_particles_with_bodies(scene, false, &bodies, &sites).map(|(p, _)| p)
 }
 
 /// As [`initial_particles`], with the particles of bodies built of particles first (`sites`:

@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod guards;
 mod physics;
+mod reference_screw;
 mod reference_stages;
 mod scenes;
 mod stability;

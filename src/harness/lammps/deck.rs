@@ -207,6 +207,40 @@ pub(crate) fn kinetic_energy_lines(dump_every: u64, rotation: bool) -> String {
     d
 }
 
+/// Lines a deck runs every `every` steps of a duration stage (LAMMPS's top-ups), `lines(n)`
+/// at the `n`-th stop (from 0); lines that add fixes end with their own `run 0` setup.
+pub(crate) struct Periodic {
+    pub every: u64,
+    pub lines: Box<dyn Fn(usize) -> String>,
+}
+
+/// What a code's deck adds to the shared stage lines: `unfix(wall)` removes a wall,
+/// `begin(stage)` adds what starts with a stage (a body's motion, a top-up), and
+/// `periodic(stage)` gives lines to run every so many steps of a duration stage.
+pub(crate) struct StageHooks<'a> {
+    pub unfix: &'a dyn Fn(&str) -> String,
+    pub begin: &'a dyn Fn(&str) -> String,
+    pub periodic: &'a dyn Fn(&str) -> Option<Periodic>,
+}
+
+impl StageHooks<'_> {
+    /// Hooks that only remove walls (`unfix`), for decks without bodies or top-ups.
+    pub fn walls_only(unfix: &dyn Fn(&str) -> String) -> StageHooks<'_> {
+        StageHooks {
+            unfix,
+            begin: &|_| String::new(),
+            periodic: &|_| None,
+        }
+    }
+}
+
+/// Where a duration stage stops: repose sample `j` at time `t`, or periodic stop `n`.
+#[derive(Clone, Copy)]
+enum Stop {
+    Sample(usize, Real),
+    Periodic(usize),
+}
+
 /// The scene's stages as deck lines (LAMMPS and LIGGGHTS take the same commands), appended to
 /// `d` after the trajectory dump is defined; returns the repose samples (stage, time after
 /// its start, file). One `run 0` sets the system up; every later run is `pre no`, so it is set
@@ -214,10 +248,10 @@ pub(crate) fn kinetic_energy_lines(dump_every: u64, rotation: bool) -> String {
 /// stored coefficient in every setup (measured: a second setup turned the wall restitution
 /// 0.49998 into 0.60055, a third into 0.49247; `reference/HERTZ_COLLAPSE.md`), and the LAMMPS
 /// decks pad their fix list for the `unfix` that follows ([`removal_pads`]). A stage first
-/// removes its walls (`unfix(name)` gives the lines), adds what starts with it (`begin(stage)`:
-/// a body's motion, a top-up), prints
+/// removes its walls (`hooks.unfix`), adds what starts with it (`hooks.begin`), prints
 /// `CGDEM_STAGE name start STEP`, then either runs its duration, stopping at each repose time
-/// for a `write_dump`, or runs in chunks of one output interval until the first chunk end
+/// for a `write_dump` and, when `hooks.periodic` gives lines, every so many steps for them, or
+/// runs in chunks of one output interval until the first chunk end
 /// after `min_duration` with `v_kepm` below the threshold (at most `max_duration`), and prints
 /// `CGDEM_STAGE name end STEP how`.
 pub(crate) fn stage_lines(
@@ -226,8 +260,7 @@ pub(crate) fn stage_lines(
     dt: Real,
     dump_every: u64,
     dumps: &StageDumps,
-    unfix: impl Fn(&str) -> String,
-    begin: impl Fn(&str) -> String,
+    hooks: &StageHooks,
 ) -> Vec<(String, Real, String)> {
     let write_dump = |file: &str| {
         format!(
@@ -240,9 +273,9 @@ pub(crate) fn stage_lines(
     for (k, stage) in scene.stages.iter().enumerate() {
         let _ = writeln!(d, "\n# stage `{}`", stage.name);
         for name in &stage.remove_walls {
-            *d += &unfix(name);
+            *d += &(hooks.unfix)(name);
         }
-        *d += &begin(&stage.name);
+        *d += &(hooks.begin)(&stage.name);
         let _ = writeln!(
             d,
             "print           \"CGDEM_STAGE {} start $(step)\"",
@@ -255,16 +288,42 @@ pub(crate) fn stage_lines(
         match stage.end {
             StageEnd::Duration(duration) => {
                 let total = (duration / dt).round() as u64;
-                let mut done = 0;
+                // Stops inside the stage, by step: repose samples and periodic lines.
+                let mut stops: Vec<(u64, Stop)> = Vec::new();
                 for (j, &t) in repose_times.iter().enumerate() {
-                    let at = ((t / dt).round() as u64).min(total);
+                    stops.push((((t / dt).round() as u64).min(total), Stop::Sample(j, t)));
+                }
+                let periodic = (hooks.periodic)(&stage.name);
+                if let Some(p) = &periodic {
+                    let every = p.every.max(1);
+                    stops.extend(
+                        (1..)
+                            .map(|n| n * every)
+                            .take_while(|&at| at < total)
+                            .enumerate()
+                            .map(|(n, at)| (at, Stop::Periodic(n))),
+                    );
+                }
+                stops.sort_by_key(|&(at, _)| at);
+                let mut done = 0;
+                for (at, stop) in stops {
                     if at > done {
                         let _ = writeln!(d, "run             {} pre no post no", at - done);
                         done = at;
                     }
-                    let file = format!("repose_{j}.dump");
-                    let _ = writeln!(d, "write_dump      {}", write_dump(&file));
-                    repose_dumps.push((stage.name.clone(), t, file));
+                    match stop {
+                        Stop::Sample(j, t) => {
+                            let file = format!("repose_{j}.dump");
+                            let _ = writeln!(d, "write_dump      {}", write_dump(&file));
+                            repose_dumps.push((stage.name.clone(), t, file));
+                        }
+                        Stop::Periodic(n) => {
+                            *d += &(periodic
+                                .as_ref()
+                                .expect("a periodic stop has its lines")
+                                .lines)(n)
+                        }
+                    }
                 }
                 if total > done {
                     let _ = writeln!(d, "run             {} pre no post no", total - done);
@@ -504,8 +563,9 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         dt,
         dump_every,
         &stages,
-        |name| format!("unfix           wlj_{name}\nunfix           wgran_{name}\n"),
-        |_| String::new(),
+        &StageHooks::walls_only(&|name| {
+            format!("unfix           wlj_{name}\nunfix           wgran_{name}\n")
+        }),
     );
     Ok(Deck {
         input: d,

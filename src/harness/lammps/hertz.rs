@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 
 use super::deck::{
     boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines, Deck, DeckError,
-    DeckPlan, StageDumps, DATA_FILE, TRAJECTORY_FILE,
+    DeckPlan, Periodic, StageDumps, StageHooks, DATA_FILE, TRAJECTORY_FILE,
 };
 use crate::contact::damping::restitution_beta;
 use crate::contact::normal::{Hertz, Material};
@@ -66,11 +66,11 @@ pub fn tangential_damping_ratio(y_eff: Real, g_eff: Real) -> Real {
 }
 
 /// The Hertz settings a reference deck can express, or why not.
-/// `meshes`: the code takes the scene's bodies as meshes and its `[[delete]]` boxes (LIGGGHTS).
+/// `bodies`: the code's deck writes the scene's bodies (checked there), else it refuses them.
 pub(crate) fn hertz_settings<'a>(
     scene: &'a Scene,
     code: &str,
-    meshes: bool,
+    bodies: bool,
 ) -> Result<&'a HertzSettings, DeckError> {
     let unsupported = |reason: String| DeckError::Unsupported {
         file: scene.source.display().to_string(),
@@ -90,9 +90,9 @@ pub(crate) fn hertz_settings<'a>(
             "{code} decks are written for damping = \"hertz\", tangential = \"history\", rolling = \"none\" or \"epsd2\", cohesion = \"none\" only"
         )));
     }
-    if !meshes && (!scene.bodies.is_empty() || !scene.deletions.is_empty()) {
+    if !bodies && !scene.bodies.is_empty() {
         return Err(unsupported(format!(
-            "{code} Hertz decks take planar walls only (no [[body]], no [[delete]]): LAMMPS has no mesh walls, and the deck with a particle-built screw is not written yet"
+            "{code} Hertz decks take planar walls only (no [[body]])"
         )));
     }
     Ok(h)
@@ -143,7 +143,7 @@ pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: 
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
-    let h = hertz_settings(scene, "LAMMPS", false)?;
+    let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::Unsupported {
         file: scene.source.display().to_string(),
         reason,
@@ -182,6 +182,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         scene.species.len(),
     );
 
+    let mut files = Vec::new();
     let mut d = String::new();
     let _ = writeln!(
         d,
@@ -231,55 +232,93 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         );
     }
     let _ = writeln!(d, "timestep        {}", g(dt));
-    if !scene.walls.is_empty() {
-        // Particle-wall pair values, passed so that this LAMMPS computes them exactly: its
-        // fix wall/gran hertz/material takes k_n = (4/3) E/(2(1 - nu)) sqrt(R delta) (measured:
-        // contact 10% short with E itself, (1 + nu)^(-2/5)), so E is given as 2 (1 - nu) Y_eff;
-        // the Mindlin stiffness is given explicitly (8 G_eff) rather than NULL.
-        let wm = wall_material(scene, h);
-        let (y_w, g_w) = (Material::y_eff(m, wm), Material::g_eff(m, wm));
-        let e_lammps = 2.0 * (1.0 - m.poisson_ratio) * y_w;
-        let w = &scene.wall_contact;
-        // The wall acts as a particle of infinite radius and mass: R_eff = r, m_eff = m.
-        let roll = if h.rolling == RollingKind::Epsd2 {
-            format!(
-                " rolling sds {} 0.0 {}",
-                g(rolling_stiffness(
-                    y_w,
-                    g_w,
-                    s0.radius(),
-                    s0.mass(),
-                    h.characteristic_velocity
-                )),
-                g(w.rolling_friction)
-            )
+    // Particle-wall pair values, passed so that this LAMMPS computes them exactly: its
+    // fix wall/gran hertz/material takes k_n = (4/3) E/(2(1 - nu)) sqrt(R delta) (measured:
+    // contact 10% short with E itself, (1 + nu)^(-2/5)), so E is given as 2 (1 - nu) Y_eff;
+    // the Mindlin stiffness is given explicitly (8 G_eff) rather than NULL.
+    let wm = wall_material(scene, h);
+    let (y_w, g_w) = (Material::y_eff(m, wm), Material::g_eff(m, wm));
+    let w = &scene.wall_contact;
+    // The wall acts as a particle of infinite radius and mass: R_eff = r, m_eff = m.
+    let wall_rolling = if h.rolling == RollingKind::Epsd2 {
+        format!(
+            " rolling sds {} 0.0 {}",
+            g(rolling_stiffness(
+                y_w,
+                g_w,
+                s0.radius(),
+                s0.mass(),
+                h.characteristic_velocity
+            )),
+            g(w.rolling_friction)
+        )
+    } else {
+        String::new()
+    };
+    let wall_model = if scene.walls.is_empty() && scene.bodies.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{wall_rolling}",
+            g(2.0 * (1.0 - m.poisson_ratio) * y_w),
+            g(q_of(w.restitution)?),
+            g(m.poisson_ratio),
+            g(8.0 * g_w),
+            g(tangential_damping_ratio(y_w, g_w)),
+            g(w.friction),
+        )
+    };
+    for wall in &scene.walls {
+        let (axis, up) = wall_axis(scene, wall)?;
+        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
+        let (lo, hi) = if up {
+            (at, "NULL".to_string())
         } else {
-            String::new()
+            ("NULL".to_string(), at)
         };
-        for wall in &scene.walls {
-            let (axis, up) = wall_axis(scene, wall)?;
-            let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
-            let (lo, hi) = if up {
-                (at, "NULL".to_string())
-            } else {
-                ("NULL".to_string(), at)
-            };
-            let _ = writeln!(
-                d,
-                "fix             w_{} all wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {}plane {lo} {hi}",
-                wall.name,
-                g(e_lammps),
-                g(q_of(w.restitution)?),
-                g(m.poisson_ratio),
-                g(8.0 * g_w),
-                g(tangential_damping_ratio(y_w, g_w)),
-                g(w.friction),
-                roll,
-                ["x", "y", "z"][axis]
-            );
-        }
-        d += &super::deck::removal_pads(scene, 1);
+        let _ = writeln!(
+            d,
+            "fix             w_{} all wall/gran granular {wall_model} {}plane {lo} {hi}",
+            wall.name,
+            ["x", "y", "z"][axis]
+        );
     }
+    let bodies = super::bodies::body_lines(scene, integrated, &wall_model)?;
+    d += &bodies.setup;
+    // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
+    // polynomial to its wall fixes' coefficient; the body region's fix is defined anew
+    // before each, planar walls cannot be.
+    let later_setups = scene.bodies.iter().any(|b| b.start_stage.is_some())
+        || scene.insertions.iter().any(|i| i.refill.is_some());
+    if later_setups && !scene.walls.is_empty() {
+        return Err(unsupported("planar walls with a top-up or a body that starts later: LAMMPS would re-apply its Tsuji polynomial to the walls' damping at each setup (reference/HERTZ_COLLAPSE.md)".into()));
+    }
+    for (start, motion) in &bodies.motions {
+        if start.is_none() {
+            d += motion;
+        }
+    }
+    d += &super::deck::removal_pads(scene, 1);
+    for (k, (lo, hi)) in scene.deletions.iter().enumerate() {
+        // Grains whose centres enter the box are removed, checked every output interval.
+        let _ = writeln!(
+            d,
+            "region          delete_{k} block {} {} {} {} {} {}",
+            g(lo.x),
+            g(hi.x),
+            g(lo.y),
+            g(hi.y),
+            g(lo.z),
+            g(hi.z)
+        );
+        let _ = writeln!(
+            d,
+            "fix             delete_{k} {integrated} evaporate {dump_every} 1000000 delete_{k} {}",
+            DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()]
+        );
+    }
+    let top_ups = top_up_lines(scene, integrated, dt, &mut files);
+    d += &top_ups.setup;
     d += &kinetic_energy_lines(dump_every, true);
     let _ = writeln!(
         d,
@@ -290,16 +329,40 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         columns: HERTZ_COLUMNS,
         modify: "format float %.17g sort id",
     };
+    let begin = |stage: &str| {
+        let mut lines = String::new();
+        for (start, motion) in &bodies.motions {
+            if start.as_deref() == Some(stage) {
+                lines += motion;
+            }
+        }
+        lines += &top_ups.begin(stage);
+        if !lines.is_empty() {
+            lines += &bodies.refix_walls;
+            lines += "run             0 post no\n";
+        }
+        lines
+    };
+    let periodic = |stage: &str| top_ups.periodic(stage, &bodies.refix_walls);
     let repose_dumps = stage_lines(
         &mut d,
         scene,
         dt,
         dump_every,
         &dumps,
-        |name| format!("unfix           w_{name}\n"),
-        |_| String::new(),
+        &StageHooks {
+            unfix: &|name| format!("unfix           w_{name}\n"),
+            begin: &begin,
+            periodic: &periodic,
+        },
     );
-    let mut notes = Vec::new();
+    let mut notes = bodies.notes;
+    if !bodies.refix_walls.is_empty() && later_setups {
+        notes.push("LAMMPS: the body region's wall fix is defined anew at each setup (when the screw starts, at each top-up), so grains sliding on the casing lose their tangential history then".into());
+    }
+    if !scene.deletions.is_empty() {
+        notes.push(format!("LAMMPS deletes grains in a [[delete]] box every {dump_every} steps (fix evaporate), cgdem every step"));
+    }
     if h.rolling == RollingKind::Epsd2 {
         notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
     }
@@ -307,7 +370,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     Ok(Deck {
         input: d,
         data,
-        files: Vec::new(),
+        files,
         plan: DeckPlan {
             code: "lammps",
             log_file: super::runner::LOG_FILE,
@@ -317,6 +380,122 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
             repose_dumps,
         },
     })
+}
+
+/// Seeds of LAMMPS's random deletions and top-ups (primes; any positive integer will do).
+const DEPOSIT_SEEDS: [u64; 4] = [1000003, 2000003, 3000017, 4000037];
+
+/// The top-ups of a LAMMPS deck (`[[insert]] refill`): as cgdem, every `interval` of the
+/// refill stage the insertion box is filled back to the count it held when the stage began.
+/// LAMMPS's `create_atoms random` has no overlap check here, so each top-up is a `fix deposit`
+/// of the missing count (one atom per step, none closer to another than the two radii),
+/// whose one-atom molecule template carries the species' diameter and mass.
+struct TopUps {
+    setup: String,
+    entries: Vec<TopUp>,
+}
+
+struct TopUp {
+    insertion: usize,
+    stage: String,
+    every: u64,
+    near: Real,
+    group: String,
+}
+
+fn top_up_lines(
+    scene: &Scene,
+    integrated: &str,
+    dt: Real,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> TopUps {
+    let mut out = TopUps {
+        setup: String::new(),
+        entries: Vec::new(),
+    };
+    let max_radius = 0.5 * scene.max_diameter();
+    for (k, ins) in scene.insertions.iter().enumerate() {
+        let Some(refill) = &ins.refill else { continue };
+        let species = &scene.species[ins.species];
+        let _ = writeln!(
+            out.setup,
+            "region          top_{k} block {} {} {} {} {} {}",
+            g(ins.lo.x),
+            g(ins.hi.x),
+            g(ins.lo.y),
+            g(ins.hi.y),
+            g(ins.lo.z),
+            g(ins.hi.z)
+        );
+        let file = format!("top_{k}.mol");
+        let _ = writeln!(out.setup, "molecule        top_{k} {file}");
+        let template = format!(
+            "# one {} grain (written by cgdem)\n\n1 atoms\n\nCoords\n\n1 0.0 0.0 0.0\n\nTypes\n\n1 {}\n\nDiameters\n\n1 {}\n\nMasses\n\n1 {}\n",
+            species.name,
+            ins.species + 1,
+            g(species.diameter),
+            g(species.mass())
+        );
+        files.push((file, template.into_bytes()));
+        out.entries.push(TopUp {
+            insertion: k,
+            stage: refill.stage.clone(),
+            every: ((refill.interval / dt).round() as u64).max(1),
+            near: species.radius() + max_radius,
+            group: integrated.to_string(),
+        });
+    }
+    out
+}
+
+impl TopUps {
+    /// At the start of `stage`: the count each of its top-ups keeps.
+    fn begin(&self, stage: &str) -> String {
+        let mut d = String::new();
+        for t in self.entries.iter().filter(|t| t.stage == stage) {
+            let k = t.insertion;
+            let _ = writeln!(
+                d,
+                "variable        top_target_{k} equal $(count(all,top_{k}))"
+            );
+        }
+        d
+    }
+
+    /// Every top-up interval of `stage`: deposit what each box lacks, define the walls anew
+    /// (`refix_walls`) and set up. Top-ups of one stage share the first one's interval.
+    fn periodic(&self, stage: &str, refix_walls: &str) -> Option<Periodic> {
+        let entries: Vec<(usize, Real, String)> = self
+            .entries
+            .iter()
+            .filter(|t| t.stage == stage)
+            .map(|t| (t.insertion, t.near, t.group.clone()))
+            .collect();
+        let every = self.entries.iter().find(|t| t.stage == stage)?.every;
+        let refix_walls = refix_walls.to_string();
+        Some(Periodic {
+            every,
+            lines: Box::new(move |n| {
+                let mut d = String::new();
+                for (k, near, group) in &entries {
+                    let add = format!("top_add_{k}_{n}");
+                    let _ = writeln!(
+                        d,
+                        "variable        {add} equal $((v_top_target_{k}-count(all,top_{k}))*(v_top_target_{k}>count(all,top_{k})))"
+                    );
+                    let seed = DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()] + 7919 * n as u64;
+                    let _ = writeln!(
+                        d,
+                        "if              \"${{{add}}} > 0\" then \"fix {add} {group} deposit ${{{add}}} 0 1 {seed} region top_{k} near {} attempt 200 mol top_{k} id max\"",
+                        g(*near)
+                    );
+                }
+                d += &refix_walls;
+                d += "run             0 post no\n";
+                d
+            }),
+        })
+    }
 }
 
 /// The deck of `validation/cases/aor_hertz.toml` with one particle, for the deck tests of
@@ -387,6 +566,92 @@ mod tests {
         let times: Vec<Real> = deck.plan.repose_dumps.iter().map(|r| r.1).collect();
         assert_eq!(times, [0.25, 0.5, 1.0]);
         assert!(deck.plan.notes.iter().any(|n| n.contains("rolling sds")));
+    }
+
+    #[test]
+    fn screw_deck_turns_the_particle_screw_from_the_conveying_stage_inside_the_casing_region() {
+        let scene = Scene::load(std::path::Path::new(
+            "validation/cases/screw_feeder_hertz_particles.toml",
+        ))
+        .unwrap();
+        let particles = crate::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let screw_atoms = (0..particles.len())
+            .filter(|&k| particles.species[k] == 1)
+            .count();
+        assert!(screw_atoms > 1000, "{screw_atoms}");
+        let deck = write_hertz_deck(&scene, &particles, 6e-5).unwrap();
+        let d = &deck.input;
+        // The screw's atoms: frozen (effective mass the grain's), grouped, their pairs excluded.
+        at(d, "fix             freeze frozen freeze");
+        at(d, "neigh_modify    exclude type 2 2");
+        at(d, "group           body_screw type 2");
+        assert_eq!(
+            deck.data
+                .lines()
+                .filter(|l| l.split_whitespace().nth(1) == Some("2")
+                    && l.split_whitespace().count() == 7)
+                .count(),
+            screw_atoms
+        );
+        // Casing and hopper: one union region, felt by the mobile grains.
+        let walls = at(
+            d,
+            "fix             w_casing_hopper mobile wall/gran/region granular hertz/material",
+        );
+        at(d, "region          casing_hopper union 5");
+        // rpm -100 about +x: counter-clockwise about -x, 0.6 s per turn, from `convey` on,
+        // with the wall fix defined anew before the setup that starts it.
+        let settle_end = at(d, "CGDEM_STAGE settle end");
+        let turn = at(d, "fix             move_screw body_screw move rotate 0.00000000000000000e0 0.00000000000000000e0 0.00000000000000000e0 -1.00000000000000000e0 -0.00000000000000000e0 -0.00000000000000000e0 5.99999999999999978e-1");
+        let target = at(d, "variable        top_target_0 equal $(count(all,top_0))");
+        let refix = at(d, "unfix           w_casing_hopper");
+        let convey = at(d, "CGDEM_STAGE convey start");
+        assert!(
+            walls < settle_end
+                && settle_end < turn
+                && turn < target
+                && target < refix
+                && refix < convey
+        );
+        assert!(d[refix..convey].contains("run             0 post no"));
+        // Top-ups every 0.1 s (1667 steps): deposit what the box lacks, refix, set up.
+        let first = at(d, "variable        top_add_0_0 equal");
+        assert!(first > convey);
+        at(d, "fix top_add_0_0 mobile deposit ${top_add_0_0} 0 1 1000003 region top_0 near 2.16000000000000011e-2 attempt 200 mol top_0 id max");
+        let runs: Vec<&str> = d[convey..first]
+            .lines()
+            .filter(|l| l.starts_with("run"))
+            .collect();
+        assert_eq!(runs, ["run             1667 pre no post no"]);
+        // 1.8 s = 30000 steps: 17 top-ups, the last chunk 30000 - 17 * 1667 = 1661 steps.
+        assert!(d.contains("top_add_0_16 ") && !d.contains("top_add_0_17 "));
+        at(d, "run             1661 pre no post no");
+        let template = deck
+            .files
+            .iter()
+            .find(|(name, _)| name == "top_0.mol")
+            .unwrap();
+        let template = String::from_utf8_lossy(&template.1);
+        assert!(
+            template.contains("Diameters\n\n1 2.16000000000000011e-2"),
+            "{template}"
+        );
+        // The outlet's deletion box.
+        at(d, "region          delete_0 block 4.50000000000000011e-1");
+        at(d, "fix             delete_0 mobile evaporate");
+    }
+
+    #[test]
+    fn planar_walls_are_refused_with_a_top_up() {
+        let (mut scene, particles) = collapse_scene_and_particle();
+        scene.insertions[0].refill = Some(crate::scene::Refill {
+            interval: 0.1,
+            stage: "collapse".into(),
+        });
+        let e = write_hertz_deck(&scene, &particles, 5e-5)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("planar walls with a top-up"), "{e}");
     }
 
     #[test]

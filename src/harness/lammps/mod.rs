@@ -3,6 +3,7 @@
 //! `reference/lammps/SEED_MODEL.md` and `reference/MAPPING.md`. `run_reference` also runs
 //! LIGGGHTS (`harness::liggghts`): both codes share the stage lines, runner and post-processing.
 
+mod bodies;
 pub mod deck;
 pub mod dump;
 pub mod hertz;

@@ -16,7 +16,7 @@ use std::path::Path;
 
 use crate::harness::lammps::deck::{
     boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines, Deck, DeckError,
-    DeckPlan, StageDumps, DATA_FILE,
+    DeckPlan, StageDumps, StageHooks, DATA_FILE,
 };
 use crate::harness::lammps::hertz::{
     hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS,
@@ -182,8 +182,11 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         dt,
         dump_every,
         &dumps,
-        |name| format!("unfix           w_{name}\n"),
-        begin,
+        &StageHooks {
+            unfix: &|name| format!("unfix           w_{name}\n"),
+            begin: &begin,
+            periodic: &|_| None,
+        },
     );
     Ok(Deck {
         input: d,
