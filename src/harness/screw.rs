@@ -64,6 +64,76 @@ pub fn points_by_code(runs: &[RunRecord]) -> Vec<(Code, Vec<SpeedPoint>)> {
     out
 }
 
+/// Per code of `runs`, its mass flow against speed with error bars and its Eq. (7) line
+/// (dashed), labelled `label(code)`.
+fn with_speed_series(
+    mut figure: Figure,
+    runs: &[RunRecord],
+    label: impl Fn(Code) -> String,
+) -> Figure {
+    for (code, points) in points_by_code(runs) {
+        figure = figure
+            .with_series(
+                Series::new(
+                    label(code),
+                    points.iter().map(|p| (p.rpm, p.mass_flow_kg_s)).collect(),
+                )
+                .style(SeriesStyle::LineMarkers)
+                .y_err(points.iter().map(|p| p.std_error_kg_s).collect()),
+            )
+            .with_series(
+                Series::new(
+                    format!("Eq. (7), {} fill", label(code)),
+                    points
+                        .iter()
+                        .map(|p| (p.rpm, p.eq7_mass_flow_kg_s))
+                        .collect(),
+                )
+                .style(SeriesStyle::Dashed),
+            );
+    }
+    figure
+}
+
+/// One figure of every screw case of a suite together (e.g. the mesh screw in cgdem and
+/// LIGGGHTS and the particle screw in cgdem and LAMMPS, which has no mesh walls): each code
+/// and case its own series, with its Eq. (7) line; under `figures/screw_overview/`.
+pub fn write_screw_overview(
+    report: &mut Report,
+    cases: &[(&Scene, &[RunRecord])],
+    out: &Path,
+) -> Result<(), ValidateError> {
+    let mut figure = Figure::new(
+        "Screw feeder: mass flow against speed, every code and screw (paper A Fig. 8)",
+        "screw speed (rpm)",
+        "mass flow (kg/s)",
+    );
+    for (scene, runs) in cases {
+        figure = with_speed_series(figure, runs, |code| {
+            format!("{}, {}", code.name(), scene.name)
+        });
+    }
+    if figure.series.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<&str> = cases.iter().map(|(s, _)| s.name.as_str()).collect();
+    let section = report.section("Screw feeder: every code in one figure");
+    section.paragraph(format!(
+        "The screw cases {names:?} together: each code with the screw it can run (LIGGGHTS takes mesh walls only, LAMMPS has no mesh walls and runs the screw built of particles), measured by the same rule; the numbers are in each case's section. Dashed: Eq. (7) with each run's measured fill ratio."
+    ));
+    let dir = out.join("figures").join("screw_overview");
+    let files =
+        write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;
+    section
+        .figure(
+            &files,
+            "mass flow against screw speed, one series per code and screw case, with Eq. (7)",
+            "Mass flow against screw speed for every code and screw case (mean over seeds), with Eq. (7) for each one's measured fill ratio.",
+        )
+        .map_err(|e| output_error(&files.png, e))?;
+    Ok(())
+}
+
 /// The section: the figure (PNG, SVG and CSV under `figures/<case>/`) and the table.
 pub fn write_screw_section(
     report: &mut Report,
@@ -94,27 +164,7 @@ pub fn write_screw_section(
         "screw speed (rpm)",
         "mass flow (kg/s)",
     );
-    for (code, points) in points_by_code(runs) {
-        figure = figure
-            .with_series(
-                Series::new(
-                    code.name(),
-                    points.iter().map(|p| (p.rpm, p.mass_flow_kg_s)).collect(),
-                )
-                .style(SeriesStyle::LineMarkers)
-                .y_err(points.iter().map(|p| p.std_error_kg_s).collect()),
-            )
-            .with_series(
-                Series::new(
-                    format!("Eq. (7), {} fill", code.name()),
-                    points
-                        .iter()
-                        .map(|p| (p.rpm, p.eq7_mass_flow_kg_s))
-                        .collect(),
-                )
-                .style(SeriesStyle::Dashed),
-            );
-    }
+    figure = with_speed_series(figure, runs, |code| code.name().to_string());
     if !figure.series.is_empty() {
         let files =
             write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;

@@ -153,6 +153,14 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
             None => scenes.push((scene, case, case_runs)),
         }
     }
+    let screws: Vec<(&Scene, &[RunRecord])> = scenes
+        .iter()
+        .filter(|(s, _, _)| s.conveying.is_some())
+        .map(|(s, _, r)| (s, r.as_slice()))
+        .collect();
+    if screws.len() > 1 {
+        super::screw::write_screw_overview(&mut report, &screws, &options.out)?;
+    }
     for (scene, case, case_runs) in scenes {
         if scene.conveying.is_some() {
             // A screw case is judged by its mass flow against Eq. (7), code by code.
