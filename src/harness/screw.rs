@@ -159,6 +159,9 @@ pub fn write_screw_section(
         case.rpms,
         case.seeds
     ));
+    if case.keep_going {
+        section.paragraph("cgdem's guards only warn in this case (suite entry `keep_going = true`): grains wedge between the flight's tip and the casing, a clearance narrower than a grain, deeper than the overlap guard allows; the warnings and the deepest overlap are in each run's summary.json.");
+    }
     let mut figure = Figure::new(
         "Screw feeder: mass flow against speed (paper A Fig. 8)",
         "screw speed (rpm)",

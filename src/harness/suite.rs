@@ -132,6 +132,11 @@ pub struct SuiteCase {
     /// Screw speeds (rev/min) for a scene with `[conveying]`: one run per speed, the stage
     /// scaled to the same number of turns (`sweep::at_speed`); empty: the scene's own speed.
     pub rpms: Vec<f64>,
+    /// cgdem's guards only warn in this case's runs (as `--keep-going`): for a case whose
+    /// geometry is known to wedge grains deeper than the overlap guard allows (the screw
+    /// feeder's tip clearance is narrower than a grain); the warnings stay in each run's
+    /// summary, and the reference codes, which have no such guard, run it alike.
+    pub keep_going: bool,
 }
 
 impl SuiteCase {
@@ -202,6 +207,8 @@ struct RawCase {
     variant: Option<String>,
     #[serde(default)]
     rpms: Vec<f64>,
+    #[serde(default)]
+    keep_going: bool,
 }
 
 impl Suite {
@@ -309,6 +316,7 @@ impl Suite {
                 overrides,
                 variant: c.variant,
                 rpms: c.rpms,
+                keep_going: c.keep_going,
             });
         }
         let accuracy = raw
@@ -352,6 +360,15 @@ mod tests {
         assert_eq!(scene.name, format!("{}-smooth-walls", plain.name));
         assert_ne!(scene.digest(), plain.digest());
         assert_ne!(scene.wall_contact, plain.wall_contact);
+    }
+
+    #[test]
+    fn keep_going_is_per_case_and_off_unless_asked() {
+        let suite = Suite::parse(CASE, Path::new("s.toml")).unwrap();
+        assert!(!suite.cases[0].keep_going);
+        let suite =
+            Suite::parse(&format!("{CASE}keep_going = true\n"), Path::new("s.toml")).unwrap();
+        assert!(suite.cases[0].keep_going);
     }
 
     #[test]

@@ -113,6 +113,7 @@ pub(super) fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateEr
     }
 }
 
+#[derive(Clone)]
 pub struct ValidateOptions {
     pub suite: PathBuf,
     pub out: PathBuf,
@@ -412,6 +413,10 @@ fn run_case(
                     &at_speed
                 }
                 _ => scene,
+            };
+            let options = &ValidateOptions {
+                keep_going: options.keep_going || case.keep_going,
+                ..options.clone()
             };
             let mut record = run_one(scene, code, lambda, rule, seed, &dir, options);
             record.rpm = rpm;
