@@ -14,7 +14,7 @@ use crate::guard::{
     forced_step_cause, overlap_fraction, undamped_limit, GuardKind, GuardPeaks, GuardSettings,
     GuardState, GuardTrip,
 };
-use crate::integrate::{drift_kick, kick, pcvv, Integrator};
+use crate::integrate::{complete_and_kick, drift_kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{Pair, VerletList};
 use crate::particles::Particles;
@@ -75,9 +75,6 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// Per particle, per planar wall (particle-major, `wall_slots()` each) contact history;
     /// zero-sized for stateless wall laws.
     wall_history: Vec<W::History>,
-    /// Per particle, the sum of its own pairs' forces (and torques) on it.
-    own_force: Vec<Vec3>,
-    own_torque: Vec<Vec3>,
     /// Per listed pair, the force on its `j` (empty when particles spin).
     reaction_force: Vec<Vec3>,
     /// Per listed pair, the force and torque on its `j`, side by side so the gather reads
@@ -126,8 +123,6 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             list: VerletList::new(neighbor.skin),
             history: Vec::new(),
             wall_history: Vec::new(),
-            own_force: Vec::new(),
-            own_torque: Vec::new(),
             reaction_force: Vec::new(),
             reaction_spin: Vec::new(),
             bodies: Vec::new(),
@@ -307,8 +302,6 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             + bytes(&self.body_loads)
             + bytes(&self.old_force)
             + bytes(&self.old_torque)
-            + bytes(&self.own_force)
-            + bytes(&self.own_torque)
             + self.list.particle_bytes();
         if let Some(a) = &p.angular {
             particle_bytes += bytes(&a.omega) + bytes(&a.torque) + bytes(&a.inv_inertia);
@@ -408,8 +401,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.rebuild();
         }
         self.pose_bodies_at(self.time + dt);
-        self.compute_forces();
-        self.guard.finite = kick(&mut self.particles, dt);
+        self.owner_pass();
+        let reactions = Reactions {
+            list: &self.list,
+            force: &self.reaction_force,
+            spin: &self.reaction_spin,
+        };
+        self.guard.finite =
+            complete_and_kick(&mut self.particles, dt, |i, f, t| reactions.add_to(i, f, t));
     }
 
     /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list
@@ -531,111 +530,112 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 .carry_history(&old_pairs, &old_history, wraps.as_deref(), remap.as_deref());
     }
 
-    /// Pair forces, then a per-particle gather in a fixed order with walls and gravity. No
-    /// atomics, no thread-count dependence.
+    /// Every particle's force and torque: the owner pass, then the reactions.
+    pub fn compute_forces(&mut self) {
+        self.owner_pass();
+        let reactions = Reactions {
+            list: &self.list,
+            force: &self.reaction_force,
+            spin: &self.reaction_spin,
+        };
+        let p = &mut self.particles;
+        match p.angular.as_mut() {
+            Some(a) => p
+                .force
+                .par_iter_mut()
+                .zip(a.torque.par_iter_mut())
+                .enumerate()
+                .with_min_len(CHUNK)
+                .for_each(|(i, (f, t))| reactions.add_to(i, f, t)),
+            None => p
+                .force
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(CHUNK)
+                .for_each(|(i, f)| reactions.add_to(i, f, &mut Vec3::default())),
+        }
+    }
+
+    /// Leaves in each particle's force (and torque) everything but the reactions of pairs
+    /// owned by other particles, which it stores per pair. No atomics, no thread-count
+    /// dependence.
     ///
     /// Each pair is evaluated once, by its owner `i` (the list holds `i < j`, grouped by `i`):
-    /// the owner sums its own share as it goes, and stores only what `j` receives (the
-    /// reaction force, and the torque on `j` when particles spin), which the gather adds in
-    /// list order.
-    pub fn compute_forces(&mut self) {
+    /// the owner sums its own share as it goes, then gravity, its walls and bodies (it has
+    /// its position and velocity at hand), and stores only what `j` receives (the reaction
+    /// force, and the torque on `j` when particles spin). Whoever completes the forces adds
+    /// those in list order: `compute_forces`, or the closing kick of a velocity-Verlet step,
+    /// which so reads each particle once instead of twice.
+    fn owner_pass(&mut self) {
         let n = self.particles.len();
         let pairs = self.list.pairs.len();
-        self.own_force.resize(n, Vec3::ZERO);
-        if !Self::ROTATES {
+        if Self::ROTATES {
+            self.reaction_spin.resize(pairs, [Vec3::ZERO; 2]);
+            let slots = self.wall_slots();
+            if self.wall_history.len() != n * slots {
+                self.wall_history.resize(n * slots, W::History::default());
+            }
+        } else {
             self.reaction_force.resize(pairs, Vec3::ZERO);
         }
-        if Self::ROTATES {
-            self.own_torque.resize(n, Vec3::ZERO);
-            self.reaction_spin.resize(pairs, [Vec3::ZERO; 2]);
-        }
-        let p = &self.particles;
+        let n_bodies = self.bodies.len();
+        self.body_loads.resize(n * n_bodies, BodyLoad::default());
+        let Particles {
+            position,
+            velocity,
+            force,
+            radius,
+            mass,
+            inv_mass,
+            species,
+            angular,
+            ..
+        } = &mut self.particles;
+        let (omega, torque) = match angular.as_mut() {
+            Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
+            None => (None, &mut [][..]),
+        };
         let pass = OwnerPass {
             law: &self.law,
-            particles: p,
-            omega: p.angular.as_ref().map(|a| a.omega.as_slice()),
+            wall_law: &self.wall_law,
+            state: ParticleState {
+                position,
+                velocity,
+                omega,
+                radius,
+                mass,
+                inv_mass,
+                species,
+            },
             images: std::array::from_fn(|k| self.domain.image_shift(k as u8)),
             n_species: self.n_species,
             dt: self.dt,
             pairs: &self.list.pairs,
             out_start: &self.list.out_start,
+            walls: &self.walls,
+            bodies: &self.bodies,
+            gravity: self.gravity,
             rotates: Self::ROTATES,
+            wall_slots: (self.walls.walls.len() + n_bodies).max(1),
         };
-        // The largest overlap fraction, for the overlap guard (max is exact in any order).
-        self.guard.pair_overlap = pass.run(
+        // The largest overlap fractions, for the overlap guard (max is exact in any order).
+        let deepest = pass.run(
             0,
             OwnerSlices {
-                own_force: &mut self.own_force,
-                own_torque: &mut self.own_torque,
+                force,
+                torque,
                 history: &mut self.history,
                 reaction_force: &mut self.reaction_force,
                 reaction_spin: &mut self.reaction_spin,
+                wall_history: &mut self.wall_history,
+                body_loads: &mut self.body_loads,
             },
         );
-
-        if Self::ROTATES {
-            self.gather_with_torques();
-            return;
+        self.guard.pair_overlap = deepest.pairs;
+        self.guard.wall_overlap = deepest.walls;
+        if n_bodies > 0 {
+            self.reduce_body_loads();
         }
-        let dt = self.dt;
-        let p = &mut self.particles;
-        let (list, own, reaction) = (&self.list, &self.own_force, &self.reaction_force);
-        let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
-        let (position, velocity, radius, mass, species) =
-            (&p.position, &p.velocity, &p.radius, &p.mass, &p.species);
-        let gather = |i: usize| -> (Vec3, WallParticle, Real) {
-            let mut f = own[i] + mass[i] * gravity;
-            let particle = WallParticle {
-                species: species[i] as usize,
-                position: position[i],
-                velocity: velocity[i],
-                radius: radius[i],
-                mass: mass[i],
-            };
-            let (wall_force, overlap) = walls.force_on(wall_law, &particle, dt);
-            f += wall_force;
-            for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                f += reaction[k as usize];
-            }
-            (f, particle, overlap)
-        };
-        if self.bodies.is_empty() {
-            self.guard.wall_overlap = p
-                .force
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(CHUNK)
-                .map(|(i, force)| {
-                    let (f, _, overlap) = gather(i);
-                    *force = f;
-                    overlap
-                })
-                .reduce(|| 0.0, larger);
-            return;
-        }
-        let bodies = &self.bodies;
-        let n_bodies = bodies.len();
-        self.body_loads
-            .resize(p.force.len() * n_bodies, BodyLoad::default());
-        self.guard.wall_overlap = p
-            .force
-            .par_iter_mut()
-            .zip(self.body_loads.par_chunks_mut(n_bodies))
-            .enumerate()
-            .with_min_len(CHUNK)
-            .map(|(i, (force, loads))| {
-                let (mut f, particle, mut overlap) = gather(i);
-                for (body, load) in bodies.iter().zip(loads.iter_mut()) {
-                    let (f_body, l, o) = body_force(body, wall_law, &particle, dt);
-                    f += f_body;
-                    *load = l;
-                    overlap = overlap.max(o);
-                }
-                *force = f;
-                overlap
-            })
-            .reduce(|| 0.0, larger);
-        self.reduce_body_loads();
     }
 
     /// Sums the per-particle body loads into the bodies, in a fixed order: bitwise identical
@@ -655,91 +655,6 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// so chunks exist).
     fn wall_slots(&self) -> usize {
         (self.walls.walls.len() + self.bodies.len()).max(1)
-    }
-
-    /// The gather for spinning particles: forces and torques of pairs, walls and gravity.
-    fn gather_with_torques(&mut self) {
-        let slots = self.wall_slots();
-        let n = self.particles.len();
-        if self.wall_history.len() != n * slots {
-            self.wall_history.resize(n * slots, W::History::default());
-        }
-        let wall_history = &mut self.wall_history;
-        let n_walls = self.walls.walls.len();
-        let bodies = &self.bodies;
-        // One load slot per body (one unused slot without bodies, so chunks exist).
-        let body_slots = bodies.len().max(1);
-        self.body_loads.resize(n * body_slots, BodyLoad::default());
-        let body_loads = &mut self.body_loads;
-        let (list, dt) = (&self.list, self.dt);
-        let (own_force, own_torque) = (&self.own_force, &self.own_torque);
-        let reaction = &self.reaction_spin;
-        let (walls, wall_law, gravity) = (&self.walls, &self.wall_law, self.gravity);
-        let Particles {
-            position,
-            velocity,
-            radius,
-            mass,
-            species,
-            force,
-            angular,
-            ..
-        } = &mut self.particles;
-        let Some(a) = angular.as_mut() else {
-            return;
-        };
-        let omega = &a.omega;
-        self.guard.wall_overlap = force
-            .par_iter_mut()
-            .zip(a.torque.par_iter_mut())
-            .zip(wall_history.par_chunks_mut(slots))
-            .zip(body_loads.par_chunks_mut(body_slots))
-            .enumerate()
-            .with_min_len(CHUNK)
-            .map(|(i, (((force, torque), wall_history), loads))| {
-                let mut f = own_force[i] + mass[i] * gravity;
-                let particle = WallParticle {
-                    species: species[i] as usize,
-                    position: position[i],
-                    velocity: velocity[i],
-                    radius: radius[i],
-                    mass: mass[i],
-                };
-                let mut t = own_torque[i];
-                let (wall_history, body_history) = wall_history.split_at_mut(n_walls);
-                let mut overlap = if W::NEEDS_ROTATION {
-                    let (wf, wt, overlap) =
-                        walls.force_and_torque_on(wall_law, &particle, omega[i], wall_history, dt);
-                    f += wf;
-                    t += wt;
-                    overlap
-                } else {
-                    let (wf, overlap) = walls.force_on(wall_law, &particle, dt);
-                    f += wf;
-                    overlap
-                };
-                for ((body, load), history) in bodies.iter().zip(loads.iter_mut()).zip(body_history)
-                {
-                    let (bf, bt, l, o) =
-                        body_force_and_torque(body, wall_law, &particle, omega[i], history, dt);
-                    f += bf;
-                    t += bt;
-                    *load = l;
-                    overlap = larger(overlap, o);
-                }
-                for &k in &list.in_pairs[list.in_start[i] as usize..list.in_start[i + 1] as usize] {
-                    let [rf, rt] = reaction[k as usize];
-                    f += rf;
-                    t += rt;
-                }
-                *force = f;
-                *torque = t;
-                overlap
-            })
-            .reduce(|| 0.0, larger);
-        if !self.bodies.is_empty() {
-            self.reduce_body_loads();
-        }
     }
 
     pub fn kinetic_energy(&self) -> Real {
@@ -1142,31 +1057,92 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 /// Particles per leaf of the owner pass's recursive split.
 const OWNER_LEAF: usize = 256;
 
-/// What the owner pass reads: the law, the particles and the list.
-struct OwnerPass<'a, L: PairLaw> {
-    law: &'a L,
-    particles: &'a Particles,
+/// The particle arrays the owner pass reads.
+#[derive(Clone, Copy)]
+struct ParticleState<'a> {
+    position: &'a [Vec3],
+    velocity: &'a [Vec3],
     omega: Option<&'a [Vec3]>,
+    radius: &'a [Real],
+    mass: &'a [Real],
+    inv_mass: &'a [Real],
+    species: &'a [u16],
+}
+
+/// What the owner pass reads: the laws, the particles, the list, and what acts on one
+/// particle alone (gravity, planar walls, bodies).
+struct OwnerPass<'a, L: PairLaw, W: WallLaw> {
+    law: &'a L,
+    wall_law: &'a W,
+    state: ParticleState<'a>,
     images: [Vec3; 27],
     n_species: usize,
     dt: Real,
     pairs: &'a [Pair],
     out_start: &'a [u32],
+    walls: &'a WallSet,
+    bodies: &'a [Body],
+    gravity: Vec3,
     /// Whether torques are summed and stored (a constant of the world's laws).
     rotates: bool,
+    /// Wall-history entries per particle (used when particles spin).
+    wall_slots: usize,
 }
 
-/// What the owner pass writes, for the particles from `first` on and their pairs (the
-/// torque slice is empty when particles do not spin, the force-only reactions when they do).
-struct OwnerSlices<'s, H> {
-    own_force: &'s mut [Vec3],
-    own_torque: &'s mut [Vec3],
+/// What the owner pass writes, for the particles from `first` on and their pairs. Slices a
+/// scene does not use are empty: torques and wall histories without spin, the force-only
+/// reactions with spin, body loads without bodies.
+struct OwnerSlices<'s, H, WH> {
+    force: &'s mut [Vec3],
+    torque: &'s mut [Vec3],
     history: &'s mut [H],
     reaction_force: &'s mut [Vec3],
     reaction_spin: &'s mut [[Vec3; 2]],
+    wall_history: &'s mut [WH],
+    body_loads: &'s mut [BodyLoad],
 }
 
-/// Splits a slice at `at`, or gives two empty slices when it is empty (unused torques).
+impl<'s, H, WH> OwnerSlices<'s, H, WH> {
+    /// Splits after `particles` particles, which own the first `pairs` pairs.
+    fn split(
+        self,
+        particles: usize,
+        pairs: usize,
+        wall_slots: usize,
+        bodies: usize,
+    ) -> (Self, Self) {
+        let (force_a, force_b) = self.force.split_at_mut(particles);
+        let (torque_a, torque_b) = split_or_empty(self.torque, particles);
+        let (history_a, history_b) = self.history.split_at_mut(pairs);
+        let (reaction_force_a, reaction_force_b) = split_or_empty(self.reaction_force, pairs);
+        let (reaction_spin_a, reaction_spin_b) = split_or_empty(self.reaction_spin, pairs);
+        let (wall_history_a, wall_history_b) =
+            split_or_empty(self.wall_history, particles * wall_slots);
+        let (body_loads_a, body_loads_b) = self.body_loads.split_at_mut(particles * bodies);
+        (
+            OwnerSlices {
+                force: force_a,
+                torque: torque_a,
+                history: history_a,
+                reaction_force: reaction_force_a,
+                reaction_spin: reaction_spin_a,
+                wall_history: wall_history_a,
+                body_loads: body_loads_a,
+            },
+            OwnerSlices {
+                force: force_b,
+                torque: torque_b,
+                history: history_b,
+                reaction_force: reaction_force_b,
+                reaction_spin: reaction_spin_b,
+                wall_history: wall_history_b,
+                body_loads: body_loads_b,
+            },
+        )
+    }
+}
+
+/// Splits a slice at `at`, or gives two empty slices when it is empty (unused arrays).
 fn split_or_empty<T>(slice: &mut [T], at: usize) -> (&mut [T], &mut [T]) {
     if slice.is_empty() {
         (&mut [], &mut [])
@@ -1175,67 +1151,55 @@ fn split_or_empty<T>(slice: &mut [T], at: usize) -> (&mut [T], &mut [T]) {
     }
 }
 
-impl<L: PairLaw> OwnerPass<'_, L> {
-    /// Evaluates the pairs owned by particles `first..first + out.own_force.len()`, halving
-    /// the range in parallel down to leaves; returns the largest overlap fraction.
-    fn run(&self, first: usize, out: OwnerSlices<'_, L::History>) -> Real {
-        let n = out.own_force.len();
-        let pair_base = self.out_start[first] as usize;
+/// The deepest overlaps the owner pass met, as fractions of the radius.
+#[derive(Clone, Copy, Default)]
+struct Deepest {
+    /// Between two particles, of the smaller radius.
+    pairs: Real,
+    /// With a wall or body.
+    walls: Real,
+}
+
+impl Deepest {
+    fn larger(self, other: Deepest) -> Deepest {
+        Deepest {
+            pairs: larger(self.pairs, other.pairs),
+            walls: larger(self.walls, other.walls),
+        }
+    }
+}
+
+impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
+    /// Evaluates the pairs owned by particles `first..first + out.force.len()` and what acts
+    /// on those particles alone, halving the range in parallel down to leaves.
+    fn run(&self, first: usize, out: OwnerSlices<'_, L::History, W::History>) -> Deepest {
+        let n = out.force.len();
         if n > OWNER_LEAF {
             let mid = n / 2;
-            let split = self.out_start[first + mid] as usize - pair_base;
-            let (own_force_a, own_force_b) = out.own_force.split_at_mut(mid);
-            let (own_torque_a, own_torque_b) = split_or_empty(out.own_torque, mid);
-            let (history_a, history_b) = out.history.split_at_mut(split);
-            let (reaction_force_a, reaction_force_b) = split_or_empty(out.reaction_force, split);
-            let (reaction_spin_a, reaction_spin_b) = split_or_empty(out.reaction_spin, split);
-            let (a, b) = rayon::join(
-                || {
-                    self.run(
-                        first,
-                        OwnerSlices {
-                            own_force: own_force_a,
-                            own_torque: own_torque_a,
-                            history: history_a,
-                            reaction_force: reaction_force_a,
-                            reaction_spin: reaction_spin_a,
-                        },
-                    )
-                },
-                || {
-                    self.run(
-                        first + mid,
-                        OwnerSlices {
-                            own_force: own_force_b,
-                            own_torque: own_torque_b,
-                            history: history_b,
-                            reaction_force: reaction_force_b,
-                            reaction_spin: reaction_spin_b,
-                        },
-                    )
-                },
-            );
-            return larger(a, b);
+            let split = (self.out_start[first + mid] - self.out_start[first]) as usize;
+            let (a, b) = out.split(mid, split, self.wall_slots, self.bodies.len());
+            let (a, b) = rayon::join(|| self.run(first, a), || self.run(first + mid, b));
+            return a.larger(b);
         }
-        let p = self.particles;
-        let mut deepest: Real = 0.0;
+        let s = self.state;
+        let pair_base = self.out_start[first] as usize;
+        let mut deepest = Deepest::default();
         for local in 0..n {
             let i = first + local;
             let owner = Owner {
-                position: p.position[i],
-                velocity: p.velocity[i],
-                omega: self.omega.map_or(Vec3::ZERO, |w| w[i]),
-                radius: p.radius[i],
-                inv_mass: p.inv_mass[i],
-                species_row: p.species[i] as usize * self.n_species,
+                position: s.position[i],
+                velocity: s.velocity[i],
+                omega: s.omega.map_or(Vec3::ZERO, |w| w[i]),
+                radius: s.radius[i],
+                inv_mass: s.inv_mass[i],
+                species_row: s.species[i] as usize * self.n_species,
             };
             let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
             for k in self.out_start[i] as usize..self.out_start[i + 1] as usize {
                 let slot = k - pair_base;
                 let (result, overlap, smaller_radius) = pair_force(
                     self.law,
-                    p,
-                    self.omega,
+                    &s,
                     &self.images,
                     &owner,
                     self.pairs[k],
@@ -1244,8 +1208,8 @@ impl<L: PairLaw> OwnerPass<'_, L> {
                 );
                 // The deepest overlap as a fraction of the smaller radius, dividing only
                 // when it grows.
-                if overlap > deepest * smaller_radius {
-                    deepest = overlap / smaller_radius;
+                if overlap > deepest.pairs * smaller_radius {
+                    deepest.pairs = overlap / smaller_radius;
                 }
                 force += result.force_on_i;
                 if self.rotates {
@@ -1255,12 +1219,96 @@ impl<L: PairLaw> OwnerPass<'_, L> {
                     out.reaction_force[slot] = -result.force_on_i;
                 }
             }
-            out.own_force[local] = force;
+            // What acts on `i` alone, after its pairs.
+            force += s.mass[i] * self.gravity;
+            let particle = WallParticle {
+                species: s.species[i] as usize,
+                position: owner.position,
+                velocity: owner.velocity,
+                radius: owner.radius,
+                mass: s.mass[i],
+            };
+            let n_bodies = self.bodies.len();
+            let loads = &mut out.body_loads[local * n_bodies..(local + 1) * n_bodies];
+            let mut overlap;
             if self.rotates {
-                out.own_torque[local] = torque;
+                let slots = &mut out.wall_history[local * self.wall_slots..][..self.wall_slots];
+                let (wall_history, body_history) = slots.split_at_mut(self.walls.walls.len());
+                if W::NEEDS_ROTATION {
+                    let (f, t, o) = self.walls.force_and_torque_on(
+                        self.wall_law,
+                        &particle,
+                        owner.omega,
+                        wall_history,
+                        self.dt,
+                    );
+                    force += f;
+                    torque += t;
+                    overlap = o;
+                } else {
+                    let (f, o) = self.walls.force_on(self.wall_law, &particle, self.dt);
+                    force += f;
+                    overlap = o;
+                }
+                for ((body, load), history) in self.bodies.iter().zip(loads).zip(body_history) {
+                    let (f, t, l, o) = body_force_and_torque(
+                        body,
+                        self.wall_law,
+                        &particle,
+                        owner.omega,
+                        history,
+                        self.dt,
+                    );
+                    force += f;
+                    torque += t;
+                    *load = l;
+                    overlap = larger(overlap, o);
+                }
+                out.torque[local] = torque;
+            } else {
+                let (f, o) = self.walls.force_on(self.wall_law, &particle, self.dt);
+                force += f;
+                overlap = o;
+                for (body, load) in self.bodies.iter().zip(loads) {
+                    let (f, l, o) = body_force(body, self.wall_law, &particle, self.dt);
+                    force += f;
+                    *load = l;
+                    overlap = larger(overlap, o);
+                }
             }
+            out.force[local] = force;
+            deepest.walls = larger(deepest.walls, overlap);
         }
         deepest
+    }
+}
+
+/// The reactions the owner pass stored per pair, which complete the forces: particle `j`
+/// receives those of the pairs it is the second particle of, in list order.
+struct Reactions<'a> {
+    list: &'a VerletList,
+    /// Force on `j` per pair (when particles do not spin).
+    force: &'a [Vec3],
+    /// Force and torque on `j` per pair (when they spin).
+    spin: &'a [[Vec3; 2]],
+}
+
+impl Reactions<'_> {
+    #[inline(always)]
+    fn add_to(&self, j: usize, force: &mut Vec3, torque: &mut Vec3) {
+        let list = self.list;
+        let incoming = &list.in_pairs[list.in_start[j] as usize..list.in_start[j + 1] as usize];
+        if self.spin.is_empty() {
+            for &k in incoming {
+                *force += self.force[k as usize];
+            }
+        } else {
+            for &k in incoming {
+                let [f, t] = self.spin[k as usize];
+                *force += f;
+                *torque += t;
+            }
+        }
     }
 }
 
@@ -1282,8 +1330,7 @@ struct Owner {
 #[inline(always)]
 fn pair_force<L: PairLaw>(
     law: &L,
-    p: &Particles,
-    omega: Option<&[Vec3]>,
+    p: &ParticleState,
     images: &[Vec3; 27],
     owner: &Owner,
     pair: Pair,
@@ -1307,7 +1354,7 @@ fn pair_force<L: PairLaw>(
     let mut relative_velocity = owner.velocity - p.velocity[j];
     let mut spins = (Vec3::ZERO, Vec3::ZERO);
     if L::NEEDS_ROTATION {
-        if let Some(omega) = omega {
+        if let Some(omega) = p.omega {
             spins = (owner.omega, omega[j]);
             // Contact point on the line of centres, inside each sphere by half the overlap.
             let arm_i = -normal * (radius_i - 0.5 * overlap);

@@ -3,7 +3,7 @@
 pub mod pcvv;
 mod velocity_verlet;
 
-pub use velocity_verlet::{drift_kick, kick};
+pub use velocity_verlet::{complete_and_kick, drift_kick};
 
 /// The scheme a world steps with, chosen once per scene (`[time] integrator`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -63,9 +63,16 @@ pub fn drift_kick(p: &mut Particles, dt: Real, check: Option<DisplacementCheck>)
     }
 }
 
-/// Half kick of velocities and spins. Returns whether every updated value is finite (the
-/// non-finite guard, at no extra pass).
-pub fn kick(p: &mut Particles, dt: Real) -> bool {
+/// Half kick of velocities and spins, completing each particle's force and torque first
+/// with `complete(i, force, torque)` (what the force pass left to add, such as the
+/// reactions of pairs owned by other particles): the pass that finishes the forces is the
+/// pass that kicks, so the particles are read once. Returns whether every updated value is
+/// finite (the non-finite guard, at no extra pass).
+pub fn complete_and_kick(
+    p: &mut Particles,
+    dt: Real,
+    complete: impl Fn(usize, &mut Vec3, &mut Vec3) + Sync,
+) -> bool {
     let half = 0.5 * dt;
     let Particles {
         velocity,
@@ -74,8 +81,11 @@ pub fn kick(p: &mut Particles, dt: Real) -> bool {
         angular,
         ..
     } = p;
-    let (force, inv_mass) = (&*force, &*inv_mass);
-    let chunks = velocity.par_chunks_mut(CHUNK).enumerate();
+    let inv_mass = &*inv_mass;
+    let chunks = velocity
+        .par_chunks_mut(CHUNK)
+        .zip(force.par_chunks_mut(CHUNK))
+        .enumerate();
     match angular {
         Some(AngularState {
             omega,
@@ -83,14 +93,33 @@ pub fn kick(p: &mut Particles, dt: Real) -> bool {
             inv_inertia,
         }) => chunks
             .zip(omega.par_chunks_mut(CHUNK))
-            .map(|((c, v), w)| {
+            .zip(torque.par_chunks_mut(CHUNK))
+            .map(|(((c, (v, f)), w), t)| {
                 let start = c * CHUNK;
-                kick_slice(v, &force[start..], &inv_mass[start..], half)
-                    & kick_slice(w, &torque[start..], &inv_inertia[start..], half)
+                let mut finite = true;
+                for k in 0..v.len() {
+                    let i = start + k;
+                    complete(i, &mut f[k], &mut t[k]);
+                    v[k] += half * inv_mass[i] * f[k];
+                    w[k] += half * inv_inertia[i] * t[k];
+                    finite &= v[k].is_finite() & w[k].is_finite();
+                }
+                finite
             })
             .reduce(|| true, |a, b| a && b),
         None => chunks
-            .map(|(c, v)| kick_slice(v, &force[c * CHUNK..], &inv_mass[c * CHUNK..], half))
+            .map(|(c, (v, f))| {
+                let start = c * CHUNK;
+                let mut finite = true;
+                for k in 0..v.len() {
+                    let i = start + k;
+                    let mut unused_torque = Vec3::ZERO;
+                    complete(i, &mut f[k], &mut unused_torque);
+                    v[k] += half * inv_mass[i] * f[k];
+                    finite &= v[k].is_finite();
+                }
+                finite
+            })
             .reduce(|| true, |a, b| a && b),
     }
 }
@@ -141,12 +170,17 @@ mod tests {
     }
 
     #[test]
-    fn kick_reports_a_non_finite_velocity_or_spin() {
+    fn kick_completes_the_forces_and_reports_a_non_finite_velocity_or_spin() {
         let n = CHUNK + 3;
+        let nothing = |_: usize, _: &mut Vec3, _: &mut Vec3| {};
         let mut p = particles(n, true);
-        assert!(kick(&mut p, 0.1));
+        assert!(complete_and_kick(&mut p, 0.1, nothing));
         assert!((p.velocity[n - 1].z - -0.1).abs() < 1e-15);
+        // The completion runs before the kick, for every particle.
+        let lift = |_: usize, f: &mut Vec3, _: &mut Vec3| f.z += 8.0;
+        assert!(complete_and_kick(&mut p, 0.1, lift));
+        assert!((p.velocity[n - 1].z - 0.0).abs() < 1e-15 && p.force[0].z == 4.0);
         p.angular.as_mut().unwrap().torque[n - 2] = Vec3::new(Real::NAN, 0.0, 0.0);
-        assert!(!kick(&mut p, 0.1));
+        assert!(!complete_and_kick(&mut p, 0.1, nothing));
     }
 }
