@@ -3,8 +3,13 @@
 use cgdem::contact::normal::WcaCoefficients;
 use cgdem::contact::SeedModel;
 use cgdem::domain::Domain;
+use cgdem::harness::lammps::{
+    self, run_reference, ReferenceCode, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
+};
+use cgdem::harness::liggghts;
 use cgdem::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem::particles::Particles;
+use cgdem::scene::Scene;
 use cgdem::simulation::{NeighborSettings, World};
 use cgdem::walls::{WallSet, WcaWall};
 
@@ -144,4 +149,45 @@ pub fn collide(world: &mut World<SeedModel, WcaWall>, contact_distance: Real) ->
         in_contact,
         world.particles.velocity[a] - world.particles.velocity[b],
     )
+}
+
+/// Runs `scene` in a reference code into a fresh `dir` under the tests' temporary directory;
+/// None (after saying so) when the code is not installed. The run must complete; returns it
+/// with its directory.
+pub fn completed_reference_run(
+    code: ReferenceCode,
+    scene: &Scene,
+    dir: &str,
+    timeout_s: u64,
+) -> Option<(ReferenceRun, std::path::PathBuf)> {
+    let found = match code {
+        ReferenceCode::Lammps => lammps::find_lmp(),
+        ReferenceCode::Liggghts => liggghts::find_liggghts(),
+    };
+    if let Err(reason) = found {
+        println!(
+            "skipped {}: {reason}; install with `{}`",
+            code.name(),
+            lammps::INSTALL_HINT
+        );
+        return None;
+    }
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    let options = ReferenceOptions {
+        code,
+        runner: RunnerOptions {
+            np: None,
+            timeout: std::time::Duration::from_secs(timeout_s),
+        },
+        ..ReferenceOptions::default()
+    };
+    let run = run_reference(scene, &dir, &options).expect("deck, run and post-processing");
+    assert!(
+        matches!(run.status, RunStatus::Completed { .. }),
+        "{}: {:?}",
+        code.name(),
+        run.status
+    );
+    Some((run, dir))
 }

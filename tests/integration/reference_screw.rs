@@ -3,23 +3,16 @@
 //! region except where they fall out of the outlet, the hopper is topped up, and the
 //! post-processing measures a mass flow.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use cgdem::geometry::screw_feeder::ScrewFeederSpec;
-use cgdem::harness::lammps::{
-    self, read_dump, run_reference, ReferenceCode, ReferenceOptions, RunStatus, RunnerOptions,
-};
+use cgdem::harness::lammps::{self, read_dump, ReferenceCode};
 use cgdem::scene::{Override, Scene};
+
+use crate::common::completed_reference_run;
 
 #[test]
 fn lammps_turns_a_particle_screw_and_conveys_grains_inside_its_casing() {
-    if let Err(reason) = lammps::find_lmp() {
-        println!(
-            "skipped LAMMPS: {reason}; install with `{}`",
-            lammps::INSTALL_HINT
-        );
-        return;
-    }
     let file = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("validation/cases/screw_feeder_hertz_particles.toml");
     // A short run: 0.05 s of settling, half a turn at 100 rpm with two top-ups.
@@ -32,22 +25,11 @@ fn lammps_turns_a_particle_screw_and_conveys_grains_inside_its_casing() {
     .map(|o| Override::parse(o, Path::new("test")).unwrap())
     .collect();
     let scene = Scene::load_with_overrides(&file, &overrides).expect("scene");
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("reference_screw");
-    let _ = std::fs::remove_dir_all(&dir);
-    let options = ReferenceOptions {
-        code: ReferenceCode::Lammps,
-        runner: RunnerOptions {
-            np: None,
-            timeout: std::time::Duration::from_secs(300),
-        },
-        ..ReferenceOptions::default()
+    let Some((run, dir)) =
+        completed_reference_run(ReferenceCode::Lammps, &scene, "reference_screw", 300)
+    else {
+        return;
     };
-    let run = run_reference(&scene, &dir, &options).expect("deck, run and post-processing");
-    assert!(
-        matches!(run.status, RunStatus::Completed { .. }),
-        "{:?}",
-        run.status
-    );
     let summary = run.summary.expect("summary");
     let conveying = summary.conveying.as_ref().expect("conveying summary");
     assert!(

@@ -4,11 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use cgdem::harness::lammps::{
-    self, read_dump, run_reference, ReferenceCode, ReferenceOptions, RunStatus, RunnerOptions,
-};
+use cgdem::harness::lammps::{self, read_dump, ReferenceCode, RunStatus, RunnerOptions};
 use cgdem::harness::liggghts;
 use cgdem::scene::Scene;
+
+use crate::common::completed_reference_run;
 
 fn scene() -> Scene {
     Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tiny_hertz_collapse.toml"))
@@ -16,38 +16,10 @@ fn scene() -> Scene {
 }
 
 fn check(code: ReferenceCode) {
-    let found = match code {
-        ReferenceCode::Lammps => lammps::find_lmp(),
-        ReferenceCode::Liggghts => liggghts::find_liggghts(),
-    };
-    if let Err(reason) = found {
-        println!(
-            "skipped {}: {reason}; install with `{}`",
-            code.name(),
-            lammps::INSTALL_HINT
-        );
+    let dir = format!("reference_stages/{}", code.name().to_lowercase());
+    let Some((run, dir)) = completed_reference_run(code, &scene(), &dir, 120) else {
         return;
-    }
-    let scene = scene();
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("reference_stages")
-        .join(code.name().to_lowercase());
-    let _ = std::fs::remove_dir_all(&dir);
-    let options = ReferenceOptions {
-        code,
-        runner: RunnerOptions {
-            np: None,
-            timeout: std::time::Duration::from_secs(120),
-        },
-        ..ReferenceOptions::default()
     };
-    let run = run_reference(&scene, &dir, &options).expect("deck, run and post-processing");
-    assert!(
-        matches!(run.status, RunStatus::Completed { .. }),
-        "{}: {:?}",
-        code.name(),
-        run.status
-    );
     let summary = run.summary.expect("summary");
     assert_eq!(summary.code, code.name().to_lowercase());
     assert_eq!(summary.n_particles, 40);

@@ -40,10 +40,7 @@ pub(crate) fn body_lines(
     integrated: &str,
     wall_model: &str,
 ) -> Result<BodyLines, DeckError> {
-    let unsupported = |reason: String| DeckError::Unsupported {
-        file: scene.source.display().to_string(),
-        reason,
-    };
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let mut out = BodyLines {
         setup: String::new(),
         refix_walls: String::new(),

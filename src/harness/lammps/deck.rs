@@ -23,7 +23,7 @@
 
 use std::fmt::Write as _;
 
-use crate::math::{Real, TWO_POW_ONE_SIXTH};
+use crate::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use crate::particles::Particles;
 use crate::scene::{ContactSettings, Scene, StageEnd};
 use crate::walls::restitution_damping_ratio;
@@ -37,6 +37,16 @@ pub const TRAJECTORY_FILE: &str = "traj.dump";
 pub enum DeckError {
     #[error("{file}: cannot write a reference-code deck for this scene: {reason}")]
     Unsupported { file: String, reason: String },
+}
+
+impl DeckError {
+    /// The scene asks for something the deck cannot express, and why.
+    pub fn unsupported(scene: &Scene, reason: String) -> Self {
+        DeckError::Unsupported {
+            file: scene.source.display().to_string(),
+            reason,
+        }
+    }
 }
 
 /// What the deck will do, for post-processing.
@@ -120,6 +130,24 @@ pub(crate) fn frozen_lines(scene: &Scene) -> (&'static str, String) {
 
 pub(crate) fn g(x: Real) -> String {
     format!("{x:.17e}")
+}
+
+/// Removes the wall fix `w_NAME` of a Hertz deck (LAMMPS and LIGGGHTS name them alike).
+pub(crate) fn unfix_wall(name: &str) -> String {
+    format!("unfix           w_{name}\n")
+}
+
+/// `region NAME block xlo xhi ylo yhi zlo zhi` for the box `lo..hi` (LAMMPS and LIGGGHTS).
+pub(crate) fn block_region(name: &str, lo: Vec3, hi: Vec3) -> String {
+    format!(
+        "region          {name} block {} {} {} {} {} {}\n",
+        g(lo.x),
+        g(hi.x),
+        g(lo.y),
+        g(hi.y),
+        g(lo.z),
+        g(hi.z)
+    )
 }
 
 /// A `read_data` file for `atom_style sphere` (LAMMPS) or `granular` (LIGGGHTS, same columns):
@@ -393,10 +421,7 @@ pub(crate) fn removal_pads(scene: &Scene, fixes_per_wall: usize) -> String {
 /// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`:
 /// the seed's WCA model here, a Hertz scene by `hertz::write_hertz_deck`.
 pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
-    let unsupported = |reason: String| DeckError::Unsupported {
-        file: scene.source.display().to_string(),
-        reason,
-    };
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let ContactSettings::Wca {
         epsilon,
         sigma,

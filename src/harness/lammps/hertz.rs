@@ -18,8 +18,9 @@
 use std::fmt::Write as _;
 
 use super::deck::{
-    boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines, Deck, DeckError,
-    DeckPlan, Periodic, StageDumps, StageHooks, DATA_FILE, TRAJECTORY_FILE,
+    block_region, boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines,
+    unfix_wall, Deck, DeckError, DeckPlan, Periodic, StageDumps, StageHooks, DATA_FILE,
+    TRAJECTORY_FILE,
 };
 use crate::contact::damping::restitution_beta;
 use crate::contact::normal::{Hertz, Material};
@@ -72,10 +73,7 @@ pub(crate) fn hertz_settings<'a>(
     code: &str,
     bodies: bool,
 ) -> Result<&'a HertzSettings, DeckError> {
-    let unsupported = |reason: String| DeckError::Unsupported {
-        file: scene.source.display().to_string(),
-        reason,
-    };
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let ContactSettings::Hertz(h) = &scene.contact else {
         return Err(unsupported(format!(
             "the {code} Hertz deck needs model = \"hertz\""
@@ -144,10 +142,7 @@ pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: 
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let h = hertz_settings(scene, "LAMMPS", true)?;
-    let unsupported = |reason: String| DeckError::Unsupported {
-        file: scene.source.display().to_string(),
-        reason,
-    };
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let q_of = |e: Real| {
         tsuji_q(e).ok_or_else(|| {
             unsupported(if e < 0.5 {
@@ -301,16 +296,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     d += &super::deck::removal_pads(scene, 1);
     for (k, (lo, hi)) in scene.deletions.iter().enumerate() {
         // Grains whose centres enter the box are removed, checked every output interval.
-        let _ = writeln!(
-            d,
-            "region          delete_{k} block {} {} {} {} {} {}",
-            g(lo.x),
-            g(hi.x),
-            g(lo.y),
-            g(hi.y),
-            g(lo.z),
-            g(hi.z)
-        );
+        d += &block_region(&format!("delete_{k}"), *lo, *hi);
         let _ = writeln!(
             d,
             "fix             delete_{k} {integrated} evaporate {dump_every} 1000000 delete_{k} {}",
@@ -351,7 +337,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         dump_every,
         &dumps,
         &StageHooks {
-            unfix: &|name| format!("unfix           w_{name}\n"),
+            unfix: &unfix_wall,
             begin: &begin,
             periodic: &periodic,
         },
@@ -417,16 +403,7 @@ fn top_up_lines(
     for (k, ins) in scene.insertions.iter().enumerate() {
         let Some(refill) = &ins.refill else { continue };
         let species = &scene.species[ins.species];
-        let _ = writeln!(
-            out.setup,
-            "region          top_{k} block {} {} {} {} {} {}",
-            g(ins.lo.x),
-            g(ins.hi.x),
-            g(ins.lo.y),
-            g(ins.hi.y),
-            g(ins.lo.z),
-            g(ins.hi.z)
-        );
+        out.setup += &block_region(&format!("top_{k}"), ins.lo, ins.hi);
         let file = format!("top_{k}.mol");
         let _ = writeln!(out.setup, "molecule        top_{k} {file}");
         let template = format!(

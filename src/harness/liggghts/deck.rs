@@ -15,8 +15,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::harness::lammps::deck::{
-    boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines, Deck, DeckError,
-    DeckPlan, StageDumps, StageHooks, DATA_FILE,
+    block_region, boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines,
+    unfix_wall, Deck, DeckError, DeckPlan, StageDumps, StageHooks, DATA_FILE,
 };
 use crate::harness::lammps::hertz::{
     hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS,
@@ -183,7 +183,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         dump_every,
         &dumps,
         &StageHooks {
-            unfix: &|name| format!("unfix           w_{name}\n"),
+            unfix: &unfix_wall,
             begin: &begin,
             periodic: &|_| None,
         },
@@ -215,10 +215,7 @@ struct MeshLines {
 }
 
 fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLines, DeckError> {
-    let unsupported = |reason: String| DeckError::Unsupported {
-        file: scene.source.display().to_string(),
-        reason,
-    };
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let mut out = MeshLines {
         setup: String::new(),
         pieces: Vec::new(),
@@ -365,16 +362,7 @@ fn stage_start_lines(scene: &Scene, pieces: &[Vec<String>], stage: &str, dt: Rea
         };
         let species = &scene.species[ins.species];
         let every = ((refill.interval / dt).round() as u64).max(1);
-        let _ = writeln!(
-            d,
-            "region          top_{k} block {} {} {} {} {} {}",
-            g(ins.lo.x),
-            g(ins.hi.x),
-            g(ins.lo.y),
-            g(ins.hi.y),
-            g(ins.lo.z),
-            g(ins.hi.z)
-        );
+        d += &block_region(&format!("top_{k}"), ins.lo, ins.hi);
         let _ = writeln!(
             d,
             "fix             pts_{k} all particletemplate/sphere {} atom_type {} density constant {} radius constant {}",
