@@ -60,7 +60,8 @@ pub struct World<L: PairLaw, W: WallLaw> {
     pub lost: u64,
     /// Moving or fixed bodies; empty for scenes without bodies, which then pay nothing.
     bodies: Vec<Body>,
-    /// Per particle, per body (particle-major) load, reduced in fixed order after the gather.
+    /// Per particle, per body (particle-major) load, reduced in fixed order after the owner
+    /// pass.
     body_loads: Vec<BodyLoad>,
     /// Frozen particles that move with a body (a body built of particles).
     kinematic: Vec<KinematicParticles>,
@@ -77,7 +78,7 @@ pub struct World<L: PairLaw, W: WallLaw> {
     wall_history: Vec<W::History>,
     /// Per listed pair, the force on its `j` (empty when particles spin).
     reaction_force: Vec<Vec3>,
-    /// Per listed pair, the force and torque on its `j`, side by side so the gather reads
+    /// Per listed pair, the force and torque on its `j`, side by side so the closing kick reads
     /// one place (empty without spin).
     reaction_spin: Vec<[Vec3; 2]>,
     integrator: Integrator,
