@@ -186,59 +186,66 @@ impl VerletList {
             return vec![H::default(); self.pairs.len()];
         }
         let wraps = wraps.filter(|w| w.iter().any(|&k| k != [0; 3]));
-        let mut old: Vec<(Pair, H)> = if remap.is_none() && wraps.is_none() {
-            old_pairs
-                .iter()
-                .copied()
-                .zip(old_history.iter().copied())
-                .collect()
-        } else {
-            let mut remapped: Vec<(Pair, H)> = old_pairs
-                .iter()
-                .zip(old_history)
-                .filter_map(|(pair, &h)| {
-                    let mut image = pair.image;
-                    if let Some(w) = wraps {
-                        // d = x_i - (x_j + o L); after wrapping x -> x - W L:
-                        // o' = o + W_j - W_i.
-                        let o = Domain::image_offset(image);
-                        let (wi, wj) = (w[pair.i as usize], w[pair.j as usize]);
-                        let moved: [i32; 3] = std::array::from_fn(|a| o[a] + wj[a] - wi[a]);
-                        if moved.iter().any(|x| x.abs() > 1) {
-                            return None;
-                        }
-                        image = Domain::image_index(moved);
-                    }
-                    let (i, j) = match remap {
-                        Some(new_index) => (new_index[pair.i as usize], new_index[pair.j as usize]),
-                        None => (pair.i, pair.j),
-                    };
-                    if i == u32::MAX || j == u32::MAX {
-                        None
-                    } else if i < j {
-                        Some((Pair { i, j, image }, h))
-                    } else {
-                        let image = 26 - image; // the opposite image
-                        Some((Pair { i: j, j: i, image }, h.mirrored()))
-                    }
-                })
-                .collect();
-            remapped.sort_unstable_by_key(|(pair, _)| *pair);
-            remapped
-        };
-        old.dedup_by_key(|(pair, _)| *pair);
-        let mut history = Vec::with_capacity(self.pairs.len());
-        let mut cursor = 0;
-        for pair in &self.pairs {
-            while cursor < old.len() && old[cursor].0 < *pair {
-                cursor += 1;
-            }
-            history.push(if cursor < old.len() && old[cursor].0 == *pair {
-                old[cursor].1
-            } else {
-                H::default()
-            });
+        if remap.is_none() && wraps.is_none() {
+            // The old list as it is: sorted by pair, each pair once.
+            return self.merge_history(old_pairs, old_history);
         }
+        let mut remapped: Vec<(Pair, H)> = old_pairs
+            .iter()
+            .zip(old_history)
+            .filter_map(|(pair, &h)| {
+                let mut image = pair.image;
+                if let Some(w) = wraps {
+                    // d = x_i - (x_j + o L); after wrapping x -> x - W L:
+                    // o' = o + W_j - W_i.
+                    let o = Domain::image_offset(image);
+                    let (wi, wj) = (w[pair.i as usize], w[pair.j as usize]);
+                    let moved: [i32; 3] = std::array::from_fn(|a| o[a] + wj[a] - wi[a]);
+                    if moved.iter().any(|x| x.abs() > 1) {
+                        return None;
+                    }
+                    image = Domain::image_index(moved);
+                }
+                let (i, j) = match remap {
+                    Some(new_index) => (new_index[pair.i as usize], new_index[pair.j as usize]),
+                    None => (pair.i, pair.j),
+                };
+                if i == u32::MAX || j == u32::MAX {
+                    None
+                } else if i < j {
+                    Some((Pair { i, j, image }, h))
+                } else {
+                    let image = 26 - image; // the opposite image
+                    Some((Pair { i: j, j: i, image }, h.mirrored()))
+                }
+            })
+            .collect();
+        remapped.sort_unstable_by_key(|(pair, _)| *pair);
+        remapped.dedup_by_key(|(pair, _)| *pair);
+        let (pairs, history): (Vec<Pair>, Vec<H>) = remapped.into_iter().unzip();
+        self.merge_history(&pairs, &history)
+    }
+
+    /// The history of each listed pair from `old_pairs` (sorted, each pair once) and their
+    /// `old_history`; the default for pairs not in it. Merged in parallel blocks, each
+    /// finding its start in the old list by bisection.
+    fn merge_history<H: PairHistory>(&self, old_pairs: &[Pair], old_history: &[H]) -> Vec<H> {
+        const BLOCK: usize = 4096;
+        let mut history = vec![H::default(); self.pairs.len()];
+        history
+            .par_chunks_mut(BLOCK)
+            .zip(self.pairs.par_chunks(BLOCK))
+            .for_each(|(history, pairs)| {
+                let mut cursor = old_pairs.partition_point(|old| *old < pairs[0]);
+                for (pair, entry) in pairs.iter().zip(history) {
+                    while cursor < old_pairs.len() && old_pairs[cursor] < *pair {
+                        cursor += 1;
+                    }
+                    if cursor < old_pairs.len() && old_pairs[cursor] == *pair {
+                        *entry = old_history[cursor];
+                    }
+                }
+            });
         history
     }
 }
