@@ -570,11 +570,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     fn owner_pass(&mut self) {
         let n = self.particles.len();
         let pairs = self.list.pairs.len();
+        let wall_slots = self.wall_slots();
         if Self::ROTATES {
             self.reaction_spin.resize(pairs, [Vec3::ZERO; 2]);
-            let slots = self.wall_slots();
-            if self.wall_history.len() != n * slots {
-                self.wall_history.resize(n * slots, W::History::default());
+            if self.wall_history.len() != n * wall_slots {
+                self.wall_history
+                    .resize(n * wall_slots, W::History::default());
             }
         } else {
             self.reaction_force.resize(pairs, Vec3::ZERO);
@@ -617,7 +618,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             bodies: &self.bodies,
             gravity: self.gravity,
             rotates: Self::ROTATES,
-            wall_slots: (self.walls.walls.len() + n_bodies).max(1),
+            wall_slots,
         };
         // The largest overlap fractions, for the overlap guard (max is exact in any order).
         let deepest = pass.run(

@@ -1,6 +1,7 @@
 //! Velocity Verlet, split around the force evaluation:
 //! `v += dt/2 F/m; x += dt v` (drift_kick), forces at the new positions and half-step
-//! velocities, then `v += dt/2 F/m` (kick); spins the same with torque and inverse inertia.
+//! velocities, then `v += dt/2 F/m` (complete_and_kick, which first adds what the force
+//! pass left to add); spins the same with torque and inverse inertia.
 //! Every particle is updated independently, so the result does not depend on how rayon
 //! splits the work.
 //!
