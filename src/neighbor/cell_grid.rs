@@ -3,6 +3,12 @@
 use crate::domain::Domain;
 use crate::math::{Real, Vec3};
 
+/// Cells allowed per particle before cells widen (a dense packing has about one particle in
+/// every two cells one diameter wide).
+const MAX_CELLS_PER_PARTICLE: usize = 16;
+/// Cells always allowed, however few the particles.
+const MIN_CELL_CAP: usize = 1 << 15;
+
 /// Particles binned into a regular grid of cells covering the domain.
 ///
 /// Cells are at least `cell_size` wide, so every partner within the cut-off lies in the 27
@@ -39,9 +45,19 @@ impl CellGrid {
             }
         }
         let mut counts = [1usize; 3];
-        let mut inv_width = Vec3::ZERO;
         for axis in 0..3 {
             counts[axis] = ((length[axis] / cell_size).floor() as usize).clamp(1, 1 << 10);
+        }
+        // One particle far from the rest (a runaway kept for the guard to report) would
+        // stretch a bounded axis over 1024 cells and the grid over a billion; past a few
+        // cells per particle, wider cells (still at least `cell_size`) lose nothing.
+        let most_cells = MAX_CELLS_PER_PARTICLE * positions.len() + MIN_CELL_CAP;
+        while counts.iter().product::<usize>() > most_cells {
+            let widest = (0..3).max_by_key(|&a| counts[a]).unwrap_or(0);
+            counts[widest] = counts[widest].div_ceil(2);
+        }
+        let mut inv_width = Vec3::ZERO;
+        for axis in 0..3 {
             inv_width[axis] = counts[axis] as Real / length[axis];
         }
         let mut grid = CellGrid {
@@ -91,5 +107,35 @@ impl CellGrid {
     pub fn particles_in(&self, cell: u32) -> &[u32] {
         let c = cell as usize;
         &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_runaway_particle_does_not_blow_up_the_grid() {
+        let domain = Domain {
+            lo: Vec3::ZERO,
+            hi: Vec3::splat(1e4),
+            periodic: [false; 3],
+        };
+        // A small cluster at the origin and one particle 9 km away on every axis.
+        let mut positions: Vec<Vec3> = (0..1000)
+            .map(|k| Vec3::new((k % 10) as Real, ((k / 10) % 10) as Real, (k / 100) as Real) * 1e-3)
+            .collect();
+        positions.push(Vec3::splat(9e3));
+        let grid = CellGrid::build(&domain, &positions, 1e-3);
+        let cells: usize = grid.counts.iter().product();
+        assert!(
+            cells <= MAX_CELLS_PER_PARTICLE * positions.len() + MIN_CELL_CAP,
+            "{cells} cells"
+        );
+        // Still cells at least one cut-off wide, each particle binned once.
+        for axis in 0..3 {
+            assert!(grid.counts[axis] as Real / grid.inv_width[axis] >= 1e-3);
+        }
+        assert_eq!(grid.items.len(), positions.len());
     }
 }

@@ -484,6 +484,17 @@ mod tests {
     }
 
     #[test]
+    fn a_runaway_particle_leaves_the_pairs_unchanged() {
+        // It stretches the grid over the bounded axes until the cap on cells widens them.
+        let domain = unit_box([false; 3], Vec3::splat(1.0));
+        let mut particles = random_particles(400, &domain, (0.02, 0.03), 7);
+        particles.position[5] = Vec3::new(5e3, -2e3, 7e3);
+        let mut list = VerletList::new(0.01);
+        list.build(&mut particles, &domain, 0.0, true);
+        assert_eq!(list.pairs, brute_force_pairs(&particles, &domain, 0.01));
+    }
+
+    #[test]
     fn rebuild_is_needed_only_after_half_the_skin() {
         let domain = unit_box([false; 3], Vec3::splat(1.0));
         let mut particles = random_particles(50, &domain, (0.02, 0.02), 1);
