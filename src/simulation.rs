@@ -403,13 +403,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         self.pose_bodies_at(self.time + dt);
         self.owner_pass();
+        let (reactions, p) = self.reactions_and_particles();
+        let finite = complete_and_kick(p, dt, |i, f, t| reactions.add_to(i, f, t));
+        self.guard.finite = finite;
+    }
+
+    /// The reactions the owner pass stored, beside the particles they complete.
+    fn reactions_and_particles(&mut self) -> (Reactions<'_>, &mut Particles) {
         let reactions = Reactions {
             list: &self.list,
             force: &self.reaction_force,
             spin: &self.reaction_spin,
         };
-        self.guard.finite =
-            complete_and_kick(&mut self.particles, dt, |i, f, t| reactions.add_to(i, f, t));
+        (reactions, &mut self.particles)
     }
 
     /// Removes particles that left the box, re-sorts now and then, rebuilds the pair list
@@ -534,12 +540,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Every particle's force and torque: the owner pass, then the reactions.
     pub fn compute_forces(&mut self) {
         self.owner_pass();
-        let reactions = Reactions {
-            list: &self.list,
-            force: &self.reaction_force,
-            spin: &self.reaction_spin,
-        };
-        let p = &mut self.particles;
+        let (reactions, p) = self.reactions_and_particles();
         match p.angular.as_mut() {
             Some(a) => p
                 .force
@@ -1174,7 +1175,7 @@ impl Deepest {
 impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
     /// Evaluates the pairs owned by particles `first..first + out.force.len()` and what acts
     /// on those particles alone, halving the range in parallel down to leaves.
-    fn run(&self, first: usize, out: OwnerSlices<'_, L::History, W::History>) -> Deepest {
+    fn run(&self, first: usize, mut out: OwnerSlices<'_, L::History, W::History>) -> Deepest {
         let n = out.force.len();
         if n > OWNER_LEAF {
             let mid = n / 2;
@@ -1189,6 +1190,7 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
         for local in 0..n {
             let i = first + local;
             let owner = Owner {
+                index: i,
                 position: s.position[i],
                 velocity: s.velocity[i],
                 omega: s.omega.map_or(Vec3::ZERO, |w| w[i]),
@@ -1221,67 +1223,83 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
                     out.reaction_force[slot] = -result.force_on_i;
                 }
             }
-            // What acts on `i` alone, after its pairs.
-            force += s.mass[i] * self.gravity;
-            let particle = WallParticle {
-                species: s.species[i] as usize,
-                position: owner.position,
-                velocity: owner.velocity,
-                radius: owner.radius,
-                mass: s.mass[i],
-            };
-            let n_bodies = self.bodies.len();
-            let loads = &mut out.body_loads[local * n_bodies..(local + 1) * n_bodies];
-            let mut overlap;
-            if self.rotates {
-                let slots = &mut out.wall_history[local * self.wall_slots..][..self.wall_slots];
-                let (wall_history, body_history) = slots.split_at_mut(self.walls.walls.len());
-                if W::NEEDS_ROTATION {
-                    let (f, t, o) = self.walls.force_and_torque_on(
-                        self.wall_law,
-                        &particle,
-                        owner.omega,
-                        wall_history,
-                        self.dt,
-                    );
-                    force += f;
-                    torque += t;
-                    overlap = o;
-                } else {
-                    let (f, o) = self.walls.force_on(self.wall_law, &particle, self.dt);
-                    force += f;
-                    overlap = o;
-                }
-                for ((body, load), history) in self.bodies.iter().zip(loads).zip(body_history) {
-                    let (f, t, l, o) = body_force_and_torque(
-                        body,
-                        self.wall_law,
-                        &particle,
-                        owner.omega,
-                        history,
-                        self.dt,
-                    );
-                    force += f;
-                    torque += t;
-                    *load = l;
-                    overlap = larger(overlap, o);
-                }
-                out.torque[local] = torque;
+            let overlap = self.act_alone(local, &owner, force, torque, &mut out);
+            deepest.walls = larger(deepest.walls, overlap);
+        }
+        deepest
+    }
+
+    /// Adds what acts on owner `i` alone (gravity, planar walls, bodies) to the sum of its
+    /// pairs and stores its force (and torque); returns its deepest wall or body overlap.
+    #[inline(always)]
+    fn act_alone(
+        &self,
+        local: usize,
+        owner: &Owner,
+        mut force: Vec3,
+        mut torque: Vec3,
+        out: &mut OwnerSlices<'_, L::History, W::History>,
+    ) -> Real {
+        let s = self.state;
+        let i = owner.index;
+        force += s.mass[i] * self.gravity;
+        let particle = WallParticle {
+            species: s.species[i] as usize,
+            position: owner.position,
+            velocity: owner.velocity,
+            radius: owner.radius,
+            mass: s.mass[i],
+        };
+        let n_bodies = self.bodies.len();
+        let loads = &mut out.body_loads[local * n_bodies..(local + 1) * n_bodies];
+        let mut overlap;
+        if self.rotates {
+            let slots = &mut out.wall_history[local * self.wall_slots..][..self.wall_slots];
+            let (wall_history, body_history) = slots.split_at_mut(self.walls.walls.len());
+            if W::NEEDS_ROTATION {
+                let (f, t, o) = self.walls.force_and_torque_on(
+                    self.wall_law,
+                    &particle,
+                    owner.omega,
+                    wall_history,
+                    self.dt,
+                );
+                force += f;
+                torque += t;
+                overlap = o;
             } else {
                 let (f, o) = self.walls.force_on(self.wall_law, &particle, self.dt);
                 force += f;
                 overlap = o;
-                for (body, load) in self.bodies.iter().zip(loads) {
-                    let (f, l, o) = body_force(body, self.wall_law, &particle, self.dt);
-                    force += f;
-                    *load = l;
-                    overlap = larger(overlap, o);
-                }
             }
-            out.force[local] = force;
-            deepest.walls = larger(deepest.walls, overlap);
+            for ((body, load), history) in self.bodies.iter().zip(loads).zip(body_history) {
+                let (f, t, l, o) = body_force_and_torque(
+                    body,
+                    self.wall_law,
+                    &particle,
+                    owner.omega,
+                    history,
+                    self.dt,
+                );
+                force += f;
+                torque += t;
+                *load = l;
+                overlap = larger(overlap, o);
+            }
+            out.torque[local] = torque;
+        } else {
+            let (f, o) = self.walls.force_on(self.wall_law, &particle, self.dt);
+            force += f;
+            overlap = o;
+            for (body, load) in self.bodies.iter().zip(loads) {
+                let (f, l, o) = body_force(body, self.wall_law, &particle, self.dt);
+                force += f;
+                *load = l;
+                overlap = larger(overlap, o);
+            }
         }
-        deepest
+        out.force[local] = force;
+        overlap
     }
 }
 
@@ -1317,6 +1335,7 @@ impl Reactions<'_> {
 /// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
 #[derive(Clone, Copy)]
 struct Owner {
+    index: usize,
     position: Vec3,
     velocity: Vec3,
     omega: Vec3,
