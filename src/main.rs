@@ -1,18 +1,36 @@
 //! The `cgdem` command: a thin layer that turns arguments into validated settings, calls the
 //! library and reports errors as messages with a non-zero exit code.
 
+mod progress_bar;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use cgdem::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
-use cgdem::geometry::accuracy::format_accuracy_table;
-use cgdem::geometry::screw_feeder::{self, ScrewFeederSpec};
-use cgdem::report::sdf_study::write_sdf_accuracy_study;
-use cgdem::run::{run, RunOptions};
-use cgdem::scene::{Override, Scene};
-use cgdem::sweep::Sweep;
+use cgdem_core::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
+use cgdem_core::geometry::accuracy::format_accuracy_table;
+use cgdem_core::geometry::screw_feeder::{self, ScrewFeederSpec};
+use cgdem_core::run::{run, RunOptions};
+use cgdem_core::scene::{Override, Scene};
+use cgdem_harness::report::sdf_study::write_sdf_accuracy_study;
+use cgdem_harness::sweep::Sweep;
+
+/// The coarse-graining rules as command-line values (`seed`, `bulk-viscosity`).
+#[derive(Clone, Copy, ValueEnum)]
+enum CgRule {
+    Seed,
+    BulkViscosity,
+}
+
+impl From<CgRule> for CoarseGrainRule {
+    fn from(rule: CgRule) -> Self {
+        match rule {
+            CgRule::Seed => CoarseGrainRule::Seed,
+            CgRule::BulkViscosity => CoarseGrainRule::BulkViscosity,
+        }
+    }
+}
 
 #[derive(Parser)]
 #[command(
@@ -38,8 +56,8 @@ enum Command {
         /// Coarse-graining rule: `seed` (paper A: eps' = lambda^3 eps, gamma' = lambda^2 gamma)
         /// or `bulk-viscosity` (eps' = lambda eps, gamma' = lambda gamma: keeps gamma/d, so
         /// viscous flows keep their speed; see reference/COARSE_GRAINING.md).
-        #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
-        cg_rule: CoarseGrainRule,
+        #[arg(long, value_enum, default_value_t = CgRule::Seed)]
+        cg_rule: CgRule,
         /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
         #[arg(long)]
         seed: Option<u64>,
@@ -197,8 +215,8 @@ struct ReferenceArgs {
     #[arg(long, default_value_t = 1)]
     lambda: u32,
     /// Coarse-graining rule, as for `cgdem run`.
-    #[arg(long, value_enum, default_value_t = CoarseGrainRule::Seed)]
-    cg_rule: CoarseGrainRule,
+    #[arg(long, value_enum, default_value_t = CgRule::Seed)]
+    cg_rule: CgRule,
     /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
     #[arg(long)]
     seed: Option<u64>,
@@ -230,7 +248,7 @@ struct ReferenceArgs {
 }
 
 fn reference_run(code: ReferenceCode) -> Result<ExitCode, String> {
-    use cgdem::harness::lammps::{self, ReferenceOptions, RunStatus, RunnerOptions};
+    use cgdem_harness::lammps::{self, ReferenceOptions, RunStatus, RunnerOptions};
     let (code, args) = match code {
         ReferenceCode::Lammps(args) => (lammps::ReferenceCode::Lammps, args),
         ReferenceCode::Liggghts(args) => (lammps::ReferenceCode::Liggghts, args),
@@ -250,7 +268,7 @@ fn reference_run(code: ReferenceCode) -> Result<ExitCode, String> {
         variant,
     } = args;
     let scene = load_scene(&case, &set, variant.as_deref(), seed)?;
-    let scene = coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())?;
+    let scene = coarse_grain_by(&scene, lambda, cg_rule.into()).map_err(|e| e.to_string())?;
     let out = out.unwrap_or_else(|| {
         PathBuf::from("runs").join(format!(
             "{}-lambda{}-{}",
@@ -439,16 +457,17 @@ fn main() -> ExitCode {
                 Ok(pool) => pool,
                 Err(code) => return code,
             };
-            let options = cgdem::harness::validate::ValidateOptions {
+            let options = cgdem_harness::validate::ValidateOptions {
                 suite: suite_path,
                 out: out.clone(),
                 quiet,
+                progress: progress_bar::progress(quiet),
                 reference_timeout_s: reference_timeout,
                 reuse,
                 keep_going,
                 jobs: usize::from(jobs),
             };
-            match pool.install(|| cgdem::harness::validate::validate(&options)) {
+            match pool.install(|| cgdem_harness::validate::validate(&options)) {
                 Ok(summary) => {
                     let failed = summary.comparisons.iter().filter(|c| !c.pass).count();
                     let runs_failed = summary.runs.iter().filter(|r| r.status == "failed").count();
@@ -457,7 +476,7 @@ fn main() -> ExitCode {
                         extra += &format!(", {} accuracy points", accuracy.points.len());
                     }
                     if !summary.stability.is_empty() {
-                        use cgdem::harness::{stability::Verdict, suite::Code};
+                        use cgdem_harness::{stability::Verdict, suite::Code};
                         let failed = |cgdem: bool| {
                             summary
                                 .stability
@@ -514,9 +533,9 @@ fn main() -> ExitCode {
             let mut parsed = Vec::new();
             for name in &codes {
                 parsed.push(match name.as_str() {
-                    "cgdem" => cgdem::harness::suite::Code::Cgdem,
-                    "liggghts" => cgdem::harness::suite::Code::Liggghts,
-                    "lammps" => cgdem::harness::suite::Code::Lammps,
+                    "cgdem" => cgdem_harness::suite::Code::Cgdem,
+                    "liggghts" => cgdem_harness::suite::Code::Liggghts,
+                    "lammps" => cgdem_harness::suite::Code::Lammps,
                     other => {
                         eprintln!("error: --codes: `{other}` is not a code; allowed: cgdem, liggghts, lammps");
                         return ExitCode::FAILURE;
@@ -528,7 +547,7 @@ fn main() -> ExitCode {
                 eprintln!("error: --threads, --pairs and --steps must be at least 1 and --prepare at least 0");
                 return ExitCode::FAILURE;
             }
-            let options = cgdem::harness::bench::BenchOptions {
+            let options = cgdem_harness::bench::BenchOptions {
                 cases,
                 out: out.clone(),
                 codes: parsed,
@@ -539,9 +558,9 @@ fn main() -> ExitCode {
                 outcome: !no_outcome,
                 timeout: std::time::Duration::from_secs(reference_timeout),
             };
-            match cgdem::harness::bench::bench(&options) {
+            match cgdem_harness::bench::bench(&options) {
                 Ok(report) => {
-                    print!("{}", cgdem::harness::bench::format_report(&report));
+                    print!("{}", cgdem_harness::bench::format_report(&report));
                     println!("report in {}", out.join("bench.json").display());
                     ExitCode::SUCCESS
                 }
@@ -556,7 +575,7 @@ fn main() -> ExitCode {
             add,
             date,
             commit,
-        } => match cgdem::harness::history::add_night(&dir, &add, &date, &commit) {
+        } => match cgdem_harness::history::add_night(&dir, &add, &date, &commit) {
             Ok(flags) => {
                 for f in &flags {
                     println!(
@@ -621,12 +640,12 @@ fn main() -> ExitCode {
                         for w in &warnings {
                             eprintln!("warning: coarse-graining: {w}");
                         }
-                        coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())
+                        coarse_grain_by(&scene, lambda, cg_rule.into()).map_err(|e| e.to_string())
                     })
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
                         if let Some(Sweep::Diameter(diameters)) = &sweep {
-                            let results = cgdem::sweep::diameter_sweep(&scene, diameters, &out_dir, quiet, force_dt, keep_going)?;
+                            let results = cgdem_harness::sweep::diameter_sweep(&scene, diameters, &out_dir, progress_bar::progress(quiet), force_dt, keep_going)?;
                             for (d, s) in &results {
                                 let porosity = s.packing.as_ref().map_or("not measured".into(), |p| format!("{:.4}", p.porosity));
                                 println!("d = {:.3e} m: {} particles, {} steps of {:.3e} s, porosity {porosity}, wall {:.1} s", d, s.n_particles, s.steps, s.dt_s, s.wall_s);
@@ -636,7 +655,7 @@ fn main() -> ExitCode {
                             return Ok((last, out_dir));
                         }
                         if let Some(Sweep::ScrewRatio(ratios)) = &sweep {
-                            let results = cgdem::sweep::screw_ratio_sweep(&scene, ratios, &out_dir, quiet, force_dt, keep_going, reuse)?;
+                            let results = cgdem_harness::sweep::screw_ratio_sweep(&scene, ratios, &out_dir, progress_bar::progress(quiet), force_dt, keep_going, reuse)?;
                             for (r, s) in &results {
                                 if let Some(c) = &s.conveying {
                                     println!("r_s/r_p = {r}: {} screw particles, {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (ratio {:.3}), wall {:.1} s", s.n_body_particles, c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.ratio_to_eq7, s.wall_s);
@@ -646,7 +665,7 @@ fn main() -> ExitCode {
                             return Ok((last, out_dir));
                         }
                         if let Some(Sweep::Rpm(speeds)) = &sweep {
-                            let results = cgdem::sweep::rpm_sweep(&scene, speeds, &out_dir, quiet, force_dt, keep_going, reuse)?;
+                            let results = cgdem_harness::sweep::rpm_sweep(&scene, speeds, &out_dir, progress_bar::progress(quiet), force_dt, keep_going, reuse)?;
                             for (rpm, s) in &results {
                                 if let Some(c) = &s.conveying {
                                     println!("{rpm} rpm: {:.4} +- {:.4} kg/s, Eq. (7) {:.4} kg/s (a = {:.3}), wall {:.1} s", c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.eq7_mass_flow_kg_s, c.fill_ratio, s.wall_s);
@@ -657,7 +676,7 @@ fn main() -> ExitCode {
                         }
                         let options = RunOptions {
                             out_dir: out_dir.clone(),
-                            quiet,
+                            progress: progress_bar::progress(quiet),
                             force_dt,
                             keep_going,
                             ..Default::default()
@@ -708,9 +727,7 @@ fn main() -> ExitCode {
 fn default_out_dir(scene: &Scene) -> PathBuf {
     let mut name = format!("{}-lambda{}", scene.name, scene.lambda);
     if scene.cg_rule != CoarseGrainRule::Seed {
-        if let Some(rule) = scene.cg_rule.to_possible_value() {
-            name += &format!("-{}", rule.get_name());
-        }
+        name += &format!("-{}", scene.cg_rule.name());
     }
     PathBuf::from("runs").join(name)
 }

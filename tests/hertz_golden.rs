@@ -17,18 +17,18 @@
 
 use std::path::{Path, PathBuf};
 
-use cgdem::contact::cohesion::NoCohesion;
-use cgdem::contact::damping::HertzDamping;
-use cgdem::contact::rolling::Epsd2;
-use cgdem::contact::tangential::Mindlin;
-use cgdem::harness::lammps::deck::Deck;
-use cgdem::harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem::harness::liggghts;
-use cgdem::math::{Real, Vec3};
-use cgdem::particles::Particles;
-use cgdem::run::{hertz_history_wall, hertz_law};
-use cgdem::scene::{ContactSettings, Scene};
-use cgdem::simulation::{NeighborSettings, World};
+use cgdem_core::contact::cohesion::NoCohesion;
+use cgdem_core::contact::damping::HertzDamping;
+use cgdem_core::contact::rolling::Epsd2;
+use cgdem_core::contact::tangential::Mindlin;
+use cgdem_core::math::{Real, Vec3};
+use cgdem_core::particles::Particles;
+use cgdem_core::run::{hertz_history_wall, hertz_law};
+use cgdem_core::scene::{ContactSettings, Scene};
+use cgdem_core::simulation::{NeighborSettings, World};
+use cgdem_harness::lammps::deck::Deck;
+use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
+use cgdem_harness::liggghts;
 
 const TOLERANCE: Real = 0.01;
 const DT: Real = 1e-7;
@@ -109,7 +109,7 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
     let mut world = World::new(
         initial.clone(),
         scene.domain.clone(),
-        cgdem::run::scene_walls(scene),
+        cgdem_core::run::scene_walls(scene),
         law,
         hertz_history_wall(scene, h),
         1,

@@ -10,12 +10,12 @@
 
 use std::path::{Path, PathBuf};
 
-use cgdem::harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
-use cgdem::particles::Particles;
-use cgdem::run;
-use cgdem::scene::{Scene, StageEnd};
-use cgdem::simulation::{NeighborSettings, World};
+use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
+use cgdem_core::particles::Particles;
+use cgdem_core::run;
+use cgdem_core::scene::{Scene, StageEnd};
+use cgdem_core::simulation::{NeighborSettings, World};
+use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
 
 const SIGMA: Real = 1.203e-3;
 const TOLERANCE: Real = 0.005;

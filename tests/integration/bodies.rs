@@ -1,12 +1,12 @@
 //! Moving bodies: friction drags a particle up to the speed of a turning disk, SDF-grid and
 //! analytic spheres rebound alike, loads are recorded, and thread count changes nothing.
 
-use cgdem::bodies::{Body, BodyShape, Motion};
-use cgdem::domain::Domain;
-use cgdem::geometry::{sphere_mesh, Cylinder, SdfGrid, Sphere};
-use cgdem::math::{Real, Vec3};
-use cgdem::particles::Particles;
-use cgdem::walls::WallSet;
+use cgdem_core::bodies::{Body, BodyShape, Motion};
+use cgdem_core::domain::Domain;
+use cgdem_core::geometry::{sphere_mesh, Cylinder, SdfGrid, Sphere};
+use cgdem_core::math::{Real, Vec3};
+use cgdem_core::particles::Particles;
+use cgdem_core::walls::WallSet;
 use rand::{Rng, SeedableRng};
 
 use crate::common::{open_box, world, Coke};
@@ -41,7 +41,7 @@ fn turning_disk_drags_a_particle_at_mu_g_until_it_co_rotates() {
     body.start(0.0);
     world.set_bodies(vec![body]);
     let t_stick = omega * r0 / (mu * G);
-    let slip = |w: &cgdem::simulation::World<_, _>| {
+    let slip = |w: &cgdem_core::simulation::World<_, _>| {
         let x = w.particles.position[0];
         (w.particles.velocity[0] - Vec3::Z.cross(x) * omega).length()
     };

@@ -131,7 +131,7 @@ fn geometry_commands_write_the_screw_feeder_meshes_and_the_sdf_study() {
         // The casing and the insertion region are unions of closed pieces that touch or
         // overlap (see screw_feeder.rs), so the strict reader's manifold check is skipped.
         let (mesh, _) =
-            cgdem::geometry::read_stl_unchecked(&dir.join("feeder").join(name)).unwrap();
+            cgdem_core::geometry::read_stl_unchecked(&dir.join("feeder").join(name)).unwrap();
         assert!(!mesh.triangles.is_empty(), "{name}");
     }
     let out = cgdem()

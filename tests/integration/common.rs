@@ -1,17 +1,17 @@
 //! Small worlds for the tests.
 
-use cgdem::contact::normal::WcaCoefficients;
-use cgdem::contact::SeedModel;
-use cgdem::domain::Domain;
-use cgdem::harness::lammps::{
+use cgdem_core::contact::normal::WcaCoefficients;
+use cgdem_core::contact::SeedModel;
+use cgdem_core::domain::Domain;
+use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
+use cgdem_core::particles::Particles;
+use cgdem_core::scene::Scene;
+use cgdem_core::simulation::{NeighborSettings, World};
+use cgdem_core::walls::{WallSet, WcaWall};
+use cgdem_harness::lammps::{
     self, run_reference, ReferenceCode, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
 };
-use cgdem::harness::liggghts;
-use cgdem::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
-use cgdem::particles::Particles;
-use cgdem::scene::Scene;
-use cgdem::simulation::{NeighborSettings, World};
-use cgdem::walls::{WallSet, WcaWall};
+use cgdem_harness::liggghts;
 
 /// The seed's coke parameters (paper A sec. 3), coarse-grained by `lambda`.
 pub struct Coke {

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use cgdem::guard::GuardKind;
-use cgdem::math::Real;
+use cgdem_core::guard::GuardKind;
+use cgdem_core::math::Real;
 
 use crate::common::{binary_collision, collide, Coke};
 

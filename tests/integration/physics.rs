@@ -2,11 +2,11 @@
 //! coarse-graining invariants, determinism.
 
 use crate::common::*;
-use cgdem::domain::Domain;
-use cgdem::geometry::FinitePlane;
-use cgdem::math::{Real, Vec3};
-use cgdem::particles::Particles;
-use cgdem::walls::{restitution_damping_ratio, Wall, WallSet};
+use cgdem_core::domain::Domain;
+use cgdem_core::geometry::FinitePlane;
+use cgdem_core::math::{Real, Vec3};
+use cgdem_core::particles::Particles;
+use cgdem_core::walls::{restitution_damping_ratio, Wall, WallSet};
 use rand::{Rng, SeedableRng};
 
 fn linear_restitution(zeta: Real) -> Real {
@@ -121,7 +121,7 @@ fn pair_forces_obey_newtons_third_law_in_a_dense_random_packing() {
         Vec3::ZERO,
         coke.pair_period() / 50.0,
     );
-    let momentum = |w: &cgdem::simulation::World<_, _>| -> Vec3 {
+    let momentum = |w: &cgdem_core::simulation::World<_, _>| -> Vec3 {
         w.particles
             .velocity
             .iter()

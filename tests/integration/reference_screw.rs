@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use cgdem::geometry::screw_feeder::ScrewFeederSpec;
-use cgdem::harness::lammps::{self, read_dump, ReferenceCode};
-use cgdem::scene::{Override, Scene};
+use cgdem_core::geometry::screw_feeder::ScrewFeederSpec;
+use cgdem_core::scene::{Override, Scene};
+use cgdem_harness::lammps::{self, read_dump, ReferenceCode};
 
 use crate::common::completed_reference_run;
 

@@ -4,9 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use cgdem::harness::lammps::{self, read_dump, ReferenceCode, RunStatus, RunnerOptions};
-use cgdem::harness::liggghts;
-use cgdem::scene::Scene;
+use cgdem_core::scene::Scene;
+use cgdem_harness::lammps::{self, read_dump, ReferenceCode, RunStatus, RunnerOptions};
+use cgdem_harness::liggghts;
 
 use crate::common::completed_reference_run;
 
@@ -103,32 +103,32 @@ fn end_wall_rebound(code: ReferenceCode) {
         return;
     }
     let mut scene = scene();
-    scene.gravity = cgdem::math::Vec3::ZERO;
+    scene.gravity = cgdem_core::math::Vec3::ZERO;
     scene.repose = None;
     scene.output.timeseries_interval = 1e-3;
     scene.stages = vec![
-        cgdem::scene::Stage {
+        cgdem_core::scene::Stage {
             name: "before".into(),
             remove_walls: Vec::new(),
-            end: cgdem::scene::StageEnd::Duration(1e-4),
+            end: cgdem_core::scene::StageEnd::Duration(1e-4),
         },
-        cgdem::scene::Stage {
+        cgdem_core::scene::Stage {
             name: "after".into(),
             remove_walls: vec!["gate".into()],
-            end: cgdem::scene::StageEnd::Duration(6e-3),
+            end: cgdem_core::scene::StageEnd::Duration(6e-3),
         },
     ];
     let s = &scene.species[0];
-    let mut particles = cgdem::particles::Particles::new(false);
+    let mut particles = cgdem_core::particles::Particles::new(false);
     let r = s.radius();
     // 0.5 mm from the end wall at x = 0.15, moving into it at 1 m/s.
     particles.push(
         0,
-        cgdem::math::Vec3::new(0.15 - r - 5e-4, 0.02, 0.06),
+        cgdem_core::math::Vec3::new(0.15 - r - 5e-4, 0.02, 0.06),
         r,
         s.mass(),
     );
-    particles.velocity[0] = cgdem::math::Vec3::new(1.0, 0.0, 0.0);
+    particles.velocity[0] = cgdem_core::math::Vec3::new(1.0, 0.0, 0.0);
     let dt = 1e-6;
     let deck = match code {
         ReferenceCode::Lammps => lammps::write_deck(&scene, &particles, dt),

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use cgdem::coarse_graining::coarse_grain;
-use cgdem::scene::{InsertAmount, Scene};
+use cgdem_core::coarse_graining::coarse_grain;
+use cgdem_core::scene::{InsertAmount, Scene};
 
 #[test]
 fn shipped_cases_validate_and_coarse_grain_to_lambda_2() {

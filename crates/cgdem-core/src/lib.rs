@@ -1,0 +1,23 @@
+//! cgdem: a discrete-element solver for powders and granular flow, with coarse-graining.
+//!
+//! The solver core (particles, neighbour search, contact slots, walls, integration,
+//! coarse-graining, scenes) never depends on the validation harness or on plotting.
+
+pub mod analysis;
+pub mod bodies;
+pub mod coarse_graining;
+pub mod contact;
+pub mod domain;
+pub mod geometry;
+pub mod guard;
+pub mod insertion;
+pub mod integrate;
+pub mod io;
+pub mod math;
+pub mod neighbor;
+pub mod particles;
+pub mod run;
+pub mod scene;
+pub mod simulation;
+pub mod timestep;
+pub mod walls;

@@ -1,0 +1,1166 @@
+//! Error against run time (`[[accuracy]]` in a suite): what each knob that buys speed costs in
+//! accuracy.
+//!
+//! A sweep names a case, a reference setting (the finest affordable) and one series per knob:
+//! the coarse-graining level `lambda`, or a scene key (`time.dt_fraction`,
+//! `neighbor.skin_fraction`, `body[0].cell_size`). Each point changes one knob from the
+//! reference and is judged against the same code's reference run: repose-angle difference and
+//! heap-profile distance for a collapse, mass-flow difference (and the distance from Eq. 7) for
+//! a screw feeder. The reference setting run with other insertion seeds gives the floor below
+//! which a difference is the packing, not the knob. The report plots error against wall time
+//! on log axes with each code's Pareto front, and tables the cheapest setting within each
+//! target.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::suite::{parse_codes, parse_variant, Code, Suite, SuiteError};
+use super::validate::{output_error, run_one, ValidateError, ValidateOptions};
+use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
+use cgdem_core::coarse_graining::CoarseGrainRule;
+use cgdem_core::io::write_atomic;
+use cgdem_core::scene::{Override, Scene};
+
+/// What a point varies: the coarse-graining level or a scene key.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Knob {
+    Lambda,
+    Scene(String),
+}
+
+impl Knob {
+    fn parse(name: &str) -> Knob {
+        match name {
+            "lambda" => Knob::Lambda,
+            key => Knob::Scene(key.to_string()),
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        match self {
+            Knob::Lambda => "lambda",
+            Knob::Scene(key) => key,
+        }
+    }
+
+    /// `time.dt_fraction` -> `time_dt_fraction`, for directory names.
+    fn file_name(&self) -> String {
+        self.name()
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect::<String>()
+            .trim_matches('_')
+            .to_string()
+    }
+}
+
+/// One knob's values, each run with every code listed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnobSeries {
+    pub knob: Knob,
+    pub values: Vec<f64>,
+    pub codes: Vec<Code>,
+}
+
+/// Target errors for the cheapest-setting table.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Targets {
+    pub angle_deg: f64,
+    /// Heap-profile distance, as a fraction of the reference heap's height.
+    pub profile: f64,
+    /// Relative mass-flow error (against the reference run and against Eq. 7).
+    pub mass_flow: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct AccuracySweep {
+    pub file: PathBuf,
+    /// Overrides every point shares (e.g. a shorter run), with `variant` naming them.
+    pub overrides: Vec<Override>,
+    pub variant: String,
+    pub seed: u64,
+    /// The reference setting with these insertion seeds: the floor (packing-to-packing).
+    pub floor_seeds: Vec<u64>,
+    /// Every knob's value at the reference; `lambda` always among them.
+    pub reference: BTreeMap<Knob, f64>,
+    pub series: Vec<KnobSeries>,
+    pub targets: Targets,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSweep {
+    file: PathBuf,
+    variant: String,
+    #[serde(default)]
+    set: Vec<String>,
+    seed: Option<u64>,
+    #[serde(default)]
+    floor_seeds: Vec<u64>,
+    reference: BTreeMap<String, toml::Value>,
+    series: Vec<RawSeries>,
+    angle_target_deg: Option<f64>,
+    profile_target: Option<f64>,
+    mass_flow_target: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSeries {
+    knob: String,
+    values: Vec<toml::Value>,
+    codes: Option<Vec<String>>,
+}
+
+fn number(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(f) => Some(*f),
+        _ => None,
+    }
+}
+
+impl AccuracySweep {
+    /// Validates `[[accuracy]]` entry `k` of suite file `path`.
+    pub(super) fn from_raw(raw: RawSweep, k: usize, path: &Path) -> Result<Self, SuiteError> {
+        let invalid = |field: &str, value: String, allowed: &str| SuiteError::Invalid {
+            file: path.to_path_buf(),
+            field: format!("accuracy[{k}].{field}"),
+            value,
+            allowed: allowed.into(),
+        };
+        // An accuracy sweep always names its variant: its runs sit beside the case's own.
+        let overrides = parse_variant(
+            &raw.set,
+            Some(&raw.variant),
+            &format!("accuracy[{k}]"),
+            path,
+        )?;
+        let lambda_ok = |v: f64| v >= 1.0 && v.fract() == 0.0 && (v as u32).is_power_of_two();
+        let mut reference = BTreeMap::new();
+        for (key, value) in &raw.reference {
+            let v = number(value)
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| {
+                    invalid(
+                        &format!("reference.{key}"),
+                        value.to_string(),
+                        "a positive number",
+                    )
+                })?;
+            reference.insert(Knob::parse(key), v);
+        }
+        let lambda = *reference.entry(Knob::Lambda).or_insert(1.0);
+        if !lambda_ok(lambda) {
+            return Err(invalid(
+                "reference.lambda",
+                lambda.to_string(),
+                "a power of two",
+            ));
+        }
+        let mut series = Vec::new();
+        for (j, s) in raw.series.into_iter().enumerate() {
+            let knob = Knob::parse(&s.knob);
+            if !reference.contains_key(&knob) {
+                return Err(invalid(
+                    &format!("series[{j}].knob"),
+                    format!("\"{}\"", s.knob),
+                    "a knob whose reference value is given in [accuracy.reference]",
+                ));
+            }
+            let values = s
+                .values
+                .iter()
+                .map(|v| number(v).filter(|v| v.is_finite() && *v > 0.0))
+                .collect::<Option<Vec<f64>>>()
+                .filter(|v| !v.is_empty())
+                .filter(|v| knob != Knob::Lambda || v.iter().all(|&l| lambda_ok(l)))
+                .ok_or_else(|| {
+                    invalid(
+                        &format!("series[{j}].values"),
+                        format!("{:?}", s.values),
+                        "one or more positive numbers (powers of two for lambda)",
+                    )
+                })?;
+            let codes = match s.codes {
+                None => vec![Code::Cgdem],
+                Some(names) => {
+                    parse_codes(&names, &format!("accuracy[{k}].series[{j}].codes"), path)?
+                }
+            };
+            series.push(KnobSeries {
+                knob,
+                values,
+                codes,
+            });
+        }
+        let target = |field: &str, v: Option<f64>, default: f64| {
+            let v = v.unwrap_or(default);
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(invalid(field, v.to_string(), "a positive number"))
+            }
+        };
+        Ok(AccuracySweep {
+            file: raw.file,
+            overrides,
+            variant: raw.variant,
+            seed: raw.seed.unwrap_or(1),
+            floor_seeds: raw.floor_seeds,
+            reference,
+            series,
+            targets: Targets {
+                angle_deg: target("angle_target_deg", raw.angle_target_deg, 1.0)?,
+                profile: target("profile_target", raw.profile_target, 0.05)?,
+                mass_flow: target("mass_flow_target", raw.mass_flow_target, 0.05)?,
+            },
+        })
+    }
+
+    /// Every code that runs a series (cgdem first), each of which also runs the reference.
+    fn codes(&self) -> Vec<Code> {
+        let mut codes: Vec<Code> = self.series.iter().flat_map(|s| s.codes.clone()).collect();
+        codes.sort();
+        codes.dedup();
+        codes
+    }
+
+    /// The scene of the setting `knobs` (the reference with some knobs changed): the file
+    /// with the shared overrides, then one override per scene knob; and its level.
+    fn scene(&self, knobs: &BTreeMap<Knob, f64>, origin: &Path) -> Result<(Scene, u32), String> {
+        let mut overrides = self.overrides.clone();
+        for (knob, value) in knobs {
+            if let Knob::Scene(key) = knob {
+                overrides.push(
+                    Override::parse(&format!("{key} = {value:?}"), origin)
+                        .map_err(|e| e.to_string())?,
+                );
+            }
+        }
+        let mut scene =
+            Scene::load_with_overrides(&self.file, &overrides).map_err(|e| e.to_string())?;
+        scene.name = format!("{}-{}", scene.name, self.variant);
+        Ok((scene, knobs[&Knob::Lambda] as u32))
+    }
+}
+
+/// One run of the sweep, as recorded in `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyPoint {
+    pub case: String,
+    pub code: Code,
+    /// "reference", "floor" (the reference setting, another insertion seed) or the knob.
+    pub series: String,
+    /// The varied knob's value (the reference's for "reference" and "floor").
+    pub value: f64,
+    /// The setting in words, e.g. "time.dt_fraction = 0.1".
+    pub setting: String,
+    pub lambda: u32,
+    pub seed: u64,
+    pub status: String,
+    pub reason: Option<String>,
+    pub dir: PathBuf,
+    pub reused: bool,
+    pub n_particles: Option<u64>,
+    pub steps: Option<u64>,
+    pub particle_steps: Option<f64>,
+    pub wall_s: Option<f64>,
+    pub repose_angle_deg: Option<f64>,
+    /// |angle - the same code's reference angle|, degrees.
+    pub angle_error_deg: Option<f64>,
+    /// RMS gap between the heap profile and the reference's, over the reference heap's
+    /// height ([`profile_distance`]).
+    pub profile_distance: Option<f64>,
+    pub mass_flow_kg_s: Option<f64>,
+    /// |Q / Q_reference - 1|.
+    pub mass_flow_error: Option<f64>,
+    /// Eq. (7) with the run's own measured fill ratio.
+    pub eq7_mass_flow_kg_s: Option<f64>,
+    /// |Q / Q_Eq7 - 1|.
+    pub eq7_error: Option<f64>,
+}
+
+/// The cheapest point within a target error, per case, code and error measure.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheapestSetting {
+    pub case: String,
+    pub code: Code,
+    pub measure: String,
+    pub target: f64,
+    /// None: no point other than the reference met the target.
+    pub setting: Option<String>,
+    pub wall_s: Option<f64>,
+    pub particle_steps: Option<f64>,
+    pub error: Option<f64>,
+    pub reference_wall_s: Option<f64>,
+    /// The largest error of the reference setting with other insertion seeds.
+    pub floor: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracySummary {
+    pub points: Vec<AccuracyPoint>,
+    pub cheapest: Vec<CheapestSetting>,
+}
+
+/// The error measures, each with the unit its target and axis use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Measure {
+    Angle,
+    Profile,
+    MassFlow,
+    Eq7,
+}
+
+impl Measure {
+    fn of(self, p: &AccuracyPoint) -> Option<f64> {
+        match self {
+            Measure::Angle => p.angle_error_deg,
+            Measure::Profile => p.profile_distance,
+            Measure::MassFlow => p.mass_flow_error,
+            Measure::Eq7 => p.eq7_error,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Measure::Angle => "repose angle vs reference",
+            Measure::Profile => "heap profile vs reference",
+            Measure::MassFlow => "mass flow vs reference",
+            Measure::Eq7 => "mass flow vs Eq. (7)",
+        }
+    }
+
+    fn stem(self) -> &'static str {
+        match self {
+            Measure::Angle => "angle_error",
+            Measure::Profile => "profile_distance",
+            Measure::MassFlow => "mass_flow_error",
+            Measure::Eq7 => "eq7_error",
+        }
+    }
+
+    fn axis(self) -> &'static str {
+        match self {
+            Measure::Angle => "|repose angle - reference| [deg]",
+            Measure::Profile => "RMS profile gap / reference heap height [-]",
+            Measure::MassFlow => "|Q / Q_reference - 1| [-]",
+            Measure::Eq7 => "|Q / Q_Eq.(7) - 1| [-]",
+        }
+    }
+
+    fn target(self, t: &Targets) -> f64 {
+        match self {
+            Measure::Angle => t.angle_deg,
+            Measure::Profile => t.profile,
+            Measure::MassFlow | Measure::Eq7 => t.mass_flow,
+        }
+    }
+
+    fn format(self, v: f64) -> String {
+        match self {
+            Measure::Angle => format!("{v:.2} deg"),
+            _ => format!("{:.1}%", 100.0 * v),
+        }
+    }
+
+    /// Measured against the reference run: the reference itself is zero by construction.
+    fn against_reference(self) -> bool {
+        self != Measure::Eq7
+    }
+}
+
+/// Indices of the points on the Pareto front of (cost, error), cheapest first: those that no
+/// other point beats in both (no cheaper-or-equal point has a smaller-or-equal error, one
+/// strictly). Points with a non-finite cost or error are not candidates.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len())
+        .filter(|&k| points[k].0.is_finite() && points[k].1.is_finite())
+        .collect();
+    order.sort_by(|&a, &b| {
+        points[a]
+            .0
+            .total_cmp(&points[b].0)
+            .then(points[a].1.total_cmp(&points[b].1))
+    });
+    let mut front = Vec::new();
+    let mut best = f64::INFINITY;
+    for k in order {
+        if points[k].1 < best {
+            best = points[k].1;
+            front.push(k);
+        }
+    }
+    front
+}
+
+/// The index of the cheapest point (least cost) whose error is within `target` (ties: the
+/// smaller error).
+pub fn cheapest_within(points: &[(f64, f64)], target: f64) -> Option<usize> {
+    (0..points.len())
+        .filter(|&k| points[k].0.is_finite() && points[k].1 <= target)
+        .min_by(|&a, &b| {
+            points[a]
+                .0
+                .total_cmp(&points[b].0)
+                .then(points[a].1.total_cmp(&points[b].1))
+        })
+}
+
+/// RMS gap between two heap profiles `(x, h)` (x ascending), over the reference's largest
+/// height: both are interpolated linearly on the union of their abscissae from the first to
+/// the last, and a profile is zero beyond its last point (no deposit) and constant before its
+/// first (the bins start half a width from the wall).
+pub fn profile_distance(reference: &[(f64, f64)], other: &[(f64, f64)]) -> Option<f64> {
+    let height = reference.iter().map(|p| p.1).fold(0.0, f64::max);
+    if reference.is_empty() || other.is_empty() || height <= 0.0 {
+        return None;
+    }
+    let at = |profile: &[(f64, f64)], x: f64| -> f64 {
+        let k = profile.partition_point(|p| p.0 < x);
+        if k == 0 {
+            profile[0].1
+        } else if k == profile.len() {
+            0.0
+        } else {
+            let (a, b) = (profile[k - 1], profile[k]);
+            a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+        }
+    };
+    let mut xs: Vec<f64> = reference.iter().chain(other).map(|p| p.0).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    let sum: f64 = xs
+        .iter()
+        .map(|&x| (at(reference, x) - at(other, x)).powi(2))
+        .sum();
+    Some((sum / xs.len() as f64).sqrt() / height)
+}
+
+/// Runs every `[[accuracy]]` sweep of the suite, writes the "Error against run time" section
+/// of the report and its figures; None when the suite has no sweep.
+pub(super) fn run_sweeps(
+    suite: &Suite,
+    options: &ValidateOptions,
+    report: &mut Report,
+) -> Result<Option<AccuracySummary>, ValidateError> {
+    if suite.accuracy.is_empty() {
+        return Ok(None);
+    }
+    let section = report.section("Error against run time");
+    section.paragraph(
+        "For each case: a reference setting (the finest affordable) and one series per knob \
+         that buys speed (coarse-graining level lambda, time-step fraction of the contact \
+         period, neighbour skin, SDF cell size), each point changing one knob from the \
+         reference. Errors are against the same code's reference run; the reference setting \
+         with other insertion seeds (\"floor\") shows how far a different random packing alone \
+         moves the result. Wall time is the whole run (insertion and output included) on the \
+         machine and thread count in the provenance; the machine is shared, so wall times \
+         carry some percent of noise. Figures: error against wall time on log axes, one series \
+         per knob and code, the Pareto front of each code dashed, the target dotted.",
+    );
+    let mut summary = AccuracySummary {
+        points: Vec::new(),
+        cheapest: Vec::new(),
+    };
+    for sweep in &suite.accuracy {
+        let mut points = run_sweep(sweep, &suite.source, options)?;
+        measure(&mut points);
+        let case = points.first().map(|p| p.case.clone()).unwrap_or_default();
+        let dir = options.out.join("figures").join("accuracy").join(&case);
+        let cheapest = write_sweep_section(section, sweep, &case, &points, &dir)?;
+        summary.points.extend(points);
+        summary.cheapest.extend(cheapest);
+    }
+    Ok(Some(summary))
+}
+
+/// Runs the reference of every code, then each series point, then the floor seeds; codes
+/// alternate within each point so machine drift hits all alike.
+fn run_sweep(
+    sweep: &AccuracySweep,
+    origin: &Path,
+    options: &ValidateOptions,
+) -> Result<Vec<AccuracyPoint>, ValidateError> {
+    let case_error = |message: String| ValidateError::Case {
+        file: sweep.file.clone(),
+        message,
+    };
+    let (reference_scene, _) = sweep.scene(&sweep.reference, origin).map_err(case_error)?;
+    let case = reference_scene.name.clone();
+    // (series, varied knob, value, codes, seed)
+    let mut jobs: Vec<(String, Knob, f64, Vec<Code>, u64)> = Vec::new();
+    let all = sweep.codes();
+    jobs.push((
+        "reference".into(),
+        Knob::Lambda,
+        0.0,
+        all.clone(),
+        sweep.seed,
+    ));
+    for s in &sweep.series {
+        for &v in &s.values {
+            if v != sweep.reference[&s.knob] {
+                jobs.push((
+                    s.knob.name().into(),
+                    s.knob.clone(),
+                    v,
+                    s.codes.clone(),
+                    sweep.seed,
+                ));
+            }
+        }
+    }
+    for &seed in &sweep.floor_seeds {
+        jobs.push(("floor".into(), Knob::Lambda, 0.0, all.clone(), seed));
+    }
+    let mut points = Vec::new();
+    for (series, knob, value, codes, seed) in jobs {
+        let mut knobs = sweep.reference.clone();
+        let (setting, value, name) = match series.as_str() {
+            "reference" | "floor" => (
+                "reference".to_string(),
+                f64::NAN,
+                format!("{series}-seed{seed}"),
+            ),
+            _ => {
+                knobs.insert(knob.clone(), value);
+                (
+                    format!("{} = {value}", knob.name()),
+                    value,
+                    format!("{}-{value}", knob.file_name()),
+                )
+            }
+        };
+        let (scene, lambda) = sweep.scene(&knobs, origin).map_err(case_error)?;
+        for code in codes {
+            let dir = options
+                .out
+                .join("runs")
+                .join(&case)
+                .join("accuracy")
+                .join(format!("{}-{name}", code.name()));
+            let point = run_point(&scene, code, lambda, seed, &dir, options);
+            let mut p = AccuracyPoint {
+                case: case.clone(),
+                code,
+                series: series.clone(),
+                value,
+                setting: setting.clone(),
+                ..point
+            };
+            if p.value.is_nan() {
+                p.value = knobs[&knob];
+            }
+            if !options.quiet {
+                eprintln!(
+                    "{case} accuracy {} {}{}: {}{}",
+                    code.name(),
+                    p.setting,
+                    if series == "floor" {
+                        format!(" (seed {seed})")
+                    } else {
+                        String::new()
+                    },
+                    p.status,
+                    p.reason
+                        .as_deref()
+                        .map_or(String::new(), |r| format!(" ({r})"))
+                );
+            }
+            points.push(p);
+        }
+    }
+    Ok(points)
+}
+
+/// Runs one point (or reuses it) and reads what it measured.
+fn run_point(
+    scene: &Scene,
+    code: Code,
+    lambda: u32,
+    seed: u64,
+    dir: &Path,
+    options: &ValidateOptions,
+) -> AccuracyPoint {
+    let rule = CoarseGrainRule::Seed;
+    let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
+    // A run that stopped early (a guard, a time limit) measured nothing comparable.
+    if record.partial {
+        record.status = "failed".into();
+    }
+    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    // A run that lost particles (LIGGGHTS and LAMMPS drop atoms that leave the box) may end
+    // without a heap or a flow to measure.
+    if record.status == "ok"
+        && record.repose_angle_deg.is_none()
+        && summary["conveying"]["mass_flow_kg_s"].as_f64().is_none()
+    {
+        record.status = "failed".into();
+        record.reason = Some(format!(
+            "measured nothing: {} particles at the end",
+            record.n_particles.map_or("?".into(), |n| n.to_string())
+        ));
+    }
+    let ok = record.status == "ok";
+    let conveying = |key: &str| {
+        summary["conveying"][key]
+            .as_f64()
+            .filter(|v| ok && v.is_finite())
+    };
+    let particle_steps = summary["particle_steps"]
+        .as_f64()
+        .or_else(|| Some(record.n_particles? as f64 * record.steps? as f64));
+    AccuracyPoint {
+        case: record.case,
+        code,
+        series: String::new(),
+        value: f64::NAN,
+        setting: String::new(),
+        lambda,
+        seed,
+        status: record.status,
+        reason: record.reason,
+        dir: dir.to_path_buf(),
+        reused: record.reused,
+        n_particles: record.n_particles,
+        steps: record.steps,
+        particle_steps: particle_steps.filter(|_| ok),
+        wall_s: record.wall_s.filter(|_| ok),
+        repose_angle_deg: record.repose_angle_deg.filter(|_| ok),
+        angle_error_deg: None,
+        profile_distance: None,
+        mass_flow_kg_s: conveying("mass_flow_kg_s"),
+        mass_flow_error: None,
+        eq7_mass_flow_kg_s: conveying("eq7_mass_flow_kg_s"),
+        eq7_error: None,
+    }
+}
+
+fn read_profile(dir: &Path) -> Vec<(f64, f64)> {
+    let Ok(text) = std::fs::read_to_string(dir.join("profile.csv")) else {
+        return Vec::new();
+    };
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let (x, h) = l.split_once(',')?;
+            Some((x.trim().parse().ok()?, h.trim().parse().ok()?))
+        })
+        .collect()
+}
+
+/// Fills each point's errors against its code's reference run.
+fn measure(points: &mut [AccuracyPoint]) {
+    let references: Vec<AccuracyPoint> = points
+        .iter()
+        .filter(|p| p.series == "reference" && p.status == "ok")
+        .cloned()
+        .collect();
+    for p in points.iter_mut().filter(|p| p.status == "ok") {
+        if let (Some(q), Some(eq7)) = (p.mass_flow_kg_s, p.eq7_mass_flow_kg_s) {
+            p.eq7_error = Some((q / eq7 - 1.0).abs()).filter(|e| e.is_finite());
+        }
+        let Some(r) = references.iter().find(|r| r.code == p.code) else {
+            continue;
+        };
+        if let (Some(a), Some(b)) = (p.repose_angle_deg, r.repose_angle_deg) {
+            p.angle_error_deg = Some((a - b).abs());
+            p.profile_distance = profile_distance(&read_profile(&r.dir), &read_profile(&p.dir));
+        }
+        if let (Some(q), Some(q_ref)) = (p.mass_flow_kg_s, r.mass_flow_kg_s) {
+            p.mass_flow_error = Some((q / q_ref - 1.0).abs()).filter(|e| e.is_finite());
+        }
+    }
+}
+
+fn fmt_opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".into(), |x| format!("{x:.digits$}"))
+}
+
+/// The sweep's subsection: runs table, one figure per error measure, the cheapest settings.
+fn write_sweep_section(
+    section: &mut Section,
+    sweep: &AccuracySweep,
+    case: &str,
+    points: &[AccuracyPoint],
+    dir: &Path,
+) -> Result<Vec<CheapestSetting>, ValidateError> {
+    let sub = section.subsection(format!("Case {case}"));
+    let reference = sweep
+        .reference
+        .iter()
+        .map(|(k, v)| format!("{} = {v}", k.name()))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let shared = sweep
+        .overrides
+        .iter()
+        .map(|o| o.key.clone())
+        .collect::<Vec<_>>()
+        .join(", ");
+    sub.paragraph(format!(
+        "Scene file {} with the overrides of variant `{}` ({}); insertion seed {}. Reference \
+         setting: {reference}.",
+        sweep.file.display(),
+        sweep.variant,
+        if shared.is_empty() { "none" } else { &shared },
+        sweep.seed
+    ));
+    let measures: Vec<Measure> = [
+        Measure::Angle,
+        Measure::Profile,
+        Measure::MassFlow,
+        Measure::Eq7,
+    ]
+    .into_iter()
+    .filter(|m| points.iter().any(|p| m.of(p).is_some()))
+    .collect();
+
+    let mut table = Table::new(
+        [
+            "code",
+            "series",
+            "setting",
+            "seed",
+            "status",
+            "particles",
+            "particle-steps",
+            "wall s",
+            "result",
+        ]
+        .into_iter()
+        .map(String::from)
+        .chain(measures.iter().map(|m| m.name().to_string())),
+    )
+    .caption("Every point: its cost and its errors");
+    let mut csv = String::from(
+        "case,code,series,knob_value,setting,lambda,seed,status,n_particles,steps,particle_steps,wall_s,repose_angle_deg,angle_error_deg,profile_distance,mass_flow_kg_s,mass_flow_error,eq7_mass_flow_kg_s,eq7_error\n",
+    );
+    let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+    for p in points {
+        let status = match p.status.as_str() {
+            "ok" if p.reused => Cell::pass("ok (reused)"),
+            "ok" => Cell::pass("ok"),
+            "skipped" => {
+                Cell::skipped(format!("skipped: {}", p.reason.clone().unwrap_or_default()))
+            }
+            _ => Cell::fail(format!("failed: {}", p.reason.clone().unwrap_or_default())),
+        };
+        let result = match (p.repose_angle_deg, p.mass_flow_kg_s) {
+            (Some(a), _) => format!("{a:.2} deg"),
+            (_, Some(q)) => format!("{q:.3} kg/s"),
+            _ => "-".into(),
+        };
+        table.row(
+            [
+                Cell::text(p.code.name()),
+                Cell::text(&p.series),
+                Cell::text(&p.setting),
+                Cell::num(p.seed.to_string()),
+                status,
+                Cell::num(p.n_particles.map_or("-".into(), |n| n.to_string())),
+                Cell::num(p.particle_steps.map_or("-".into(), |n| format!("{n:.3e}"))),
+                Cell::num(fmt_opt(p.wall_s, 1)),
+                Cell::num(result),
+            ]
+            .into_iter()
+            .chain(
+                measures
+                    .iter()
+                    .map(|m| Cell::num(m.of(p).map_or("-".into(), |v| m.format(v)))),
+            ),
+        );
+        csv += &format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            p.case,
+            p.code.name(),
+            p.series,
+            p.value,
+            p.setting.replace(',', ";"),
+            p.lambda,
+            p.seed,
+            p.status,
+            p.n_particles.map_or(String::new(), |n| n.to_string()),
+            p.steps.map_or(String::new(), |n| n.to_string()),
+            o(p.particle_steps),
+            o(p.wall_s),
+            o(p.repose_angle_deg),
+            o(p.angle_error_deg),
+            o(p.profile_distance),
+            o(p.mass_flow_kg_s),
+            o(p.mass_flow_error),
+            o(p.eq7_mass_flow_kg_s),
+            o(p.eq7_error),
+        );
+    }
+    std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
+    let csv_path = dir.join("points.csv");
+    write_atomic(&csv_path, csv.as_bytes()).map_err(|e| output_error(&csv_path, e))?;
+
+    let mut cheapest = Vec::new();
+    let codes = sweep.codes();
+    for &m in &measures {
+        for cost in [Cost::WallTime, Cost::ParticleSteps] {
+            let fig = error_figure(case, m, cost, &sweep.targets, &codes, points);
+            let stem = match cost {
+                Cost::WallTime => m.stem().to_string(),
+                Cost::ParticleSteps => format!("{}_vs_particle_steps", m.stem()),
+            };
+            let files = write_figure(dir, &stem, &fig).map_err(|e| output_error(dir, e))?;
+            sub.figure(
+                &files,
+                fig.title.clone(),
+                format!(
+                    "{} against {}, log axes; one series per knob and code (points in the \
+                     knob's order), the Pareto front of each code dashed, the target ({}) as a \
+                     line.{} All points: points.csv beside it.",
+                    m.name(),
+                    cost.name(),
+                    m.format(m.target(&sweep.targets)),
+                    match cost {
+                        Cost::WallTime => "",
+                        Cost::ParticleSteps =>
+                            " Particle-steps do not depend on the load of a shared machine, nor \
+                             on the code's speed.",
+                    }
+                ),
+            )
+            .map_err(|e| output_error(dir, e))?;
+        }
+        for &code in &codes {
+            cheapest.push(cheapest_setting(case, code, m, &sweep.targets, points));
+        }
+    }
+    let mut choice = Table::new([
+        "code",
+        "error measure",
+        "target",
+        "cheapest setting within it",
+        "wall s",
+        "particle-steps",
+        "its error",
+        "reference wall s",
+        "speed-up",
+        "floor (other seeds)",
+    ])
+    .caption("Cheapest setting within each target, per code: the fewest particle-steps (wall time beside it; on a shared machine the wall time of equal work varies too much to choose by). The reference is the yardstick: when no other point meets the target, none is named. Floor: the largest error of the reference setting with other insertion seeds; a target below it is met by chance.");
+    for c in &cheapest {
+        let m = measure_named(&c.measure);
+        let speedup = match (c.reference_wall_s, c.wall_s) {
+            (Some(r), Some(w)) if w > 0.0 => format!("{:.1}x", r / w),
+            _ => "-".into(),
+        };
+        choice.row([
+            Cell::text(c.code.name()),
+            Cell::text(&c.measure),
+            Cell::num(m.format(c.target)),
+            match &c.setting {
+                Some(s) => Cell::pass(s.clone()),
+                None => Cell::skipped("none: only the reference"),
+            },
+            Cell::num(fmt_opt(c.wall_s, 1)),
+            Cell::num(c.particle_steps.map_or("-".into(), |n| format!("{n:.3e}"))),
+            Cell::num(c.error.map_or("-".into(), |v| m.format(v))),
+            Cell::num(fmt_opt(c.reference_wall_s, 1)),
+            Cell::num(speedup),
+            Cell::num(c.floor.map_or("-".into(), |v| m.format(v))),
+        ]);
+    }
+    sub.table(choice);
+    sub.table(table);
+    Ok(cheapest)
+}
+
+fn measure_named(name: &str) -> Measure {
+    [
+        Measure::Angle,
+        Measure::Profile,
+        Measure::MassFlow,
+        Measure::Eq7,
+    ]
+    .into_iter()
+    .find(|m| m.name() == name)
+    .unwrap_or(Measure::Angle)
+}
+
+/// The points that are settings to choose from: the series, and the reference where its
+/// error is not zero by construction.
+fn candidates(code: Code, m: Measure, points: &[AccuracyPoint]) -> Vec<&AccuracyPoint> {
+    points
+        .iter()
+        .filter(|p| p.code == code && p.status == "ok" && p.series != "floor")
+        .filter(|p| p.series != "reference" || !m.against_reference())
+        .collect()
+}
+
+fn cheapest_setting(
+    case: &str,
+    code: Code,
+    m: Measure,
+    targets: &Targets,
+    points: &[AccuracyPoint],
+) -> CheapestSetting {
+    // Chosen by particle-steps, not wall time: within one code the two are proportional at a
+    // given per-step cost, and on a shared machine the wall time of equal work varied
+    // two-fold between runs (reports/accuracy/NOTE.md).
+    let found = candidates(code, m, points);
+    let cost: Vec<(f64, f64)> = found
+        .iter()
+        .map(|p| {
+            (
+                p.particle_steps.unwrap_or(f64::NAN),
+                m.of(p).unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    let best = cheapest_within(&cost, m.target(targets)).map(|k| found[k]);
+    let reference = points
+        .iter()
+        .find(|p| p.code == code && p.series == "reference" && p.status == "ok");
+    let floor = points
+        .iter()
+        .filter(|p| p.code == code && p.series == "floor")
+        .filter_map(|p| m.of(p))
+        .fold(None, |a: Option<f64>, e| Some(a.map_or(e, |a| a.max(e))));
+    CheapestSetting {
+        case: case.to_string(),
+        code,
+        measure: m.name().into(),
+        target: m.target(targets),
+        setting: best.map(|p| p.setting.clone()),
+        wall_s: best.and_then(|p| p.wall_s),
+        particle_steps: best.and_then(|p| p.particle_steps),
+        error: best.and_then(|p| m.of(p)),
+        reference_wall_s: reference.and_then(|p| p.wall_s),
+        floor,
+    }
+}
+
+/// The cost a figure's x axis shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cost {
+    WallTime,
+    ParticleSteps,
+}
+
+impl Cost {
+    fn of(self, p: &AccuracyPoint) -> Option<f64> {
+        match self {
+            Cost::WallTime => p.wall_s,
+            Cost::ParticleSteps => p.particle_steps,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Cost::WallTime => "wall time",
+            Cost::ParticleSteps => "particle-steps",
+        }
+    }
+}
+
+fn error_figure(
+    case: &str,
+    m: Measure,
+    cost_axis: Cost,
+    targets: &Targets,
+    codes: &[Code],
+    points: &[AccuracyPoint],
+) -> Figure {
+    let mut fig = Figure::new(
+        format!("{case}: {} against {}", m.name(), cost_axis.name()),
+        match cost_axis {
+            Cost::WallTime => "wall time [s]",
+            Cost::ParticleSteps => "particle-steps [-]",
+        },
+        m.axis(),
+    )
+    .log_x()
+    .log_y();
+    let mut walls: Vec<f64> = Vec::new();
+    for &code in codes {
+        let mut knobs: Vec<&str> = points
+            .iter()
+            .filter(|p| p.code == code)
+            .map(|p| p.series.as_str())
+            .collect();
+        knobs.sort();
+        knobs.dedup();
+        for knob in knobs {
+            let mut series: Vec<&AccuracyPoint> = points
+                .iter()
+                .filter(|p| p.code == code && p.series == knob && p.status == "ok")
+                .collect();
+            series.sort_by(|a, b| a.value.total_cmp(&b.value));
+            let xy: Vec<(f64, f64)> = series
+                .iter()
+                .filter_map(|p| Some((cost_axis.of(p)?, m.of(p)?)))
+                .collect();
+            walls.extend(xy.iter().map(|p| p.0));
+            if xy.is_empty() || (knob == "reference" && m.against_reference()) {
+                continue;
+            }
+            let label = match knob {
+                "floor" => format!("{}: reference, other seeds", code.name()),
+                _ => format!("{}: {knob}", code.name()),
+            };
+            let style = match knob {
+                "floor" | "reference" => SeriesStyle::Markers,
+                _ => SeriesStyle::LineMarkers,
+            };
+            fig.series.push(Series::new(label, xy).style(style));
+        }
+        let found = candidates(code, m, points);
+        let cost: Vec<(f64, f64)> = found
+            .iter()
+            .map(|p| {
+                (
+                    cost_axis.of(p).unwrap_or(f64::NAN),
+                    m.of(p).unwrap_or(f64::NAN),
+                )
+            })
+            .collect();
+        let front: Vec<(f64, f64)> = pareto_front(&cost)
+            .into_iter()
+            .map(|k| cost[k])
+            .filter(|p| p.1 > 0.0)
+            .collect();
+        if !front.is_empty() {
+            // One point (it beats every other) is a front too; a lone dash would not show.
+            let style = if front.len() > 1 {
+                SeriesStyle::Dashed
+            } else {
+                SeriesStyle::Markers
+            };
+            fig.series
+                .push(Series::new(format!("{}: Pareto front", code.name()), front).style(style));
+        }
+    }
+    let (lo, hi) = walls
+        .iter()
+        .filter(|w| **w > 0.0)
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &w| {
+            (lo.min(w), hi.max(w))
+        });
+    if lo < hi {
+        let t = m.target(targets);
+        fig.series.push(
+            Series::new(format!("target {}", m.format(t)), vec![(lo, t), (hi, t)])
+                .style(SeriesStyle::Dashed),
+        );
+    }
+    fig
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pareto_front_keeps_only_points_no_cheaper_point_beats() {
+        // (wall s, error): 1 is dominated by 0 (dearer and worse); 3 ties 2 in cost but is
+        // worse; 4 is the most accurate; 5 has no error (a failed run).
+        let points = [
+            (1.0, 0.5),
+            (2.0, 0.6),
+            (4.0, 0.2),
+            (4.0, 0.3),
+            (10.0, 0.01),
+            (0.5, f64::NAN),
+        ];
+        assert_eq!(pareto_front(&points), vec![0, 2, 4]);
+        assert!(pareto_front(&[]).is_empty());
+        // Equal points: only one is on the front.
+        assert_eq!(pareto_front(&[(1.0, 1.0), (1.0, 1.0)]).len(), 1);
+    }
+
+    #[test]
+    fn the_cheapest_setting_is_the_least_cost_within_the_target() {
+        let points = [(10.0, 0.01), (1.0, 2.0), (3.0, 0.9), (2.0, 1.0), (2.0, 0.5)];
+        // Within 1: indices 0, 2, 3, 4; cheapest 2.0 s, of which the smaller error.
+        assert_eq!(cheapest_within(&points, 1.0), Some(4));
+        assert_eq!(cheapest_within(&points, 0.1), Some(0));
+        assert_eq!(cheapest_within(&points, 0.001), None);
+        assert_eq!(cheapest_within(&[(f64::NAN, 0.0)], 1.0), None);
+    }
+
+    #[test]
+    fn profile_distance_is_zero_for_equal_heaps_and_scales_with_the_gap() {
+        let heap: Vec<(f64, f64)> = (0..20)
+            .map(|k| (0.005 + 0.01 * k as f64, (0.1 - 0.005 * k as f64).max(0.0)))
+            .collect();
+        assert_eq!(profile_distance(&heap, &heap), Some(0.0));
+        // Uniformly 1 cm higher where the heap is: 0.01 / 0.1 over every point.
+        let higher: Vec<(f64, f64)> = heap.iter().map(|&(x, h)| (x, h + 0.01)).collect();
+        let d = profile_distance(&heap, &higher).unwrap();
+        assert!((d - 0.1).abs() < 1e-12, "{d}");
+        // Coarser bins of the same straight heap: only the interpolation differs.
+        let coarse: Vec<(f64, f64)> = heap.iter().step_by(2).copied().collect();
+        assert!(profile_distance(&heap, &coarse).unwrap() < 0.05);
+        assert_eq!(profile_distance(&[], &heap), None);
+    }
+
+    #[test]
+    fn shipped_suites_parse_and_every_accuracy_point_is_a_valid_scene() {
+        crate::at_repo_root();
+        for entry in std::fs::read_dir("validation/suites").unwrap() {
+            let path = entry.unwrap().path();
+            let suite = Suite::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            for sweep in &suite.accuracy {
+                for s in &sweep.series {
+                    for &v in &s.values {
+                        let mut knobs = sweep.reference.clone();
+                        knobs.insert(s.knob.clone(), v);
+                        sweep.scene(&knobs, &path).unwrap_or_else(|e| {
+                            panic!("{}: {} = {v}: {e}", path.display(), s.knob.name())
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_sweep_needs_its_knobs_reference_values() {
+        crate::at_repo_root();
+        let suite = |series: &str| {
+            format!(
+                "name = \"a\"\n[[accuracy]]\nfile = \"validation/cases/aor_hertz_smoke.toml\"\n\
+                 variant = \"acc\"\n[accuracy.reference]\nlambda = 1\n\"time.dt_fraction\" = 0.02\n\
+                 [[accuracy.series]]\n{series}\n"
+            )
+        };
+        let ok = Suite::parse(
+            &suite("knob = \"time.dt_fraction\"\nvalues = [0.05, 0.1]\ncodes = [\"cgdem\", \"lammps\"]"),
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        let sweep = &ok.accuracy[0];
+        assert_eq!(sweep.codes(), vec![Code::Cgdem, Code::Lammps]);
+        assert_eq!(sweep.targets.angle_deg, 1.0);
+        let (scene, lambda) = sweep.scene(&sweep.reference, Path::new("s.toml")).unwrap();
+        assert_eq!(lambda, 1);
+        assert_eq!(scene.name, "aor_hertz_smoke-acc");
+        let e = Suite::parse(
+            &suite("knob = \"neighbor.skin_fraction\"\nvalues = [0.1]"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("accuracy[0].series[0].knob"), "{e}");
+        let e = Suite::parse(
+            &suite("knob = \"lambda\"\nvalues = [3]"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("accuracy[0].series[0].values"), "{e}");
+    }
+}

@@ -1,0 +1,882 @@
+//! `cgdem bench`: throughput of cgdem, LIGGGHTS and LAMMPS on the same case, measured side
+//! by side.
+//!
+//! Every code starts from one prepared state (cgdem runs the case for `prepare_s` first, so
+//! the timed window is a heap that is forming, not particles in free fall), with identical
+//! particles, physics, time step and step count. The codes alternate within each repetition
+//! (forward order on even repetitions, reverse on odd ones), so machine drift hits all alike,
+//! and each repetition gives one ratio cgdem / other from adjacent runs; the report quotes
+//! medians. Throughput is particles times steps over the loop time (LAMMPS and LIGGGHTS:
+//! their `Loop time` line; cgdem: its step loop), so start-up and file reading are excluded
+//! from every code alike.
+//!
+//! A separate, untimed run of each code from the same state to the scene's end measures the
+//! outcome (height and flank slope of the heap), so that the speed is compared on the same
+//! physics.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use serde::Serialize;
+
+use crate::lammps::postprocess::log_timing;
+use crate::lammps::runner::RunStatus;
+use crate::lammps::{self, read_dump, RunnerOptions};
+use crate::liggghts;
+use crate::report::plot::write_bar_chart;
+use crate::suite::Code;
+use cgdem_core::analysis::conical_heap::{conical_heap, ConicalHeap};
+use cgdem_core::math::{Real, Vec3};
+use cgdem_core::particles::Particles;
+use cgdem_core::run::{run, RunOptions};
+use cgdem_core::scene::{ContactSettings, Scene, StageEnd};
+use cgdem_core::timestep::TimeStepRequest;
+
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    pub cases: Vec<PathBuf>,
+    pub out: PathBuf,
+    pub codes: Vec<Code>,
+    /// Threads for cgdem, MPI ranks for the reference codes.
+    pub threads: Vec<usize>,
+    /// Repetitions of the alternating sequence.
+    pub pairs: usize,
+    /// Steps in each timed run.
+    pub steps: u64,
+    /// Simulated seconds cgdem runs the case before the timed window (0: start from the
+    /// scene's insertions).
+    pub prepare_s: Real,
+    /// Also run each code once from the prepared state to the scene's end and compare the
+    /// heap it leaves.
+    pub outcome: bool,
+    pub timeout: Duration,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    #[error("{0}")]
+    Case(String),
+    #[error("{path}: {message}")]
+    Output { path: PathBuf, message: String },
+}
+
+/// One timed run.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchRun {
+    pub case: String,
+    pub code: Code,
+    pub threads: usize,
+    pub repetition: usize,
+    /// `completed`, `skipped`, `failed` or `timed out`.
+    pub status: String,
+    pub reason: Option<String>,
+    pub n_particles: usize,
+    pub steps: u64,
+    pub loop_s: Option<Real>,
+    pub particle_steps_per_s: Option<Real>,
+    /// Memory the code reports for its data (LAMMPS/LIGGGHTS: `Per MPI rank memory
+    /// allocation`, average times ranks; cgdem: its particle, pair and history arrays), MB.
+    pub memory_mb: Option<Real>,
+    pub dir: PathBuf,
+}
+
+/// Medians over the repetitions of one case, code and thread count.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchMedian {
+    pub case: String,
+    pub code: Code,
+    pub threads: usize,
+    pub runs: usize,
+    pub median_particle_steps_per_s: Real,
+    pub min_particle_steps_per_s: Real,
+    pub max_particle_steps_per_s: Real,
+    /// Median throughput at this thread count over `threads` times the median at one.
+    pub parallel_efficiency: Option<Real>,
+}
+
+/// cgdem over another code (or over itself on another case), per repetition and median.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchRatio {
+    pub numerator: String,
+    pub denominator: String,
+    pub threads: usize,
+    pub per_repetition: Vec<Real>,
+    pub median: Real,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchOutcome {
+    pub case: String,
+    pub code: Code,
+    pub status: String,
+    pub simulated_s: Real,
+    pub heap: Option<ConicalHeap>,
+}
+
+/// cgdem's memory for one case (arrays at their capacity at the end of the timed run).
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchMemory {
+    pub case: String,
+    pub bytes_per_particle: Real,
+    pub bytes_per_listed_pair: Real,
+    pub listed_pairs: usize,
+    pub history_entries: usize,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    pub provenance: BTreeMap<String, String>,
+    pub steps: u64,
+    pub prepare_s: Real,
+    pub runs: Vec<BenchRun>,
+    pub medians: Vec<BenchMedian>,
+    pub ratios: Vec<BenchRatio>,
+    pub outcomes: Vec<BenchOutcome>,
+    pub memory: Vec<BenchMemory>,
+}
+
+/// A case ready to time: the scene cut to `steps`, its step and the prepared state.
+struct PreparedCase {
+    name: String,
+    timed: Scene,
+    full: Option<Scene>,
+    state: Particles,
+    dt: Real,
+    reference_codes: bool,
+}
+
+pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
+    let out = &options.out;
+    let mut cases = Vec::new();
+    for path in &options.cases {
+        cases.push(prepare(path, options)?);
+    }
+    let mut runs: Vec<BenchRun> = Vec::new();
+    let mut memory = Vec::new();
+    for &threads in &options.threads {
+        for repetition in 0..options.pairs {
+            for case in &cases {
+                let mut order: Vec<Code> = options.codes.clone();
+                if repetition % 2 == 1 {
+                    order.reverse();
+                }
+                for code in order {
+                    let dir = out
+                        .join(&case.name)
+                        .join(format!("{}-t{threads}-r{repetition}", code.name()));
+                    let (run, mem) = timed_run(case, code, threads, repetition, &dir, options);
+                    eprintln!(
+                        "bench {} {} threads={threads} rep={repetition}: {}",
+                        case.name,
+                        code.name(),
+                        run.particle_steps_per_s
+                            .map_or(run.status.clone(), |v| format!("{v:.3e} particle-steps/s"))
+                    );
+                    if let Some(m) = mem {
+                        if memory.iter().all(|x: &BenchMemory| x.case != m.case) {
+                            memory.push(m);
+                        }
+                    }
+                    runs.push(run);
+                }
+            }
+        }
+    }
+    let medians = medians(&runs);
+    let ratios = ratios(
+        &runs,
+        &cases.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
+    );
+    let mut outcomes = Vec::new();
+    if options.outcome {
+        let threads = options.threads.iter().copied().max().unwrap_or(1);
+        for case in &cases {
+            for &code in &options.codes {
+                outcomes.push(outcome_run(case, code, threads, options));
+            }
+        }
+    }
+    let report = BenchReport {
+        provenance: crate::validate::machine_provenance(),
+        steps: options.steps,
+        prepare_s: options.prepare_s,
+        runs,
+        medians,
+        ratios,
+        outcomes,
+        memory,
+    };
+    write_report(&report, out)?;
+    Ok(report)
+}
+
+fn prepare(path: &Path, options: &BenchOptions) -> Result<PreparedCase, BenchError> {
+    let scene = Scene::load(path).map_err(|e| BenchError::Case(e.to_string()))?;
+    let file = path.display().to_string();
+    let [stage] = scene.stages.as_slice() else {
+        return Err(BenchError::Case(format!(
+            "{file}: the bench takes scenes of one stage with a duration; this one has {}",
+            scene.stages.len()
+        )));
+    };
+    let StageEnd::Duration(duration) = stage.end else {
+        return Err(BenchError::Case(format!(
+            "{file}: stage[0]: the bench needs a fixed duration (stage.duration), not a settling condition"
+        )));
+    };
+    if options.prepare_s >= duration {
+        return Err(BenchError::Case(format!(
+            "{file}: --prepare {} s is not shorter than the scene's {duration} s",
+            options.prepare_s
+        )));
+    }
+    let rotation = matches!(scene.contact, ContactSettings::Hertz(_));
+    // The step every code takes: the scene's explicit one, else cgdem's choice.
+    let mut dt = match (&scene.contact, scene.time_step) {
+        (_, TimeStepRequest::Explicit(dt)) => Some(dt),
+        (ContactSettings::Wca { .. }, _) => Some(
+            cgdem_core::run::time_step(&scene, false)
+                .map_err(|e| BenchError::Case(e.to_string()))?
+                .0,
+        ),
+        _ => None,
+    };
+    let state = if options.prepare_s > 0.0 {
+        let dir = options.out.join(&scene.name).join("prepare");
+        let threads = options.threads.iter().copied().max().unwrap_or(1);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| BenchError::Case(e.to_string()))?;
+        // In a pool of its own: rayon calls from outside any pool would each be handed over
+        // to the global pool and waited for.
+        let summary = pool
+            .install(|| {
+                run(
+                    &with_duration(&scene, options.prepare_s),
+                    &RunOptions {
+                        out_dir: dir,
+                        keep_final_state: true,
+                        ..Default::default()
+                    },
+                )
+            })
+            .map_err(|e| BenchError::Case(format!("preparing the state: {e}")))?;
+        dt = dt.or(Some(summary.dt_s));
+        summary.final_state.expect("asked for the final state")
+    } else {
+        cgdem_core::run::initial_particles(&scene, rotation, &[])
+            .map_err(|e| BenchError::Case(e.to_string()))?
+    };
+    let Some(dt) = dt else {
+        return Err(BenchError::Case(format!(
+            "{file}: give the time step ([time] dt) or --prepare > 0: a Hertz scene's step is chosen when cgdem runs it"
+        )));
+    };
+    let window = options.steps as Real * dt;
+    let remaining = duration - options.prepare_s;
+    Ok(PreparedCase {
+        name: scene.name.clone(),
+        timed: with_duration(&scene, window),
+        full: (options.outcome && remaining > window).then(|| with_duration(&scene, remaining)),
+        state,
+        dt,
+        reference_codes: rotation,
+    })
+}
+
+/// The scene cut to one stage of `duration`, with one output row (or dump frame) at its end
+/// and no VTK, so that output costs every code the same (nothing).
+fn with_duration(scene: &Scene, duration: Real) -> Scene {
+    let mut s = scene.clone();
+    s.stages[0].end = StageEnd::Duration(duration);
+    s.output.timeseries_interval = duration;
+    s.output.vtk_interval = 0.0;
+    s
+}
+
+fn runner(threads: usize, options: &BenchOptions) -> RunnerOptions {
+    RunnerOptions {
+        np: (threads > 1).then_some(threads as u32),
+        timeout: options.timeout,
+    }
+}
+
+/// One run of `code` on `scene` from the case's state in `dir`, plus cgdem's summary (with
+/// its final particles).
+fn run_code(
+    case: &PreparedCase,
+    scene: &Scene,
+    code: Code,
+    threads: usize,
+    dir: &Path,
+    options: &BenchOptions,
+) -> (RunResult, Option<cgdem_core::run::RunSummary>) {
+    let mut result = RunResult::default();
+    match code {
+        Code::Cgdem => {
+            let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => pool,
+                Err(e) => return (RunResult::failed(e.to_string()), None),
+            };
+            let run_options = RunOptions {
+                out_dir: dir.to_path_buf(),
+                initial_state: Some(case.state.clone()),
+                keep_final_state: true,
+                ..Default::default()
+            };
+            match pool.install(|| run(scene, &run_options)) {
+                Ok(summary) => {
+                    result.status = "completed".into();
+                    result.n_particles = summary.n_particles;
+                    result.steps = summary.steps;
+                    result.loop_s = Some(summary.wall_s);
+                    result.particle_steps = Some(summary.particle_steps);
+                    result.memory = summary.memory;
+                    return (result, Some(summary));
+                }
+                Err(e) => return (RunResult::failed(e.to_string()), None),
+            }
+        }
+        Code::Liggghts | Code::Lammps if !case.reference_codes => {
+            result.status = "skipped".into();
+            result.reason = Some(format!(
+                "the reference decks are written for Hertz scenes; `{}` uses the seed's WCA model (cgdem alone)",
+                case.name
+            ));
+            return (result, None);
+        }
+        Code::Liggghts => {
+            let deck = liggghts::deck::write_deck(scene, &case.state, case.dt);
+            finish_reference(
+                deck,
+                dir,
+                |dir| liggghts::runner::run_deck(dir, &runner(threads, options)),
+                liggghts::deck::LOG_FILE,
+                &mut result,
+            );
+        }
+        Code::Lammps => {
+            let deck = lammps::write_hertz_deck(scene, &case.state, case.dt);
+            finish_reference(
+                deck,
+                dir,
+                |dir| lammps::run_deck(dir, &runner(threads, options)),
+                lammps::runner::LOG_FILE,
+                &mut result,
+            );
+        }
+    }
+    (result, None)
+}
+
+#[derive(Clone, Debug, Default)]
+struct RunResult {
+    status: String,
+    reason: Option<String>,
+    n_particles: usize,
+    steps: u64,
+    loop_s: Option<Real>,
+    particle_steps: Option<u64>,
+    memory: Option<cgdem_core::simulation::MemoryUse>,
+    memory_mb: Option<Real>,
+}
+
+impl RunResult {
+    fn failed(reason: String) -> RunResult {
+        RunResult {
+            status: "failed".into(),
+            reason: Some(reason),
+            ..Default::default()
+        }
+    }
+}
+
+fn finish_reference(
+    deck: Result<lammps::Deck, lammps::DeckError>,
+    dir: &Path,
+    run_deck: impl Fn(&Path) -> RunStatus,
+    log_file: &str,
+    result: &mut RunResult,
+) {
+    let deck = match deck {
+        Ok(deck) => deck,
+        Err(e) => {
+            *result = RunResult::failed(e.to_string());
+            return;
+        }
+    };
+    if let Err(e) = deck.write_to(dir) {
+        *result = RunResult::failed(format!("cannot write the deck into {}: {e}", dir.display()));
+        return;
+    }
+    match run_deck(dir) {
+        RunStatus::Completed { .. } => {
+            let log = std::fs::read_to_string(dir.join(log_file)).unwrap_or_default();
+            let timing = log_timing(&log);
+            match timing {
+                Some(t) => {
+                    result.status = "completed".into();
+                    result.n_particles = t.atoms;
+                    result.steps = t.steps;
+                    result.loop_s = Some(t.loop_s);
+                    result.particle_steps = Some(t.particle_steps);
+                    result.memory_mb = t.memory_mb;
+                }
+                None => {
+                    *result = RunResult::failed(format!(
+                        "{}: no `Loop time of ...` line",
+                        dir.join(log_file).display()
+                    ))
+                }
+            }
+        }
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => {
+            result.status = "skipped".into();
+            result.reason = Some(format!("{reason}; install with `{install_hint}`"));
+        }
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => {
+            *result = RunResult::failed(format!("exit code {exit_code:?}; log tail:\n{log_tail}"));
+        }
+        RunStatus::TimedOut { after_s, log_tail } => {
+            result.status = "timed out".into();
+            result.reason = Some(format!(
+                "killed after {after_s:.0} s; log tail:\n{log_tail}"
+            ));
+        }
+    }
+}
+
+fn timed_run(
+    case: &PreparedCase,
+    code: Code,
+    threads: usize,
+    repetition: usize,
+    dir: &Path,
+    options: &BenchOptions,
+) -> (BenchRun, Option<BenchMemory>) {
+    let (result, _) = run_code(case, &case.timed, code, threads, dir, options);
+    let per_s = match (result.particle_steps, result.loop_s) {
+        (Some(ps), Some(s)) if s > 0.0 => Some(ps as Real / s),
+        _ => None,
+    };
+    let memory = result.memory.map(|m| BenchMemory {
+        case: case.name.clone(),
+        bytes_per_particle: m.particle_bytes as Real / m.particles.max(1) as Real,
+        bytes_per_listed_pair: m.pair_bytes as Real / m.pairs.max(1) as Real,
+        listed_pairs: m.pairs,
+        history_entries: m.history_entries,
+    });
+    let memory_mb = result
+        .memory
+        .map(|m| (m.particle_bytes + m.pair_bytes) as Real / 1e6)
+        .or(result.memory_mb);
+    (
+        BenchRun {
+            case: case.name.clone(),
+            code,
+            threads,
+            repetition,
+            status: result.status,
+            reason: result.reason,
+            n_particles: result.n_particles,
+            steps: result.steps,
+            loop_s: result.loop_s,
+            particle_steps_per_s: per_s,
+            memory_mb,
+            dir: dir.to_path_buf(),
+        },
+        memory,
+    )
+}
+
+fn outcome_run(
+    case: &PreparedCase,
+    code: Code,
+    threads: usize,
+    options: &BenchOptions,
+) -> BenchOutcome {
+    let Some(full) = &case.full else {
+        return BenchOutcome {
+            case: case.name.clone(),
+            code,
+            status: "skipped: the timed window already reaches the scene's end".into(),
+            simulated_s: 0.0,
+            heap: None,
+        };
+    };
+    let dir = options
+        .out
+        .join(&case.name)
+        .join(format!("{}-outcome", code.name()));
+    let (result, summary) = run_code(case, full, code, threads, &dir, options);
+    let simulated_s = match full.stages[0].end {
+        StageEnd::Duration(d) => d,
+        _ => 0.0,
+    };
+    let frozen: Vec<bool> = full.species.iter().map(|s| s.frozen).collect();
+    let axis = mobile_centroid(&case.state);
+    let floor_z = full.domain.lo.z;
+    let ring = full.max_diameter();
+    let heap = match (code, &summary) {
+        (Code::Cgdem, Some(s)) => s.final_state.as_ref().and_then(|p| {
+            conical_heap(
+                &p.position,
+                &p.radius,
+                |k| !p.is_frozen(k),
+                axis,
+                floor_z,
+                ring,
+            )
+        }),
+        (Code::Liggghts | Code::Lammps, _) if result.status == "completed" => {
+            let path = dir.join(lammps::deck::TRAJECTORY_FILE);
+            match read_dump(&path) {
+                Ok(frames) => frames.last().and_then(|f| {
+                    let (x, y, z, r, t) = (
+                        f.column("x")?,
+                        f.column("y")?,
+                        f.column("z")?,
+                        f.column("radius")?,
+                        f.column("type")?,
+                    );
+                    let positions: Vec<Vec3> =
+                        (0..f.len()).map(|k| Vec3::new(x[k], y[k], z[k])).collect();
+                    conical_heap(
+                        &positions,
+                        r,
+                        |k| !frozen.get(t[k] as usize - 1).copied().unwrap_or(false),
+                        axis,
+                        floor_z,
+                        ring,
+                    )
+                }),
+                Err(e) => {
+                    return BenchOutcome {
+                        case: case.name.clone(),
+                        code,
+                        status: format!("failed: {e}"),
+                        simulated_s,
+                        heap: None,
+                    }
+                }
+            }
+        }
+        _ => None,
+    };
+    BenchOutcome {
+        case: case.name.clone(),
+        code,
+        status: match &result.reason {
+            Some(reason) => format!("{}: {reason}", result.status),
+            None => result.status.clone(),
+        },
+        simulated_s,
+        heap,
+    }
+}
+
+/// Centre (x, y) of the mobile particles: the heap's axis.
+fn mobile_centroid(p: &Particles) -> Vec3 {
+    let (mut sum, mut n) = (Vec3::ZERO, 0usize);
+    for k in (0..p.len()).filter(|&k| !p.is_frozen(k)) {
+        sum += p.position[k];
+        n += 1;
+    }
+    if n == 0 {
+        Vec3::ZERO
+    } else {
+        Vec3::new(sum.x / n as Real, sum.y / n as Real, 0.0)
+    }
+}
+
+fn median(values: &mut [Real]) -> Real {
+    values.sort_by(|a, b| a.total_cmp(b));
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+fn medians(runs: &[BenchRun]) -> Vec<BenchMedian> {
+    let mut groups: BTreeMap<(String, Code, usize), Vec<Real>> = BTreeMap::new();
+    for r in runs {
+        if let Some(v) = r.particle_steps_per_s {
+            groups
+                .entry((r.case.clone(), r.code, r.threads))
+                .or_default()
+                .push(v);
+        }
+    }
+    let mut out: Vec<BenchMedian> = groups
+        .iter()
+        .map(|((case, code, threads), values)| {
+            let mut v = values.clone();
+            BenchMedian {
+                case: case.clone(),
+                code: *code,
+                threads: *threads,
+                runs: v.len(),
+                median_particle_steps_per_s: median(&mut v),
+                min_particle_steps_per_s: v[0],
+                max_particle_steps_per_s: v[v.len() - 1],
+                parallel_efficiency: None,
+            }
+        })
+        .collect();
+    let singles: Vec<(String, Code, Real)> = out
+        .iter()
+        .filter(|m| m.threads == 1)
+        .map(|m| (m.case.clone(), m.code, m.median_particle_steps_per_s))
+        .collect();
+    for m in &mut out {
+        if let Some((_, _, one)) = singles.iter().find(|s| s.0 == m.case && s.1 == m.code) {
+            m.parallel_efficiency = Some(m.median_particle_steps_per_s / (m.threads as Real * one));
+        }
+    }
+    out
+}
+
+/// Per repetition, cgdem over each other code on the same case, and cgdem on each case over
+/// cgdem on the first case.
+fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
+    let speed = |case: &str, code: Code, threads: usize, rep: usize| {
+        runs.iter()
+            .find(|r| {
+                r.case == case && r.code == code && r.threads == threads && r.repetition == rep
+            })
+            .and_then(|r| r.particle_steps_per_s)
+    };
+    let mut keys: Vec<(usize, usize)> = runs.iter().map(|r| (r.threads, r.repetition)).collect();
+    keys.sort();
+    keys.dedup();
+    let mut thread_counts: Vec<usize> = keys.iter().map(|k| k.0).collect();
+    thread_counts.dedup();
+    let mut out = Vec::new();
+    let mut push = |numerator: String, denominator: String, threads: usize, values: Vec<Real>| {
+        if !values.is_empty() {
+            let mut v = values.clone();
+            out.push(BenchRatio {
+                numerator,
+                denominator,
+                threads,
+                per_repetition: values,
+                median: median(&mut v),
+            });
+        }
+    };
+    for &threads in &thread_counts {
+        let reps: Vec<usize> = keys
+            .iter()
+            .filter(|k| k.0 == threads)
+            .map(|k| k.1)
+            .collect();
+        for case in cases {
+            for other in [Code::Liggghts, Code::Lammps] {
+                let values: Vec<Real> = reps
+                    .iter()
+                    .filter_map(|&rep| {
+                        Some(
+                            speed(case, Code::Cgdem, threads, rep)?
+                                / speed(case, other, threads, rep)?,
+                        )
+                    })
+                    .collect();
+                push(
+                    format!("{case} cgdem"),
+                    format!("{case} {}", other.name()),
+                    threads,
+                    values,
+                );
+            }
+        }
+        for case in cases.iter().skip(1) {
+            let values: Vec<Real> = reps
+                .iter()
+                .filter_map(|&rep| {
+                    Some(
+                        speed(case, Code::Cgdem, threads, rep)?
+                            / speed(&cases[0], Code::Cgdem, threads, rep)?,
+                    )
+                })
+                .collect();
+            push(
+                format!("{case} cgdem"),
+                format!("{} cgdem", cases[0]),
+                threads,
+                values,
+            );
+        }
+    }
+    out
+}
+
+fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
+    let io = |path: &Path, e: &dyn std::fmt::Display| BenchError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    std::fs::create_dir_all(out).map_err(|e| io(out, &e))?;
+    let json_path = out.join("bench.json");
+    let json = serde_json::to_string_pretty(report).map_err(|e| io(&json_path, &e))?;
+    cgdem_core::io::write_atomic(&json_path, json.as_bytes()).map_err(|e| io(&json_path, &e))?;
+    let mut csv = String::from("case,code,threads,repetition,status,n_particles,steps,loop_s,particle_steps_per_s,memory_mb\n");
+    let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+    for r in &report.runs {
+        csv += &format!(
+            "{},{},{},{},{},{},{},{},{},{}\n",
+            r.case,
+            r.code.name(),
+            r.threads,
+            r.repetition,
+            r.status,
+            r.n_particles,
+            r.steps,
+            opt(r.loop_s),
+            opt(r.particle_steps_per_s),
+            opt(r.memory_mb)
+        );
+    }
+    let csv_path = out.join("bench_runs.csv");
+    cgdem_core::io::write_atomic(&csv_path, csv.as_bytes()).map_err(|e| io(&csv_path, &e))?;
+    let bars: Vec<(String, String, f64, Option<f64>)> = report
+        .medians
+        .iter()
+        .map(|m| {
+            (
+                format!("{}, {} thread(s)", m.case, m.threads),
+                m.code.name().to_string(),
+                m.median_particle_steps_per_s / 1e6,
+                Some(0.5 * (m.max_particle_steps_per_s - m.min_particle_steps_per_s) / 1e6),
+            )
+        })
+        .collect();
+    if !bars.is_empty() {
+        write_bar_chart(
+            out,
+            "throughput",
+            &format!(
+                "Throughput, median of {} alternating runs of {} steps (error bar: half the range)",
+                report
+                    .runs
+                    .iter()
+                    .map(|r| r.repetition + 1)
+                    .max()
+                    .unwrap_or(0),
+                report.steps
+            ),
+            "million particle-steps per second",
+            &bars,
+        )
+        .map_err(|e| io(&out.join("throughput.png"), &e))?;
+    }
+    Ok(())
+}
+
+/// The report as text: medians, ratios, outcomes and memory.
+pub fn format_report(report: &BenchReport) -> String {
+    let mut s = String::new();
+    s += "case | code | threads | runs | median particle-steps/s | range | parallel efficiency\n";
+    for m in &report.medians {
+        s += &format!(
+            "{} | {} | {} | {} | {:.3e} | {:.3e} .. {:.3e} | {}\n",
+            m.case,
+            m.code.name(),
+            m.threads,
+            m.runs,
+            m.median_particle_steps_per_s,
+            m.min_particle_steps_per_s,
+            m.max_particle_steps_per_s,
+            m.parallel_efficiency
+                .map_or("-".into(), |e| format!("{:.0}%", 100.0 * e))
+        );
+    }
+    s += "\nratio | threads | median | per repetition\n";
+    for r in &report.ratios {
+        s += &format!(
+            "{} / {} | {} | {:.2} | {}\n",
+            r.numerator,
+            r.denominator,
+            r.threads,
+            r.median,
+            r.per_repetition
+                .iter()
+                .map(|v| format!("{v:.2}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+    }
+    if !report.outcomes.is_empty() {
+        s += "\noutcome | code | simulated s | heap height mm | edge radius mm | flank slope deg | status\n";
+        for o in &report.outcomes {
+            let (h, e, a) = o.heap.map_or(("-".into(), "-".into(), "-".into()), |h| {
+                (
+                    format!("{:.2}", 1e3 * h.height_m),
+                    format!("{:.1}", 1e3 * h.edge_radius_m),
+                    format!("{:.2}", h.slope_deg),
+                )
+            });
+            s += &format!(
+                "{} | {} | {:.3} | {h} | {e} | {a} | {}\n",
+                o.case,
+                o.code.name(),
+                o.simulated_s,
+                o.status.lines().next().unwrap_or("")
+            );
+        }
+    }
+    for m in &report.memory {
+        s += &format!(
+            "\nmemory ({}): {:.0} bytes per particle, {:.0} bytes per listed pair ({} pairs, {} history entries)\n",
+            m.case, m.bytes_per_particle, m.bytes_per_listed_pair, m.listed_pairs, m.history_entries
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ratios_pair_adjacent_runs_and_take_the_median() {
+        let run = |code, rep, v| BenchRun {
+            case: "heap".into(),
+            code,
+            threads: 1,
+            repetition: rep,
+            status: "completed".into(),
+            reason: None,
+            n_particles: 1,
+            steps: 1,
+            loop_s: Some(1.0),
+            particle_steps_per_s: Some(v),
+            memory_mb: None,
+            dir: PathBuf::new(),
+        };
+        let runs = vec![
+            run(Code::Cgdem, 0, 10.0),
+            run(Code::Lammps, 0, 5.0),
+            run(Code::Cgdem, 1, 9.0),
+            run(Code::Lammps, 1, 3.0),
+            run(Code::Cgdem, 2, 12.0),
+            run(Code::Lammps, 2, 5.0),
+        ];
+        let r = ratios(&runs, &["heap".into()]);
+        assert_eq!(r.len(), 1);
+        assert_eq!(r[0].per_repetition, vec![2.0, 3.0, 2.4]);
+        assert_eq!(r[0].median, 2.4);
+        let m = medians(&runs);
+        assert_eq!(m[0].median_particle_steps_per_s, 10.0);
+        assert_eq!(m[0].parallel_efficiency, Some(1.0));
+    }
+}

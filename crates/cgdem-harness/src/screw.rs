@@ -1,0 +1,222 @@
+//! The report section of a screw-feeder case (a scene with `[conveying]`): mass flow against
+//! screw speed for every code with its block-average standard error, beside Eq. (7) with
+//! each code's measured fill ratio (paper A Fig. 8), and a table of the numbers. Every code's
+//! flow is measured the same way (`analysis::conveying`: cgdem from its state, LIGGGHTS and
+//! LAMMPS from their dumps, `lammps::postprocess::conveying_samples`).
+
+use std::path::Path;
+
+use super::suite::{Code, SuiteCase};
+use super::validate::{output_error, RunRecord, ValidateError};
+use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
+use cgdem_core::scene::Scene;
+
+/// One code's points at one speed: the mean over seeds of the flow, its standard error
+/// (the block errors combined, `sqrt(sum se^2) / n`) and Eq. (7).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedPoint {
+    pub rpm: f64,
+    pub mass_flow_kg_s: f64,
+    pub std_error_kg_s: f64,
+    pub eq7_mass_flow_kg_s: f64,
+}
+
+/// Per code, its points in order of speed (runs without a measurement left out).
+pub fn points_by_code(runs: &[RunRecord]) -> Vec<(Code, Vec<SpeedPoint>)> {
+    let mut out: Vec<(Code, Vec<SpeedPoint>)> = Vec::new();
+    for code in [Code::Cgdem, Code::Liggghts, Code::Lammps] {
+        let mut speeds: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.code == code)
+            .filter_map(|r| r.rpm)
+            .collect();
+        speeds.sort_by(f64::total_cmp);
+        speeds.dedup();
+        let mut points = Vec::new();
+        for rpm in speeds {
+            let at: Vec<&RunRecord> = runs
+                .iter()
+                .filter(|r| r.code == code && r.rpm == Some(rpm) && r.status == "ok")
+                .filter(|r| r.mass_flow_kg_s.is_some())
+                .collect();
+            if at.is_empty() {
+                continue;
+            }
+            let n = at.len() as f64;
+            let mean =
+                |f: fn(&RunRecord) -> Option<f64>| at.iter().filter_map(|r| f(r)).sum::<f64>() / n;
+            let se2: f64 = at
+                .iter()
+                .filter_map(|r| r.mass_flow_std_error_kg_s)
+                .map(|e| e * e)
+                .sum();
+            points.push(SpeedPoint {
+                rpm,
+                mass_flow_kg_s: mean(|r| r.mass_flow_kg_s),
+                std_error_kg_s: se2.sqrt() / n,
+                eq7_mass_flow_kg_s: mean(|r| r.eq7_mass_flow_kg_s),
+            });
+        }
+        if !points.is_empty() {
+            out.push((code, points));
+        }
+    }
+    out
+}
+
+/// Per code of `runs`, its mass flow against speed with error bars and its Eq. (7) line
+/// (dashed), labelled `label(code)`.
+fn with_speed_series(
+    mut figure: Figure,
+    runs: &[RunRecord],
+    label: impl Fn(Code) -> String,
+) -> Figure {
+    for (code, points) in points_by_code(runs) {
+        figure = figure
+            .with_series(
+                Series::new(
+                    label(code),
+                    points.iter().map(|p| (p.rpm, p.mass_flow_kg_s)).collect(),
+                )
+                .style(SeriesStyle::LineMarkers)
+                .y_err(points.iter().map(|p| p.std_error_kg_s).collect()),
+            )
+            .with_series(
+                Series::new(
+                    format!("Eq. (7), {} fill", label(code)),
+                    points
+                        .iter()
+                        .map(|p| (p.rpm, p.eq7_mass_flow_kg_s))
+                        .collect(),
+                )
+                .style(SeriesStyle::Dashed),
+            );
+    }
+    figure
+}
+
+/// One figure of every screw case of a suite together (e.g. the mesh screw in cgdem and
+/// LIGGGHTS and the particle screw in cgdem and LAMMPS, which has no mesh walls): each code
+/// and case its own series, with its Eq. (7) line; under `figures/screw_overview/`.
+pub fn write_screw_overview(
+    report: &mut Report,
+    cases: &[(&Scene, &[RunRecord])],
+    out: &Path,
+) -> Result<(), ValidateError> {
+    let mut figure = Figure::new(
+        "Screw feeder: mass flow against speed, every code and screw (paper A Fig. 8)",
+        "screw speed (rpm)",
+        "mass flow (kg/s)",
+    );
+    for (scene, runs) in cases {
+        figure = with_speed_series(figure, runs, |code| {
+            format!("{}, {}", code.name(), scene.name)
+        });
+    }
+    if figure.series.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<&str> = cases.iter().map(|(s, _)| s.name.as_str()).collect();
+    let section = report.section("Screw feeder: every code in one figure");
+    section.paragraph(format!(
+        "The screw cases {names:?} together: each code with the screw it can run (LIGGGHTS takes mesh walls only, LAMMPS has no mesh walls and runs the screw built of particles), measured by the same rule; the numbers are in each case's section. Dashed: Eq. (7) with each run's measured fill ratio."
+    ));
+    let dir = out.join("figures").join("screw_overview");
+    let files =
+        write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;
+    section
+        .figure(
+            &files,
+            "mass flow against screw speed, one series per code and screw case, with Eq. (7)",
+            "Mass flow against screw speed for every code and screw case (mean over seeds), with Eq. (7) for each one's measured fill ratio.",
+        )
+        .map_err(|e| output_error(&files.png, e))?;
+    Ok(())
+}
+
+/// The section: the figure (PNG, SVG and CSV under `figures/<case>/`) and the table.
+pub fn write_screw_section(
+    report: &mut Report,
+    scene: &Scene,
+    case: &SuiteCase,
+    runs: &[RunRecord],
+    out: &Path,
+) -> Result<(), ValidateError> {
+    let dir = out.join("figures").join(&scene.name);
+    let section = report.section(format!(
+        "Case {}: mass flow against screw speed",
+        scene.name
+    ));
+    let flow_rule = scene
+        .conveying
+        .as_ref()
+        .map(cgdem_core::analysis::conveying::flow_rule)
+        .unwrap_or_default();
+    section.paragraph(format!(
+        "{} Scene file: {}. Speeds: {:?} rpm (the conveying stage and its discarded start-up scaled to the same number of turns at every speed). Seeds: {:?}. Mass flow {flow_rule}, the same rule for every code (LIGGGHTS and LAMMPS from their dumps: a grain that vanishes counts as deleted with its mass); error bars: block-average standard error. Dashed: Eq. (7) with the code's measured fill ratio, (pi/4)(Ds^2 - ds^2) ps ns rho_p times the solid fill ratio.",
+        scene.description,
+        case.file.display(),
+        case.rpms,
+        case.seeds
+    ));
+    if case.keep_going {
+        section.paragraph("cgdem's guards only warn in this case (suite entry `keep_going = true`): grains wedge between the flight's tip and the casing, a clearance narrower than a grain, deeper than the overlap guard allows; the warnings and the deepest overlap are in each run's summary.json.");
+    }
+    let mut figure = Figure::new(
+        "Screw feeder: mass flow against speed (paper A Fig. 8)",
+        "screw speed (rpm)",
+        "mass flow (kg/s)",
+    );
+    figure = with_speed_series(figure, runs, |code| code.name().to_string());
+    if !figure.series.is_empty() {
+        let files =
+            write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;
+        section
+            .figure(
+                &files,
+                "mass flow against screw speed, one series per code, with Eq. (7)",
+                "Mass flow against screw speed per code (mean over seeds), with Eq. (7) for each code's measured fill ratio.",
+            )
+            .map_err(|e| output_error(&files.png, e))?;
+    }
+    let mut table = Table::new([
+        "code",
+        "rpm",
+        "seed",
+        "status",
+        "mass flow (kg/s)",
+        "std error (kg/s)",
+        "fill ratio",
+        "bulk density (kg/m3)",
+        "Eq. (7) (kg/s)",
+        "flow / Eq. (7)",
+        "wall s",
+    ])
+    .caption("Screw runs: the conveying measurement of every code and speed");
+    let num = |v: Option<f64>, digits: usize| {
+        Cell::num(v.map_or("-".into(), |x| format!("{x:.digits$}")))
+    };
+    for r in runs {
+        let status = match r.status.as_str() {
+            "ok" if r.partial => Cell::skipped(r.reason.clone().unwrap_or_default()),
+            "ok" => Cell::pass("ok"),
+            "skipped" => Cell::skipped(r.reason.clone().unwrap_or_default()),
+            _ => Cell::fail(r.reason.clone().unwrap_or_default()),
+        };
+        table.row([
+            Cell::text(r.code.name()),
+            num(r.rpm, 0),
+            Cell::num(r.seed.to_string()),
+            status,
+            num(r.mass_flow_kg_s, 3),
+            num(r.mass_flow_std_error_kg_s, 3),
+            num(r.fill_ratio, 3),
+            num(r.bulk_density_kg_m3, 0),
+            num(r.eq7_mass_flow_kg_s, 3),
+            num(r.ratio_to_eq7, 3),
+            num(r.wall_s, 0),
+        ]);
+    }
+    section.table(table);
+    Ok(())
+}

@@ -1,0 +1,399 @@
+//! Suite files (`validation/suites/*.toml`): which cases, codes, lambda levels, rules and
+//! seeds a validation run covers, and the tolerances it is judged by.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::accuracy::{AccuracySweep, RawSweep};
+use cgdem_core::coarse_graining::CoarseGrainRule;
+use cgdem_core::scene::{Override, Scene, SceneError};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Code {
+    Cgdem,
+    Lammps,
+    Liggghts,
+}
+
+impl Code {
+    pub fn name(self) -> &'static str {
+        match self {
+            Code::Cgdem => "cgdem",
+            Code::Lammps => "lammps",
+            Code::Liggghts => "liggghts",
+        }
+    }
+
+    /// The code a suite file names: "cgdem", "lammps" or "liggghts".
+    pub fn from_name(name: &str) -> Option<Code> {
+        [Code::Cgdem, Code::Lammps, Code::Liggghts]
+            .into_iter()
+            .find(|c| c.name() == name)
+    }
+}
+
+/// The scene of a suite entry: its file with the overrides applied, named after the
+/// variant (`aor_collapse-smooth-walls`) when there is one.
+pub(crate) fn load_variant(
+    file: &Path,
+    overrides: &[Override],
+    variant: Option<&str>,
+) -> Result<Scene, SceneError> {
+    let mut scene = Scene::load_with_overrides(file, overrides)?;
+    if let Some(v) = variant {
+        scene.name = format!("{}-{v}", scene.name);
+    }
+    Ok(scene)
+}
+
+/// A suite entry's `set` overrides, checked with its `variant` name: a name of letters,
+/// digits, `-` and `_`, required when `set` changes the scene. `entry` names the entry in
+/// messages (`case[2]`).
+pub(crate) fn parse_variant(
+    set: &[String],
+    variant: Option<&str>,
+    entry: &str,
+    path: &Path,
+) -> Result<Vec<Override>, SuiteError> {
+    let invalid = |field: &str, value: String, allowed: String| SuiteError::Invalid {
+        file: path.to_path_buf(),
+        field: format!("{entry}.{field}"),
+        value,
+        allowed,
+    };
+    let overrides = set
+        .iter()
+        .map(|o| Override::parse(o, path))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| invalid("set", format!("{set:?}"), e.to_string()))?;
+    let name_ok = |v: &str| {
+        !v.is_empty()
+            && v.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+    };
+    match variant {
+        Some(v) if !name_ok(v) => Err(invalid(
+            "variant",
+            format!("\"{v}\""),
+            "a name of letters, digits, `-` and `_`".into(),
+        )),
+        None if !overrides.is_empty() => Err(invalid(
+            "variant",
+            "(missing)".into(),
+            "a name for the variant that `set` makes, e.g. variant = \"smooth-walls\"".into(),
+        )),
+        _ => Ok(overrides),
+    }
+}
+
+/// A suite entry's `codes`, by name; `field` names the list in messages.
+pub(crate) fn parse_codes(
+    names: &[String],
+    field: &str,
+    path: &Path,
+) -> Result<Vec<Code>, SuiteError> {
+    names
+        .iter()
+        .map(|name| {
+            Code::from_name(name).ok_or_else(|| SuiteError::Invalid {
+                file: path.to_path_buf(),
+                field: field.into(),
+                value: format!("\"{name}\""),
+                allowed: "\"cgdem\", \"lammps\" or \"liggghts\"".into(),
+            })
+        })
+        .collect()
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SuiteCase {
+    /// The scene file, relative to the repository root (the working directory).
+    pub file: PathBuf,
+    pub codes: Vec<Code>,
+    pub lambdas: Vec<u32>,
+    pub cg_rules: Vec<CoarseGrainRule>,
+    pub seeds: Vec<u64>,
+    /// Largest acceptable repose-angle difference between codes or levels, degrees, when
+    /// it is not already within the combined seed spread.
+    pub angle_tolerance_deg: f64,
+    /// Largest acceptable |ratio - 1| of the characteristic flow times (`t_half`, the time
+    /// for the front to cover half its largest advance) between codes or levels.
+    pub time_ratio_tolerance: f64,
+    /// Largest acceptable gap between two front-position histories, as a fraction of the
+    /// box length.
+    pub front_tolerance: f64,
+    /// Scene overrides (`KEY=VALUE`) that make this case a variant of its file.
+    pub overrides: Vec<Override>,
+    /// The variant's name, appended to the scene's name (`aor_collapse-smooth-walls`) in run
+    /// directories and the report; required with `set`.
+    pub variant: Option<String>,
+    /// Screw speeds (rev/min) for a scene with `[conveying]`: one run per speed, the stage
+    /// scaled to the same number of turns (`sweep::at_speed`); empty: the scene's own speed.
+    pub rpms: Vec<f64>,
+    /// cgdem's guards only warn in this case's runs (as `--keep-going`): for a case whose
+    /// geometry is known to wedge grains deeper than the overlap guard allows (the screw
+    /// feeder's tip clearance is narrower than a grain); the warnings stay in each run's
+    /// summary, and the reference codes, which have no such guard, run it alike.
+    pub keep_going: bool,
+}
+
+impl SuiteCase {
+    /// The case's scene: its file with the overrides applied, named after the variant.
+    pub fn load_scene(&self) -> Result<Scene, SceneError> {
+        load_variant(&self.file, &self.overrides, self.variant.as_deref())
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Suite {
+    pub name: String,
+    pub description: String,
+    pub source: PathBuf,
+    pub cases: Vec<SuiteCase>,
+    /// Error-against-run-time sweeps (`[[accuracy]]`).
+    pub accuracy: Vec<AccuracySweep>,
+    /// `[[stability]]` cases (`harness::stability`).
+    pub stability: Vec<super::stability::StabilityCase>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SuiteError {
+    #[error("{file}: cannot read the suite file: {source}")]
+    Unreadable {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{file}: not a valid suite file: {message}")]
+    Syntax { file: PathBuf, message: String },
+    #[error("{file}: field `{field}` = {value} is not allowed: {allowed}")]
+    Invalid {
+        file: PathBuf,
+        field: String,
+        value: String,
+        allowed: String,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSuite {
+    name: String,
+    #[serde(default)]
+    description: String,
+    #[serde(rename = "case", default)]
+    cases: Vec<RawCase>,
+    #[serde(default)]
+    accuracy: Vec<RawSweep>,
+    #[serde(default)]
+    stability: Vec<super::stability::RawStabilityCase>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCase {
+    file: PathBuf,
+    codes: Vec<String>,
+    lambdas: Vec<u32>,
+    #[serde(default)]
+    cg_rules: Vec<String>,
+    seeds: Vec<u64>,
+    angle_tolerance_deg: Option<f64>,
+    time_ratio_tolerance: Option<f64>,
+    front_tolerance: Option<f64>,
+    #[serde(default)]
+    set: Vec<String>,
+    variant: Option<String>,
+    #[serde(default)]
+    rpms: Vec<f64>,
+    #[serde(default)]
+    keep_going: bool,
+}
+
+impl Suite {
+    pub fn load(path: &Path) -> Result<Suite, SuiteError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SuiteError::Unreadable {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Suite::parse(&text, path)
+    }
+
+    /// Validates suite text; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Suite, SuiteError> {
+        let raw: RawSuite = toml::from_str(text).map_err(|e| SuiteError::Syntax {
+            file: path.to_path_buf(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        })?;
+        let invalid = |field: String, value: String, allowed: &str| SuiteError::Invalid {
+            file: path.to_path_buf(),
+            field,
+            value,
+            allowed: allowed.into(),
+        };
+        let mut cases = Vec::new();
+        for (k, c) in raw.cases.into_iter().enumerate() {
+            let codes = parse_codes(&c.codes, &format!("case[{k}].codes"), path)?;
+            if codes.is_empty() {
+                return Err(invalid(
+                    format!("case[{k}].codes"),
+                    "[]".into(),
+                    "at least one code",
+                ));
+            }
+            if c.lambdas.is_empty() || c.lambdas.iter().any(|l| !l.is_power_of_two()) {
+                return Err(invalid(
+                    format!("case[{k}].lambdas"),
+                    format!("{:?}", c.lambdas),
+                    "one or more powers of two",
+                ));
+            }
+            if c.seeds.is_empty() {
+                return Err(invalid(
+                    format!("case[{k}].seeds"),
+                    "[]".into(),
+                    "at least one insertion seed",
+                ));
+            }
+            let cg_rules = if c.cg_rules.is_empty() {
+                vec![CoarseGrainRule::Seed]
+            } else {
+                c.cg_rules
+                    .iter()
+                    .map(|name| match name.as_str() {
+                        "seed" => Ok(CoarseGrainRule::Seed),
+                        "bulk-viscosity" => Ok(CoarseGrainRule::BulkViscosity),
+                        other => Err(invalid(
+                            format!("case[{k}].cg_rules"),
+                            format!("\"{other}\""),
+                            "\"seed\" or \"bulk-viscosity\"",
+                        )),
+                    })
+                    .collect::<Result<Vec<_>, _>>()?
+            };
+            let angle_tolerance_deg = c.angle_tolerance_deg.unwrap_or(2.0);
+            if angle_tolerance_deg.is_nan() || angle_tolerance_deg <= 0.0 {
+                return Err(invalid(
+                    format!("case[{k}].angle_tolerance_deg"),
+                    angle_tolerance_deg.to_string(),
+                    "a number of degrees > 0",
+                ));
+            }
+            let fraction = |field: &str, value: Option<f64>, default: f64| {
+                let v = value.unwrap_or(default);
+                if v.is_finite() && v > 0.0 && v < 1.0 {
+                    Ok(v)
+                } else {
+                    Err(invalid(
+                        format!("case[{k}].{field}"),
+                        v.to_string(),
+                        "a fraction between 0 and 1 (exclusive)",
+                    ))
+                }
+            };
+            let time_ratio_tolerance =
+                fraction("time_ratio_tolerance", c.time_ratio_tolerance, 0.10)?;
+            let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
+            let overrides =
+                parse_variant(&c.set, c.variant.as_deref(), &format!("case[{k}]"), path)?;
+            if let Some(bad) = c.rpms.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+                return Err(invalid(
+                    format!("case[{k}].rpms"),
+                    bad.to_string(),
+                    "screw speeds in rev/min, finite and > 0",
+                ));
+            }
+            cases.push(SuiteCase {
+                file: c.file,
+                codes,
+                lambdas: c.lambdas,
+                cg_rules,
+                seeds: c.seeds,
+                angle_tolerance_deg,
+                time_ratio_tolerance,
+                front_tolerance,
+                overrides,
+                variant: c.variant,
+                rpms: c.rpms,
+                keep_going: c.keep_going,
+            });
+        }
+        let accuracy = raw
+            .accuracy
+            .into_iter()
+            .enumerate()
+            .map(|(k, a)| AccuracySweep::from_raw(a, k, path))
+            .collect::<Result<Vec<_>, _>>()?;
+        let stability = super::stability::parse_cases(raw.stability, path)?;
+        if cases.is_empty() && accuracy.is_empty() && stability.is_empty() {
+            return Err(invalid(
+                "case".into(),
+                "(none)".into(),
+                "at least one [[case]], [[accuracy]] or [[stability]]",
+            ));
+        }
+        Ok(Suite {
+            name: raw.name,
+            description: raw.description,
+            source: path.to_path_buf(),
+            cases,
+            accuracy,
+            stability,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CASE: &str = "name = \"t\"\n[[case]]\nfile = \"validation/cases/aor_smoke.toml\"\ncodes = [\"cgdem\"]\nlambdas = [8]\nseeds = [1]\n";
+
+    #[test]
+    fn a_variant_overrides_its_scene_and_is_named_after_it() {
+        crate::at_repo_root();
+        let text =
+            format!("{CASE}set = [\"wall_contact.friction=0.0\"]\nvariant = \"smooth-walls\"\n");
+        let suite = Suite::parse(&text, Path::new("s.toml")).unwrap();
+        let scene = suite.cases[0].load_scene().unwrap();
+        let plain = Scene::load(Path::new("validation/cases/aor_smoke.toml")).unwrap();
+        assert_eq!(scene.name, format!("{}-smooth-walls", plain.name));
+        assert_ne!(scene.digest(), plain.digest());
+        assert_ne!(scene.wall_contact, plain.wall_contact);
+    }
+
+    #[test]
+    fn keep_going_is_per_case_and_off_unless_asked() {
+        let suite = Suite::parse(CASE, Path::new("s.toml")).unwrap();
+        assert!(!suite.cases[0].keep_going);
+        let suite =
+            Suite::parse(&format!("{CASE}keep_going = true\n"), Path::new("s.toml")).unwrap();
+        assert!(suite.cases[0].keep_going);
+    }
+
+    #[test]
+    fn set_needs_a_variant_name_and_valid_overrides() {
+        let e = Suite::parse(
+            &format!("{CASE}set = [\"wall_contact.friction=0.0\"]\n"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("case[0].variant") && e.contains("(missing)"),
+            "{e}"
+        );
+        let e = Suite::parse(
+            &format!("{CASE}set = [\"friction\"]\nvariant = \"v\"\n"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("case[0].set") && e.contains("KEY=VALUE"), "{e}");
+        let e = Suite::parse(&format!("{CASE}variant = \"a b\"\n"), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("case[0].variant"), "{e}");
+    }
+}

@@ -1,0 +1,1279 @@
+//! `cgdem validate`: run a suite, compare the runs, write `summary.json` and `index.html`.
+//!
+//! Every run, whatever the code, leaves the same files in its own directory (`summary.json`,
+//! `profile.csv`, `timeseries.csv`); the comparisons and plots read only those, so the
+//! reference codes go through exactly the same post-processing as cgdem.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::dynamics::{flow_difference, FlowSeries};
+use super::suite::{Code, Suite, SuiteCase};
+use crate::report::{
+    write_bar_chart, write_figure, Cell, Figure, Report, Series, SeriesStyle, Table,
+};
+use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
+use cgdem_core::io::write_atomic;
+use cgdem_core::run::{run, Progress, RunOptions};
+use cgdem_core::scene::Scene;
+
+/// One run of one code, as recorded in the suite's `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunRecord {
+    pub case: String,
+    pub code: Code,
+    pub lambda: u32,
+    pub cg_rule: CoarseGrainRule,
+    pub seed: u64,
+    /// "ok", "failed" or "skipped".
+    pub status: String,
+    pub reason: Option<String>,
+    pub dir: PathBuf,
+    pub n_particles: Option<u64>,
+    pub steps: Option<u64>,
+    pub wall_s: Option<f64>,
+    pub particle_steps_per_s: Option<f64>,
+    pub repose_angle_deg: Option<f64>,
+    pub repose_fit_r2: Option<f64>,
+    pub runout_m: Option<f64>,
+    /// The run was not repeated: its directory already held it (`--reuse`).
+    pub reused: bool,
+    /// The run stopped before its last stage ended (time limit, killed, stopped by a
+    /// guard): its fixed-time samples and histories count, its final state does not.
+    pub partial: bool,
+    /// Screw speed of a conveying case run at a suite's `rpms`, rev/min.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rpm: Option<f64>,
+    /// The conveying measurement (`analysis::conveying`) of a screw case.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_flow_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_flow_std_error_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fill_ratio: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bulk_density_kg_m3: Option<f64>,
+    /// Eq. (7) with the measured fill ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eq7_mass_flow_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio_to_eq7: Option<f64>,
+}
+
+/// One judged comparison.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    pub case: String,
+    /// "codes" (two codes at one level) or "levels" (one code at two levels).
+    pub kind: String,
+    /// "final state" (repose angle, in degrees) or "dynamics" (characteristic-time ratio
+    /// `t_half`, judged as |ratio - 1|, and the front-history gap): a pair is similar only if
+    /// both pass.
+    pub part: String,
+    pub what: String,
+    /// The numbers behind the verdict, in words.
+    pub detail: String,
+    pub difference: f64,
+    pub combined_spread: f64,
+    pub tolerance: f64,
+    pub within_spread: bool,
+    pub pass: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ValidationSummary {
+    pub suite: String,
+    pub provenance: BTreeMap<String, String>,
+    pub runs: Vec<RunRecord>,
+    pub comparisons: Vec<Comparison>,
+    /// Error against run time (the suite's `[[accuracy]]` sweeps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<super::accuracy::AccuracySummary>,
+    /// The `[[stability]]` cases' verdicts, one per case and code.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stability: Vec<super::stability::StabilityRecord>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ValidateError {
+    #[error(transparent)]
+    Suite(#[from] super::suite::SuiteError),
+    #[error("{file}: {message}")]
+    Case { file: PathBuf, message: String },
+    #[error("cannot write {path}: {message}")]
+    Output { path: PathBuf, message: String },
+}
+
+pub(super) fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateError {
+    ValidateError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+#[derive(Clone)]
+pub struct ValidateOptions {
+    pub suite: PathBuf,
+    pub out: PathBuf,
+    pub quiet: bool,
+    /// Where cgdem's runs report their progress.
+    pub progress: Option<Progress>,
+    /// Time limit of one reference-code run, seconds.
+    pub reference_timeout_s: u64,
+    /// Reuse a run directory that already holds this exact run (an interrupted suite resumes;
+    /// a report is rebuilt without re-running): when its summary's scene digest matches, or
+    /// for a reference run without one, when its deck is the one the case writes now (its
+    /// dumps are then post-processed again by the current code).
+    pub reuse: bool,
+    /// cgdem's guards only warn instead of stopping a run (`--keep-going`).
+    pub keep_going: bool,
+    /// Runs of a case made at the same time (`--jobs`), sharing the threads.
+    pub jobs: usize,
+}
+
+/// Runs every case of the suite with every code, level, rule and seed; a run that fails is
+/// recorded with its reason and the suite goes on.
+pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, ValidateError> {
+    let suite = Suite::load(&options.suite)?;
+    std::fs::create_dir_all(&options.out).map_err(|e| output_error(&options.out, e))?;
+    let mut runs = Vec::new();
+    let mut comparisons = Vec::new();
+    let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
+    let provenance = provenance(&suite, options);
+    // Cases of one scene (e.g. its two coarse-graining rules) are compared and reported
+    // together: one section, one set of figures, judged by the first case's tolerances.
+    let mut scenes: Vec<(Scene, &SuiteCase, Vec<RunRecord>)> = Vec::new();
+    for case in &suite.cases {
+        let scene = case.load_scene().map_err(|e| ValidateError::Case {
+            file: case.file.clone(),
+            message: e.to_string(),
+        })?;
+        let case_runs = run_case(&scene, case, options)?;
+        match scenes.iter_mut().find(|(s, _, _)| s.name == scene.name) {
+            Some((_, _, earlier)) => earlier.extend(case_runs),
+            None => scenes.push((scene, case, case_runs)),
+        }
+    }
+    let screws: Vec<(&Scene, &[RunRecord])> = scenes
+        .iter()
+        .filter(|(s, _, _)| s.conveying.is_some())
+        .map(|(s, _, r)| (s, r.as_slice()))
+        .collect();
+    if screws.len() > 1 {
+        super::screw::write_screw_overview(&mut report, &screws, &options.out)?;
+    }
+    for (scene, case, case_runs) in scenes {
+        if scene.conveying.is_some() {
+            // A screw case is judged by its mass flow against Eq. (7), code by code.
+            super::screw::write_screw_section(&mut report, &scene, case, &case_runs, &options.out)?;
+            runs.extend(case_runs);
+            continue;
+        }
+        let case_comparisons = compare(&scene, case, &case_runs);
+        write_case_section(
+            &mut report,
+            &scene,
+            case,
+            &case_runs,
+            &case_comparisons,
+            &options.out,
+        )?;
+        runs.extend(case_runs);
+        comparisons.extend(case_comparisons);
+    }
+    let accuracy = super::accuracy::run_sweeps(&suite, options, &mut report)?;
+    let stability = super::stability::run_stability(
+        &suite.stability,
+        &options.out,
+        options.quiet,
+        options.keep_going,
+        options.reference_timeout_s,
+        &mut report,
+    )
+    .map_err(|message| ValidateError::Case {
+        file: suite.source.clone(),
+        message,
+    })?;
+    let summary = ValidationSummary {
+        suite: suite.name.clone(),
+        provenance,
+        runs,
+        comparisons,
+        accuracy,
+        stability,
+    };
+    let intro = report.intro();
+    intro.paragraph(format!(
+        "{} {}",
+        suite.description,
+        "Each run's files are under runs/; figures have their data as CSV beside them."
+    ));
+    let mut table = Table::new([
+        "case",
+        "comparison",
+        "part",
+        "what",
+        "difference",
+        "combined seed spread",
+        "tolerance",
+        "verdict",
+    ])
+    .caption("Summary: every comparison against its stated tolerance (final state: repose angle in degrees; dynamics: |t_half ratio - 1| and the front-history gap)");
+    for c in &summary.comparisons {
+        table.row(std::iter::once(Cell::text(&c.case)).chain(comparison_cells(c)));
+    }
+    let mut run_table = Table::new([
+        "case",
+        "code",
+        "lambda",
+        "rule",
+        "seed",
+        "status",
+        "particles",
+        "wall s",
+        "particle-steps/s",
+    ])
+    .caption("Runs");
+    for r in &summary.runs {
+        let status = match r.status.as_str() {
+            "ok" if r.partial => Cell::skipped(r.reason.clone().unwrap_or_default()),
+            "ok" if r.reused => Cell::pass("ok (reused)"),
+            "ok" => Cell::pass("ok"),
+            "skipped" => {
+                Cell::skipped(format!("skipped: {}", r.reason.clone().unwrap_or_default()))
+            }
+            _ => Cell::fail(format!("failed: {}", r.reason.clone().unwrap_or_default())),
+        };
+        run_table.row([
+            Cell::text(&r.case),
+            Cell::text(r.code.name()),
+            Cell::num(r.lambda.to_string()),
+            Cell::text(rule_name(r.cg_rule)),
+            Cell::num(r.seed.to_string()),
+            status,
+            Cell::num(opt(r.n_particles.map(|n| n as f64), 0)),
+            Cell::num(opt(r.wall_s, 1)),
+            Cell::num(
+                r.particle_steps_per_s
+                    .map_or(String::from("-"), |v| format!("{v:.3e}")),
+            ),
+        ]);
+    }
+    // A suite of only accuracy sweeps or stability cases has neither: its sections say it all.
+    if !summary.comparisons.is_empty() {
+        intro.table(table);
+    }
+    if !summary.runs.is_empty() {
+        intro.table(run_table);
+    }
+    intro.key_values(
+        Some("Provenance"),
+        summary
+            .provenance
+            .iter()
+            .map(|(k, v)| (k.clone(), v.clone()))
+            .collect::<Vec<_>>(),
+    );
+    let json_path = options.out.join("summary.json");
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&json_path, e))?;
+    write_atomic(&json_path, json.as_bytes()).map_err(|e| output_error(&json_path, e))?;
+    let html_path = options.out.join("index.html");
+    report
+        .write(&html_path)
+        .map_err(|e| output_error(&html_path, e))?;
+    Ok(summary)
+}
+
+/// A comparison's table cells: kind, what, difference, spread, tolerance, verdict.
+fn comparison_cells(c: &Comparison) -> [Cell; 7] {
+    [
+        Cell::text(&c.kind),
+        Cell::text(&c.part),
+        Cell::text(&c.what),
+        Cell::num(format!("{:.2}", c.difference)),
+        Cell::num(format!("{:.2}", c.combined_spread)),
+        Cell::num(format!("{:.2}", c.tolerance)),
+        if c.pass {
+            Cell::pass("pass")
+        } else {
+            Cell::fail("fail")
+        },
+    ]
+}
+
+fn rule_name(rule: CoarseGrainRule) -> &'static str {
+    match rule {
+        CoarseGrainRule::Seed => "seed",
+        CoarseGrainRule::BulkViscosity => "bulk-viscosity",
+    }
+}
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or(String::from("-"), |x| format!("{x:.digits$}"))
+}
+
+fn provenance(suite: &Suite, options: &ValidateOptions) -> BTreeMap<String, String> {
+    let mut p = machine_provenance();
+    p.insert("suite file".into(), suite.source.display().to_string());
+    p.insert("output".into(), options.out.display().to_string());
+    p.insert("concurrent runs (jobs)".into(), options.jobs.to_string());
+    p
+}
+
+/// cgdem's version and commit, the machine, the date, the command line and the threads.
+pub(crate) fn machine_provenance() -> BTreeMap<String, String> {
+    let command = |program: &str, args: &[&str]| -> String {
+        std::process::Command::new(program)
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+            .unwrap_or_else(|| "unknown".into())
+    };
+    let mut p = BTreeMap::new();
+    p.insert("cgdem version".into(), env!("CARGO_PKG_VERSION").into());
+    p.insert(
+        "cgdem commit".into(),
+        command("git", &["rev-parse", "--short", "HEAD"]),
+    );
+    p.insert(
+        "machine".into(),
+        format!(
+            "{} ({} cores)",
+            command("uname", &["-srm"]),
+            std::thread::available_parallelism().map_or(0, |n| n.get())
+        ),
+    );
+    p.insert(
+        "date".into(),
+        command("date", &["-u", "+%Y-%m-%dT%H:%M:%SZ"]),
+    );
+    p.insert(
+        "command".into(),
+        std::env::args().collect::<Vec<_>>().join(" "),
+    );
+    p.insert("threads".into(), rayon::current_num_threads().to_string());
+    p
+}
+
+fn run_dir(
+    out: &Path,
+    scene: &Scene,
+    code: Code,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+) -> PathBuf {
+    let mut name = format!("{}-lambda{lambda}", code.name());
+    if rule != CoarseGrainRule::Seed {
+        name += &format!("-{}", rule_name(rule));
+    }
+    out.join("runs")
+        .join(&scene.name)
+        .join(format!("{name}-seed{seed}"))
+}
+
+fn run_case(
+    scene: &Scene,
+    case: &SuiteCase,
+    options: &ValidateOptions,
+) -> Result<Vec<RunRecord>, ValidateError> {
+    // A conveying case runs once per listed screw speed, the scene at its own otherwise.
+    let speeds: Vec<Option<f64>> = match &scene.conveying {
+        Some(_) if !case.rpms.is_empty() => case.rpms.iter().map(|&r| Some(r)).collect(),
+        _ => vec![None],
+    };
+    // Alternate the codes within each seed and speed, so machine drift hits all alike.
+    let mut settings = Vec::new();
+    for &rule in &case.cg_rules {
+        for &lambda in &case.lambdas {
+            for &seed in &case.seeds {
+                for &rpm in &speeds {
+                    for &code in &case.codes {
+                        settings.push((rule, lambda, seed, rpm, code));
+                    }
+                }
+            }
+        }
+    }
+    let records = run_concurrently(
+        &settings,
+        options.jobs,
+        |&(rule, lambda, seed, rpm, code)| {
+            let mut dir = run_dir(&options.out, scene, code, lambda, rule, seed);
+            let at_speed;
+            let scene = match (rpm, &scene.conveying) {
+                (Some(rpm), Some(c)) => {
+                    dir.set_file_name(format!(
+                        "{}-rpm{rpm}",
+                        dir.file_name().unwrap_or_default().to_string_lossy()
+                    ));
+                    at_speed = crate::sweep::at_speed(scene, &c.body, rpm);
+                    &at_speed
+                }
+                _ => scene,
+            };
+            let options = &ValidateOptions {
+                keep_going: options.keep_going || case.keep_going,
+                ..options.clone()
+            };
+            let mut record = run_one(scene, code, lambda, rule, seed, &dir, options);
+            record.rpm = rpm;
+            if !options.quiet {
+                eprintln!(
+                    "{} {} lambda={lambda} rule={} seed={seed}{}: {}{}",
+                    scene.name,
+                    code.name(),
+                    rule_name(rule),
+                    rpm.map_or(String::new(), |r| format!(" rpm={r}")),
+                    record.status,
+                    record
+                        .reason
+                        .as_deref()
+                        .map_or(String::new(), |r| format!(" ({r})"))
+                );
+            }
+            record
+        },
+    );
+    Ok(records)
+}
+
+/// `run` applied to every item, `jobs` at a time, results in the items' order. With more
+/// than one job, the cores of the calling rayon pool are shared out: each job runs in a pool
+/// of its own with `threads / jobs` threads (at least one), so cgdem runs do not oversubscribe
+/// the machine; a reference code runs as one process per job.
+pub(super) fn run_concurrently<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    run: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    if jobs <= 1 || items.len() <= 1 {
+        return items.iter().map(&run).collect();
+    }
+    let threads_per_job = (rayon::current_num_threads() / jobs).max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<std::sync::Mutex<Option<R>>> =
+        items.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.min(items.len()) {
+            scope.spawn(|| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads_per_job)
+                    .build();
+                loop {
+                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some(item) = items.get(k) else { break };
+                    let result = match &pool {
+                        Ok(pool) => pool.install(|| run(item)),
+                        Err(_) => run(item), // no pool of its own: the global one
+                    };
+                    *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+                }
+            });
+        }
+    });
+    results
+        .into_iter()
+        .map(|r| {
+            r.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .expect("every item is taken by exactly one job")
+        })
+        .collect()
+}
+
+/// Runs one code on one setting (or, with `--reuse`, takes the run already in `dir`) and
+/// reads what it measured; a run that could not be made is recorded as skipped or failed.
+pub(super) fn run_one(
+    scene: &Scene,
+    code: Code,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    options: &ValidateOptions,
+) -> RunRecord {
+    let mut record = RunRecord {
+        case: scene.name.clone(),
+        code,
+        lambda,
+        cg_rule: rule,
+        seed,
+        status: "ok".into(),
+        reason: None,
+        dir: dir.to_path_buf(),
+        n_particles: None,
+        steps: None,
+        wall_s: None,
+        particle_steps_per_s: None,
+        repose_angle_deg: None,
+        repose_fit_r2: None,
+        runout_m: None,
+        reused: false,
+        partial: false,
+        rpm: None,
+        mass_flow_kg_s: None,
+        mass_flow_std_error_kg_s: None,
+        fill_ratio: None,
+        bulk_density_kg_m3: None,
+        eq7_mass_flow_kg_s: None,
+        ratio_to_eq7: None,
+    };
+    let outcome = match code {
+        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
+        Code::Lammps | Code::Liggghts => {
+            run_reference_code(code, scene, lambda, rule, seed, dir, options)
+        }
+    };
+    match outcome {
+        Ok(reused) => {
+            record.reused = reused;
+            fill_from_summary(&mut record);
+        }
+        Err(RunOutcome::Skipped(reason)) => {
+            record.status = "skipped".into();
+            record.reason = Some(reason);
+        }
+        Err(RunOutcome::Failed(reason)) => {
+            record.status = "failed".into();
+            record.reason = Some(reason);
+        }
+    }
+    record
+}
+
+enum RunOutcome {
+    Skipped(String),
+    Failed(String),
+}
+
+/// Runs cgdem, or with `--reuse` takes the run already in `dir`; true when reused.
+fn run_cgdem(
+    scene: &Scene,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    options: &ValidateOptions,
+) -> Result<bool, RunOutcome> {
+    let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))?;
+    if options.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+        return Ok(true);
+    }
+    let run_options = RunOptions {
+        out_dir: dir.to_path_buf(),
+        progress: options.progress.clone(),
+        force_dt: false,
+        keep_going: options.keep_going,
+        ..Default::default()
+    };
+    run(&coarse, &run_options)
+        .map(|_| false)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))
+}
+
+/// The scene digest in `dir/summary.json`, if a finished run left one.
+fn finished_digest(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value.get("scene_digest")?.as_str().map(str::to_string)
+}
+
+/// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
+/// reused. LIGGGHTS cannot express the seed's WCA model: its runs of such a case are skipped.
+fn run_reference_code(
+    code: Code,
+    scene: &Scene,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    validate: &ValidateOptions,
+) -> Result<bool, RunOutcome> {
+    use super::lammps::{run_reference, ReferenceCode, ReferenceOptions, RunStatus, RunnerOptions};
+    let reference = match code {
+        Code::Liggghts => ReferenceCode::Liggghts,
+        _ => ReferenceCode::Lammps,
+    };
+    if reference == ReferenceCode::Liggghts
+        && matches!(
+            scene.contact,
+            cgdem_core::scene::ContactSettings::Wca { .. }
+        )
+    {
+        return Err(RunOutcome::Skipped(
+            "LIGGGHTS cannot express the seed's WCA model (model = \"wca\"); it runs Hertz cases"
+                .into(),
+        ));
+    }
+    let name = reference.name();
+    let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))?;
+    let mut options = ReferenceOptions {
+        code: reference,
+        runner: RunnerOptions {
+            np: None,
+            timeout: std::time::Duration::from_secs(validate.reference_timeout_s),
+        },
+        ..ReferenceOptions::default()
+    };
+    // A finished run of this very scene is reused; one whose deck is the one this case
+    // writes now (an older summary without a digest) is post-processed again; anything else
+    // (no run, another deck, dumps gone) runs.
+    if validate.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+        return Ok(true);
+    }
+    if validate.reuse && dir.join("summary.json").exists() {
+        options.postprocess_only = true;
+        if let Ok(run) = run_reference(&coarse, dir, &options) {
+            if run.summary.is_some() {
+                return Ok(true);
+            }
+        }
+        options.postprocess_only = false;
+    }
+    let run = run_reference(&coarse, dir, &options).map_err(RunOutcome::Failed)?;
+    match run.status {
+        RunStatus::Completed { .. } => Ok(false),
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => Err(RunOutcome::Skipped(format!(
+            "{reason}; install with `{install_hint}`"
+        ))),
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => Err(RunOutcome::Failed(format!(
+            "{name} exit code {exit_code:?}; log tail: {log_tail}"
+        ))),
+        RunStatus::TimedOut { after_s, log_tail } => Err(RunOutcome::Failed(format!(
+            "{name} timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
+        ))),
+    }
+}
+
+fn fill_from_summary(record: &mut RunRecord) {
+    let path = record.dir.join("summary.json");
+    let value: serde_json::Value = match std::fs::read_to_string(&path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+    {
+        Ok(v) => v,
+        Err(e) => {
+            record.status = "failed".into();
+            record.reason = Some(format!("{}: {e}", path.display()));
+            return;
+        }
+    };
+    let f = |key: &str| value.get(key).and_then(|v| v.as_f64());
+    record.n_particles = value.get("n_particles").and_then(|v| v.as_u64());
+    record.steps = value.get("steps").and_then(|v| v.as_u64());
+    record.wall_s = f("wall_s");
+    record.particle_steps_per_s = f("particle_steps_per_s");
+    record.repose_angle_deg = f("repose_angle_deg");
+    record.repose_fit_r2 = f("repose_fit_r2");
+    record.runout_m = f("runout_m");
+    let conveying = |key: &str| value["conveying"][key].as_f64();
+    record.mass_flow_kg_s = conveying("mass_flow_kg_s");
+    record.mass_flow_std_error_kg_s = conveying("mass_flow_std_error_kg_s");
+    record.fill_ratio = conveying("fill_ratio");
+    record.bulk_density_kg_m3 = conveying("bulk_density_kg_m3");
+    record.eq7_mass_flow_kg_s = conveying("eq7_mass_flow_kg_s");
+    record.ratio_to_eq7 = conveying("ratio_to_eq7");
+    let unfinished = value["stages"].as_array().and_then(|stages| {
+        stages.iter().find(|st| {
+            let how = st["ended_by"].as_str().unwrap_or("");
+            how == "did not finish" || how.starts_with("stopped")
+        })
+    });
+    if let Some(stage) = unfinished {
+        record.partial = true;
+        record.reason = Some(format!(
+            "partial: stage `{}` {} after {:.2} s",
+            stage["name"].as_str().unwrap_or("?"),
+            stage["ended_by"].as_str().unwrap_or("?"),
+            stage["end_s"].as_f64().unwrap_or(0.0) - stage["start_s"].as_f64().unwrap_or(0.0),
+        ));
+    }
+}
+
+/// Mean and sample standard deviation.
+fn mean_spread(values: &[f64]) -> Option<(f64, f64)> {
+    if values.is_empty() {
+        return None;
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let spread = if values.len() > 1 {
+        (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    Some((mean, spread))
+}
+
+type Group = (CoarseGrainRule, u32, Code);
+/// A group of runs: (coarse-graining rule as u8, lambda, code).
+type GroupKey = (u8, u32, Code);
+
+fn angles_by_group(runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<f64>> {
+    let mut groups: BTreeMap<GroupKey, Vec<f64>> = BTreeMap::new();
+    for r in runs.iter().filter(|r| !r.partial) {
+        if let Some(a) = r.repose_angle_deg {
+            groups
+                .entry((r.cg_rule as u8, r.lambda, r.code))
+                .or_default()
+                .push(a);
+        }
+    }
+    groups
+}
+
+fn rule_of(index: u8) -> CoarseGrainRule {
+    if index == CoarseGrainRule::Seed as u8 {
+        CoarseGrainRule::Seed
+    } else {
+        CoarseGrainRule::BulkViscosity
+    }
+}
+
+/// The pairs a case compares: codes against each other at each level and rule ("codes"),
+/// and each code's neighbouring levels under each rule ("levels"), finer first.
+fn comparison_pairs(keys: &[GroupKey]) -> Vec<(&'static str, GroupKey, GroupKey)> {
+    let mut out = Vec::new();
+    for &(rule, lambda, code_a) in keys {
+        for &(rule_b, lambda_b, code_b) in keys {
+            if rule == rule_b && lambda == lambda_b && code_a < code_b {
+                out.push(("codes", (rule, lambda, code_a), (rule, lambda, code_b)));
+            }
+        }
+    }
+    for &(rule, lambda, code) in keys {
+        let finer = keys
+            .iter()
+            .filter(|&&(r, l, c)| r == rule && c == code && l < lambda)
+            .max_by_key(|&&(_, l, _)| l);
+        if let Some(&f) = finer {
+            out.push(("levels", f, (rule, lambda, code)));
+        }
+    }
+    out
+}
+
+fn pair_name(kind: &str, a: GroupKey, b: GroupKey) -> String {
+    let rule = rule_name(rule_of(a.0));
+    if kind == "codes" {
+        format!(
+            "{} vs {}, lambda = {} ({rule})",
+            a.2.name(),
+            b.2.name(),
+            a.1
+        )
+    } else {
+        format!("{} lambda = {} vs {} ({rule})", a.2.name(), a.1, b.1)
+    }
+}
+
+/// The ratio of characteristic times the derivation in reference/COARSE_GRAINING.md
+/// predicts between two groups: 1 between codes and under the bulk-viscosity rule; under the
+/// seed rule between 1 (inertial collapse) and the lambda ratio (viscous collapse).
+fn predicted_time_ratio(kind: &str, a: GroupKey, b: GroupKey) -> String {
+    match (kind, rule_of(a.0)) {
+        ("levels", CoarseGrainRule::Seed) => format!(
+            "1 (inertial) to {} (viscous): bulk viscosity ~ lambda gamma/d",
+            b.1 as f64 / a.1 as f64
+        ),
+        _ => "1".into(),
+    }
+}
+
+fn compare(scene: &Scene, case: &SuiteCase, runs: &[RunRecord]) -> Vec<Comparison> {
+    let groups = angles_by_group(runs);
+    let stats: BTreeMap<GroupKey, (f64, f64)> = groups
+        .iter()
+        .filter_map(|(k, v)| mean_spread(v).map(|s| (*k, s)))
+        .collect();
+    let flows = flows_by_group(scene, runs);
+    let mut keys: Vec<GroupKey> = stats.keys().chain(flows.keys()).copied().collect();
+    keys.sort();
+    keys.dedup();
+    let box_length = scene.domain.hi.x - scene.domain.lo.x;
+    let mut out = Vec::new();
+    for (kind, a, b) in comparison_pairs(&keys) {
+        let what = pair_name(kind, a, b);
+        if let (Some(&sa), Some(&sb)) = (stats.get(&a), stats.get(&b)) {
+            let difference = (sa.0 - sb.0).abs();
+            let combined_spread = (sa.1 * sa.1 + sb.1 * sb.1).sqrt();
+            let within_spread = difference <= combined_spread;
+            out.push(Comparison {
+                case: scene.name.clone(),
+                kind: kind.into(),
+                part: "final state".into(),
+                what: what.clone(),
+                detail: format!(
+                    "repose angle {:.1} +- {:.1} vs {:.1} +- {:.1} deg",
+                    sa.0, sa.1, sb.0, sb.1
+                ),
+                difference,
+                combined_spread,
+                tolerance: case.angle_tolerance_deg,
+                within_spread,
+                pass: within_spread || difference <= case.angle_tolerance_deg,
+            });
+        }
+        if let (Some(fa), Some(fb)) = (flows.get(&a), flows.get(&b)) {
+            if let Some(c) = compare_flows(scene, case, kind, (a, fa), (b, fb), box_length) {
+                out.push(Comparison { what, ..c });
+            }
+        }
+    }
+    out
+}
+
+/// The dynamics part of a comparison: the ratio of the seeds' mean `t_half` (judged against
+/// 1 within `time_ratio_tolerance`, or within the combined relative spread) and the gap
+/// between the seed-mean front histories (within `front_tolerance` of the box length).
+fn compare_flows(
+    scene: &Scene,
+    case: &SuiteCase,
+    kind: &str,
+    (a, fa): (GroupKey, &Vec<FlowSeries>),
+    (b, fb): (GroupKey, &Vec<FlowSeries>),
+    box_length: f64,
+) -> Option<Comparison> {
+    let ta: Vec<f64> = fa.iter().filter_map(FlowSeries::t_half).collect();
+    let tb: Vec<f64> = fb.iter().filter_map(FlowSeries::t_half).collect();
+    let (ma, sa) = mean_spread(&ta)?;
+    let (mb, sb) = mean_spread(&tb)?;
+    let ratio = mb / ma;
+    let relative_spread = ratio * ((sa / ma).powi(2) + (sb / mb).powi(2)).sqrt();
+    let difference = (ratio - 1.0).abs();
+    let within_spread = difference <= relative_spread;
+    let step = FLOW_GRID_S;
+    let mean_a = FlowSeries::mean(fa, step)?;
+    let mean_b = FlowSeries::mean(fb, step)?;
+    let gap = flow_difference(&mean_a, &mean_b, box_length, step)?;
+    let front_ok = gap.front_max <= case.front_tolerance;
+    Some(Comparison {
+        case: scene.name.clone(),
+        kind: kind.into(),
+        part: "dynamics".into(),
+        what: String::new(),
+        detail: format!(
+            "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {}); \
+             front gap max {:.3}, mean {:.3} of the box length (tolerance {}); wall height gap \
+             max {:.3}, mean {:.3} of the initial height; kinetic energy gap max {:.3}, mean {:.3} \
+             of the peak",
+            predicted_time_ratio(kind, a, b),
+            gap.front_max,
+            gap.front_mean,
+            case.front_tolerance,
+            gap.wall_height_max,
+            gap.wall_height_mean,
+            gap.kinetic_energy_max,
+            gap.kinetic_energy_mean,
+        ),
+        difference,
+        combined_spread: relative_spread,
+        tolerance: case.time_ratio_tolerance,
+        within_spread,
+        pass: (within_spread || difference <= case.time_ratio_tolerance) && front_ok,
+    })
+}
+
+/// Spacing of the common time grid on which flow histories are averaged and compared.
+const FLOW_GRID_S: f64 = 0.01;
+
+/// Every successful run's flow during the measured stage, per group.
+fn flows_by_group(scene: &Scene, runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<FlowSeries>> {
+    let mut groups: BTreeMap<GroupKey, Vec<FlowSeries>> = BTreeMap::new();
+    let Some(stage) = scene.repose.as_ref().map(|r| r.stage.as_str()) else {
+        return groups;
+    };
+    for r in runs.iter().filter(|r| r.status == "ok") {
+        if let Some(flow) = FlowSeries::read(&r.dir, stage) {
+            groups
+                .entry((r.cg_rule as u8, r.lambda, r.code))
+                .or_default()
+                .push(flow);
+        }
+    }
+    groups
+}
+
+fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap_or("")
+        .split(',')
+        .map(String::from)
+        .collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(String::from))
+                .collect()
+        })
+        .collect()
+}
+
+fn number(row: &BTreeMap<String, String>, key: &str) -> Option<f64> {
+    row.get(key).and_then(|v| v.parse().ok())
+}
+
+fn label(code: Code, lambda: u32, rule: CoarseGrainRule) -> String {
+    match rule {
+        CoarseGrainRule::Seed => format!("{} lambda={lambda}", code.name()),
+        other => format!("{} lambda={lambda} {}", code.name(), rule_name(other)),
+    }
+}
+
+fn write_case_section(
+    report: &mut Report,
+    scene: &Scene,
+    case: &SuiteCase,
+    runs: &[RunRecord],
+    comparisons: &[Comparison],
+    out: &Path,
+) -> Result<(), ValidateError> {
+    let dir = out.join("figures").join(&scene.name);
+    let figure_error = |e: crate::report::PlotError| output_error(&dir, e);
+    let section = report.section(format!("Case {}", scene.name));
+    section.paragraph(format!(
+        "{} Scene file: {}. Seeds: {:?}.",
+        scene.description,
+        case.file.display(),
+        case.seeds
+    ));
+    let ok_runs: Vec<&RunRecord> = runs.iter().filter(|r| r.status == "ok").collect();
+
+    // Heap profiles, averaged over seeds per code, level and rule.
+    let mut profiles = Figure::new(
+        format!("{}: heap profiles (mean over seeds)", scene.name),
+        "distance from the remaining wall x [m]",
+        "surface height h(x) [m]",
+    );
+    let mut keys: Vec<Group> = ok_runs
+        .iter()
+        .map(|r| (r.cg_rule, r.lambda, r.code))
+        .collect();
+    keys.sort_by_key(|k| (k.0 as u8, k.1, k.2));
+    keys.dedup();
+    for &(rule, lambda, code) in &keys {
+        let members: Vec<&&RunRecord> = ok_runs
+            .iter()
+            .filter(|r| (r.cg_rule, r.lambda, r.code) == (rule, lambda, code))
+            .collect();
+        let mut sum: Vec<(f64, f64)> = Vec::new();
+        for r in &members {
+            for (k, row) in read_csv(&r.dir.join("profile.csv")).iter().enumerate() {
+                if let (Some(x), Some(h)) = (number(row, "x_m"), number(row, "height_m")) {
+                    if k < sum.len() {
+                        sum[k].1 += h;
+                    } else {
+                        sum.push((x, h));
+                    }
+                }
+            }
+        }
+        let n = members.len().max(1) as f64;
+        profiles.series.push(
+            Series::new(
+                label(code, lambda, rule),
+                sum.into_iter().map(|(x, h)| (x, h / n)).collect(),
+            )
+            .style(SeriesStyle::Line),
+        );
+    }
+    let files = write_figure(&dir, "profiles", &profiles).map_err(figure_error)?;
+    section.figure(&files, "heap profiles", "Free-surface height against distance from the remaining wall at the measurement time, averaged over seeds.").map_err(|e| output_error(&dir, e))?;
+
+    // Repose angle per level with seed spread.
+    let mut angles = Figure::new(
+        format!("{}: repose angle per level", scene.name),
+        "coarse-graining level lambda",
+        "repose angle [deg]",
+    )
+    .log_x();
+    let groups = angles_by_group(runs);
+    // (rule, code) -> (lambda, mean angle) points and their seed spreads.
+    type AngleSeries = (Vec<(f64, f64)>, Vec<f64>);
+    let mut series: BTreeMap<(u8, Code), AngleSeries> = BTreeMap::new();
+    for (&(rule, lambda, code), values) in &groups {
+        if let Some((mean, spread)) = mean_spread(values) {
+            let entry = series.entry((rule, code)).or_default();
+            entry.0.push((lambda as f64, mean));
+            entry.1.push(spread);
+        }
+    }
+    for ((rule, code), (points, errors)) in series {
+        let name = match rule_of(rule) {
+            CoarseGrainRule::Seed => code.name().to_string(),
+            other => format!("{} {}", code.name(), rule_name(other)),
+        };
+        angles.series.push(
+            Series::new(name, points)
+                .y_err(errors)
+                .style(SeriesStyle::LineMarkers),
+        );
+    }
+    let files = write_figure(&dir, "repose_angle", &angles).map_err(figure_error)?;
+    section.figure(&files, "repose angle per level", "Mean repose angle over seeds; error bars are the sample standard deviation across seeds.").map_err(|e| output_error(&dir, e))?;
+
+    let bars: Vec<(String, String, f64, Option<f64>)> = keys
+        .iter()
+        .filter_map(|&(rule, lambda, code)| {
+            let values: Vec<f64> = ok_runs
+                .iter()
+                .filter(|r| (r.cg_rule, r.lambda, r.code) == (rule, lambda, code))
+                .filter_map(|r| r.particle_steps_per_s)
+                .collect();
+            let (mean, spread) = mean_spread(&values)?;
+            let group = match rule {
+                CoarseGrainRule::Seed => format!("lambda={lambda}"),
+                other => format!("lambda={lambda} {}", rule_name(other)),
+            };
+            Some((group, code.name().to_string(), mean, Some(spread)))
+        })
+        .collect();
+    let files = write_bar_chart(
+        &dir,
+        "throughput",
+        &format!("{}: throughput", scene.name),
+        "particle-steps per second",
+        &bars,
+    )
+    .map_err(figure_error)?;
+    section.figure(&files, "throughput per code and level", "Particle-steps per second (mean and spread over seeds); wall time includes insertion and output.").map_err(|e| output_error(&dir, e))?;
+
+    write_similarity(section, scene, case, runs, comparisons, &dir)?;
+    let rule = scene.repose.as_ref().map(|_| {
+        "The repose angle is measured by the rule stated in each run's summary.json (repose_rule)."
+    });
+    if let Some(rule) = rule {
+        section.paragraph(rule);
+    }
+    Ok(())
+}
+
+/// The case's similarity section: for every compared pair, the final state and the dynamics
+/// judged separately (a pair is similar only if both pass), and the flow histories behind the
+/// dynamics, mean over seeds, one line per code, level and rule.
+fn write_similarity(
+    section: &mut crate::report::Section,
+    scene: &Scene,
+    case: &SuiteCase,
+    runs: &[RunRecord],
+    comparisons: &[Comparison],
+    dir: &Path,
+) -> Result<(), ValidateError> {
+    let figure_error = |e: crate::report::PlotError| output_error(dir, e);
+    let sub = section.subsection("Similarity: final state and dynamics");
+    sub.paragraph(format!(
+        "A pair of codes or levels is similar only if both its final state (repose angle within \
+         {} deg or within the combined seed spread) and its dynamics agree: the characteristic \
+         time t_half (time for the front to cover half its largest advance after the gate \
+         opens, mean over seeds) in a ratio within 1 +- {} (or within the combined spread), and \
+         the seed-mean front histories within {} of the box length at all times. The predicted \
+         time ratios are derived in reference/COARSE_GRAINING.md.",
+        case.angle_tolerance_deg, case.time_ratio_tolerance, case.front_tolerance
+    ));
+    let mut table = Table::new(["pair", "final state", "dynamics", "similar", "numbers"])
+        .caption("Final-state and dynamic similarity, judged separately");
+    let mut pairs: Vec<&str> = comparisons.iter().map(|c| c.what.as_str()).collect();
+    pairs.dedup();
+    for what in pairs {
+        let part = |name: &str| {
+            comparisons
+                .iter()
+                .find(|c| c.what == what && c.part == name)
+        };
+        let verdict = |c: Option<&Comparison>| match c {
+            Some(c) if c.pass => Cell::pass("agrees"),
+            Some(_) => Cell::fail("differs"),
+            None => Cell::skipped("not measured"),
+        };
+        let (fs, dy) = (part("final state"), part("dynamics"));
+        let similar = match (fs.map(|c| c.pass), dy.map(|c| c.pass)) {
+            (Some(true), Some(true)) => Cell::pass("yes"),
+            (Some(false), Some(false)) => Cell::fail("no: final state and dynamics"),
+            (Some(false), _) => Cell::fail("no: final state"),
+            (_, Some(false)) => Cell::fail("no: dynamics"),
+            _ => Cell::skipped("incomplete"),
+        };
+        let numbers = [fs, dy]
+            .iter()
+            .flatten()
+            .map(|c| c.detail.clone())
+            .collect::<Vec<_>>()
+            .join("; ");
+        table.row([
+            Cell::text(what),
+            verdict(fs),
+            verdict(dy),
+            similar,
+            Cell::text(numbers),
+        ]);
+    }
+    sub.table(table);
+
+    let flows = flows_by_group(scene, runs);
+    let time_axis = "time after the gate opens t [s]";
+    let mut front = Figure::new(
+        format!("{}: front position (mean over seeds)", scene.name),
+        time_axis,
+        "front position x_f [m]",
+    );
+    let mut height = Figure::new(
+        format!(
+            "{}: height at the remaining wall (mean over seeds)",
+            scene.name
+        ),
+        time_axis,
+        "wall height h_w [m]",
+    );
+    let mut energy = Figure::new(
+        format!("{}: kinetic energy (mean over seeds)", scene.name),
+        time_axis,
+        "kinetic energy per mass [J/kg]",
+    )
+    .log_y();
+    for (&(rule, lambda, code), series) in &flows {
+        let Some(mean) = FlowSeries::mean(series, FLOW_GRID_S) else {
+            continue;
+        };
+        let name = label(code, lambda, rule_of(rule));
+        let points = |v: &[f64]| {
+            mean.time_s
+                .iter()
+                .copied()
+                .zip(v.iter().copied())
+                .collect::<Vec<_>>()
+        };
+        front
+            .series
+            .push(Series::new(name.clone(), points(&mean.front_m)).style(SeriesStyle::Line));
+        height
+            .series
+            .push(Series::new(name.clone(), points(&mean.wall_height_m)).style(SeriesStyle::Line));
+        let positive = points(&mean.kinetic_energy_per_mass)
+            .into_iter()
+            .filter(|p| p.1 > 0.0)
+            .collect();
+        energy
+            .series
+            .push(Series::new(name, positive).style(SeriesStyle::Line));
+    }
+    // The repose angle at the fixed times after the gate opens, mean and spread over seeds.
+    let mut angle = Figure::new(
+        format!(
+            "{}: repose angle at fixed times (mean over seeds)",
+            scene.name
+        ),
+        time_axis,
+        "repose angle [deg]",
+    );
+    let mut keys: Vec<GroupKey> = runs
+        .iter()
+        .filter(|r| r.status == "ok")
+        .map(|r| (r.cg_rule as u8, r.lambda, r.code))
+        .collect();
+    keys.sort();
+    keys.dedup();
+    for key in keys {
+        let mut by_time: BTreeMap<u64, Vec<f64>> = BTreeMap::new();
+        for r in runs
+            .iter()
+            .filter(|r| r.status == "ok" && (r.cg_rule as u8, r.lambda, r.code) == key)
+        {
+            for (t, a) in fixed_time_angles(&r.dir) {
+                by_time.entry(t.to_bits()).or_default().push(a);
+            }
+        }
+        let (points, errors): (Vec<(f64, f64)>, Vec<f64>) = by_time
+            .iter()
+            .filter_map(|(t, v)| mean_spread(v).map(|(m, s)| ((f64::from_bits(*t), m), s)))
+            .unzip();
+        if !points.is_empty() {
+            angle.series.push(
+                Series::new(label(key.2, key.1, rule_of(key.0)), points)
+                    .y_err(errors)
+                    .style(SeriesStyle::LineMarkers),
+            );
+        }
+    }
+    for (stem, fig, title, caption) in [
+        ("front_position", &front, "front position against time", "Furthest point where the deposit is at least two diameters deep, against time after the gate opens; mean over seeds (a run that came to rest holds its last value)."),
+        ("wall_height", &height, "height at the remaining wall against time", "Surface height next to the remaining wall; mean over seeds."),
+        ("kinetic_energy", &energy, "kinetic energy against time", "Kinetic energy per unit mass; mean over seeds."),
+        ("angle_vs_time", &angle, "repose angle at fixed times", "Repose angle by the case's rule at fixed times after the gate opens (the heap is still flowing at the early ones); error bars are the spread over seeds."),
+    ] {
+        let files = write_figure(dir, stem, fig).map_err(figure_error)?;
+        sub.figure(&files, title, caption).map_err(|e| output_error(dir, e))?;
+    }
+    Ok(())
+}
+
+/// (time after the stage start, angle) of a run's fixed-time repose samples.
+fn fixed_time_angles(dir: &Path) -> Vec<(f64, f64)> {
+    let Ok(text) = std::fs::read_to_string(dir.join("summary.json")) else {
+        return Vec::new();
+    };
+    let Ok(value) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    value
+        .get("repose_samples")
+        .and_then(|v| v.as_array())
+        .map(|samples| {
+            samples
+                .iter()
+                .filter(|s| s.get("trigger").and_then(|v| v.as_str()) == Some("fixed time"))
+                .filter_map(|s| {
+                    Some((
+                        s.get("time_after_start_s")?.as_f64()?,
+                        s.get("repose_angle_deg")?.as_f64()?,
+                    ))
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::run_concurrently;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn concurrent_runs_take_every_item_once_and_keep_the_order() {
+        let items: Vec<u32> = (0..17).collect();
+        for jobs in [1, 2, 3, 40] {
+            let calls = AtomicUsize::new(0);
+            let out = run_concurrently(&items, jobs, |&k| {
+                calls.fetch_add(1, Ordering::Relaxed);
+                (k * k, rayon::current_num_threads())
+            });
+            assert_eq!(calls.load(Ordering::Relaxed), items.len(), "jobs {jobs}");
+            let squares: Vec<u32> = out.iter().map(|o| o.0).collect();
+            assert_eq!(squares, items.iter().map(|k| k * k).collect::<Vec<_>>());
+            if jobs > 1 {
+                // Each job's pool holds its share of the threads, at least one.
+                let share = (rayon::current_num_threads() / jobs).max(1);
+                assert!(out.iter().all(|o| o.1 == share), "jobs {jobs}: {out:?}");
+            }
+        }
+    }
+}
