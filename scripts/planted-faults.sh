@@ -41,19 +41,24 @@ print(f"unchanged run: {len(s['comparisons'])} comparisons, no red, {len(amber)}
 sys.exit(1 if bad else 0)
 PY
 
-# name | case (scene name) | comparison prefix | part | overrides (space-separated)
+# name | case (scene name) | comparison (start of its name) | overrides (space-separated).
+# A fault is caught when a part (final state or dynamics) of that comparison turns red, or
+# when cgdem's run is stopped by a guard (a failed run turns the night red; it is said so).
+# Measured and not caught at smoke size (README, "Proven able to fail"): Hertz friction
+# 0.5 -> 0.3, Hertz restitution 0.5 -> 0.25 and the seed model's time step at 0.2 of the
+# contact period.
 faults=(
-  "hertz-friction-0.3|aor_hertz_smoke|cgdem vs lammps|final state|contact.friction=0.3"
-  "hertz-no-rolling-friction|aor_hertz_smoke|cgdem vs lammps|final state|contact.rolling_friction=0.0 wall_contact.rolling_friction=0.0"
-  "hertz-dt-0.2|aor_hertz_smoke|cgdem vs lammps|dynamics|time.dt_fraction=0.2"
-  "wca-damping-doubled|aor_smoke-smooth-walls|cgdem vs lammps|dynamics|contact.gamma_n=0.2514 contact.gamma_t=0.2514"
+  "hertz-friction-0.1|aor_hertz_smoke|cgdem vs lammps|contact.friction=0.1"
+  "hertz-no-rolling-resistance|aor_hertz_smoke|cgdem vs lammps|contact.rolling=\"none\" wall_contact.rolling_friction=0.0"
+  "hertz-dt-0.2|aor_hertz_smoke|cgdem vs lammps|time.dt_fraction=0.2"
+  "wca-damping-doubled|aor_smoke-smooth-walls|cgdem vs lammps|contact.gamma_n=0.2514 contact.gamma_t=0.2514"
 )
 
 status=0
 echo "| fault | comparison | part | decided by | value | threshold | verdict |" > "$out/table.md"
 echo "|---|---|---|---|---|---|---|" >> "$out/table.md"
 for f in "${faults[@]}"; do
-    IFS='|' read -r name case what part overrides <<<"$f"
+    IFS='|' read -r name case what overrides <<<"$f"
     dir="$out/$name"
     mkdir -p "$dir/runs"
     # The targeted case alone, as a suite of its own; the reference runs from the unchanged report.
@@ -79,19 +84,24 @@ PY
     rm -rf "$dir/runs/$case"/cgdem-*
     args=()
     for o in $overrides; do args+=(--fault "$o"); done
-    "$cgdem" validate --suite "$dir/suite.toml" --out "$dir" --reuse --quiet "${args[@]}" >/dev/null
-    python3 - "$dir/summary.json" "$name" "$what" "$part" "$overrides" >> "$out/table.md" <<'PY' || status=1
+    "$cgdem" validate --suite "$dir/suite.toml" --out "$dir" --reuse --quiet --jobs 2 "${args[@]}" >/dev/null
+    python3 - "$dir/summary.json" "$name" "$what" "$overrides" >> "$out/table.md" <<'PY' || status=1
 import json, sys
 s = json.load(open(sys.argv[1]))
-name, what, part, overrides = sys.argv[2:]
-rows = [c for c in s["comparisons"] if c["what"].startswith(what) and c["part"] == part]
+name, what, overrides = sys.argv[2:]
+rows = [c for c in s["comparisons"] if c["what"].startswith(what)]
+failed_runs = [r for r in s["runs"] if r["code"] == "cgdem" and r["status"] == "failed"]
+if failed_runs:
+    reason = failed_runs[0]["reason"].split(": run stopped: ")[-1].split(";")[0]
+    print(f"| {name} (`{overrides}`) | {what} | - | - | - | - | night red: {len(failed_runs)} cgdem runs failed ({reason}) |")
+    sys.exit(0)
 if not rows:
-    print(f"| {name} (`{overrides}`) | {what} | {part} | - | - | - | not measured |")
+    print(f"| {name} (`{overrides}`) | {what} | - | - | - | - | not measured |")
     sys.exit(1)
-c = rows[0]
-print(f"| {name} (`{overrides}`) | {c['case']}: {c['what']} | {part} | {c['decided_by']} | "
-      f"{c['difference']:.3g} | {c['threshold']:.3g} | {c['verdict']} |")
-sys.exit(0 if c["verdict"] == "fail" else 1)
+for c in rows:
+    print(f"| {name} (`{overrides}`) | {c['case']}: {c['what']} | {c['part']} | {c['decided_by']} | "
+          f"{c['difference']:.3g} | {c['threshold']:.3g} | {c['verdict']} |")
+sys.exit(0 if any(c["verdict"] == "fail" for c in rows) else 1)
 PY
 done
 cat "$out/table.md"

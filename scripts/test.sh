@@ -19,7 +19,7 @@ cargo test --release --workspace
 # The smoke suite: every part of the harness on a small collapse (a few minutes).
 report=target/smoke-report
 rm -rf "$report"
-cargo run --release --quiet -- validate --suite smoke --out "$report" --quiet
+cargo run --release --quiet -- validate --suite smoke --out "$report" --quiet --jobs 2
 python3 - "$report/summary.json" <<'PY'
 import json, sys
 summary = json.load(open(sys.argv[1]))

@@ -598,4 +598,33 @@ mod tests {
         );
         let _ = std::fs::remove_dir_all(&base);
     }
+
+    #[test]
+    fn the_first_screen_lists_what_moved_since_the_previous_night() {
+        let base = std::env::temp_dir().join(format!("cgdem-since-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        let night1 = base.join("night1");
+        std::fs::create_dir_all(&night1).unwrap();
+        std::fs::write(night1.join("summary.json"), summary(30.0, 1e6).to_string()).unwrap();
+        let (text, items) = since_previous(&base, &base.join("night2"), &summary(30.0, 1e6));
+        assert!(
+            text.contains("no history") || text.contains("first night"),
+            "{text}"
+        );
+        assert!(items.is_empty());
+        add_night(&base, &night1, "2026-11-01", "abc").unwrap();
+        // Same numbers: nothing moved.
+        let (text, items) = since_previous(&base, &base.join("night2"), &summary(30.4, 1e6));
+        assert!(text.contains("no metric moved"), "{text}");
+        assert!(items.is_empty(), "{items:?}");
+        // The angle moves by 3 deg (tolerance 1.5) and the comparison turns red.
+        let mut now = summary(33.0, 1e6);
+        now["comparisons"][0]["pass"] = serde_json::json!(false);
+        now["comparisons"][0]["verdict"] = serde_json::json!("fail");
+        let (_, items) = since_previous(&base, &base.join("night2"), &now);
+        assert_eq!(items.len(), 2, "{items:?}");
+        assert!(items[0].contains("repose angle: 30.0 -> 33.0"), "{items:?}");
+        assert!(items[1].ends_with("pass -> fail"), "{items:?}");
+        let _ = std::fs::remove_dir_all(&base);
+    }
 }

@@ -187,8 +187,9 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
     let provenance = provenance(&suite, options);
     // Cases of one scene (e.g. its two coarse-graining rules) are compared and reported
-    // together: one section, one set of figures, judged by the first case's tolerances.
-    let mut scenes: Vec<(Scene, &SuiteCase, Vec<RunRecord>)> = Vec::new();
+    // together: one section, one set of figures, judged by the first case's tolerances and
+    // by the known differences any of them declares.
+    let mut scenes: Vec<(Scene, SuiteCase, Vec<RunRecord>)> = Vec::new();
     for case in &suite.cases {
         let scene = case.load_scene().map_err(|e| ValidateError::Case {
             file: case.file.clone(),
@@ -196,8 +197,13 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         })?;
         let case_runs = run_case(&scene, case, options)?;
         match scenes.iter_mut().find(|(s, _, _)| s.name == scene.name) {
-            Some((_, _, earlier)) => earlier.extend(case_runs),
-            None => scenes.push((scene, case, case_runs)),
+            Some((_, first, earlier)) => {
+                earlier.extend(case_runs);
+                first
+                    .known_differences
+                    .extend(case.known_differences.iter().cloned());
+            }
+            None => scenes.push((scene, case.clone(), case_runs)),
         }
     }
     let screws: Vec<(&Scene, &[RunRecord])> = scenes
@@ -211,15 +217,21 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     for (scene, case, case_runs) in scenes {
         if scene.conveying.is_some() {
             // A screw case is judged by its mass flow against Eq. (7), code by code.
-            super::screw::write_screw_section(&mut report, &scene, case, &case_runs, &options.out)?;
+            super::screw::write_screw_section(
+                &mut report,
+                &scene,
+                &case,
+                &case_runs,
+                &options.out,
+            )?;
             runs.extend(case_runs);
             continue;
         }
-        let case_comparisons = compare(&scene, case, &case_runs);
+        let case_comparisons = compare(&scene, &case, &case_runs);
         write_case_section(
             &mut report,
             &scene,
-            case,
+            &case,
             &case_runs,
             &case_comparisons,
             &options.out,
@@ -1363,13 +1375,21 @@ fn write_similarity(
     let figure_error = |e: crate::report::PlotError| output_error(dir, e);
     let sub = section.subsection("Similarity: final state and dynamics");
     sub.paragraph(format!(
-        "A pair of codes or levels is similar only if both its final state (repose angle within \
-         {} deg or within the combined seed spread) and its dynamics agree: the characteristic \
-         time t_half (time for the front to cover half its largest advance after the gate \
-         opens, mean over seeds) in a ratio within 1 +- {} (or within the combined spread), and \
-         the seed-mean front histories within {} of the box length at all times. The predicted \
-         time ratios are derived in reference/COARSE_GRAINING.md.",
-        case.angle_tolerance_deg, case.time_ratio_tolerance, case.front_tolerance
+        "A pair of codes or levels is similar only if both its final state and its dynamics \
+         agree. Final state: the repose angles of the seed means within {} deg. Dynamics: the \
+         characteristic time t_half (time for the front to cover half its largest advance \
+         after the gate opens, mean over seeds) in a ratio within 1 +- {}; the seed-mean \
+         histories of the front within {} of the box length, of the height at the wall within \
+         {} of its initial height and of the kinetic energy within {} of its peak, at all \
+         times. Each tolerance is widened by {} combined standard errors of the seeds (the \
+         noise); declared known differences are judged by their bands. The predicted time \
+         ratios are derived in reference/COARSE_GRAINING.md.",
+        case.angle_tolerance_deg,
+        case.time_ratio_tolerance,
+        case.front_tolerance,
+        case.wall_height_tolerance,
+        case.kinetic_energy_tolerance,
+        super::verdict::K_NOISE
     ));
     let mut table = Table::new(["pair", "final state", "dynamics", "similar", "numbers"])
         .caption("Final-state and dynamic similarity, judged separately");
