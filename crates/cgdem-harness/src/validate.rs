@@ -386,13 +386,9 @@ fn criteria_table(comparisons: &[Comparison]) -> Table {
                 ),
                 None => super::verdict::fmt(crit.threshold),
             };
+            // The reason is on the first screen and in the case's similarity table.
             let verdict_text = match &crit.known_difference {
-                Some(kd) => format!(
-                    "{}: {} (evidence: {})",
-                    crit.verdict.name(),
-                    kd.reason,
-                    kd.evidence
-                ),
+                Some(kd) => format!("{} (evidence: {})", crit.verdict.name(), kd.evidence),
                 None => crit.verdict.name().to_string(),
             };
             let cells = [
@@ -1105,11 +1101,6 @@ fn compare_flows(
 ) -> Option<Comparison> {
     let ta: Vec<f64> = fa.iter().filter_map(FlowSeries::t_half).collect();
     let tb: Vec<f64> = fb.iter().filter_map(FlowSeries::t_half).collect();
-    let (ma, sa, na) = mean_sd(&ta)?;
-    let (mb, sb, nb) = mean_sd(&tb)?;
-    let ratio = mb / ma;
-    // Standard error of the ratio from the relative standard errors of the two means.
-    let ratio_noise = ratio * combined_standard_error((sa / ma, na), (sb / mb, nb));
     let step = FLOW_GRID_S;
     let mean_a = FlowSeries::mean(fa, step)?;
     let mean_b = FlowSeries::mean(fb, step)?;
@@ -1121,16 +1112,36 @@ fn compare_flows(
             .iter()
             .find(|k| k.applies_to(what, criterion))
     };
-    let criteria = vec![
-        Criterion::judge(
-            "t_half ratio",
-            "|ratio - 1|",
-            (ratio - 1.0).abs(),
-            ratio_noise,
-            [na, nb],
-            case.time_ratio_tolerance,
-            known("t_half ratio"),
+    let mut criteria = Vec::new();
+    // t_half exists only where the front moved; without it on a side, the gaps still judge.
+    let t_half_text = match (mean_sd(&ta), mean_sd(&tb)) {
+        (Some((ma, sa, na)), Some((mb, sb, nb))) => {
+            let ratio = mb / ma;
+            // Standard error of the ratio from the relative standard errors of the means.
+            let ratio_noise = ratio * combined_standard_error((sa / ma, na), (sb / mb, nb));
+            criteria.push(Criterion::judge(
+                "t_half ratio",
+                "|ratio - 1|",
+                (ratio - 1.0).abs(),
+                ratio_noise,
+                [na, nb],
+                case.time_ratio_tolerance,
+                known("t_half ratio"),
+            ));
+            format!(
+                "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {})",
+                predicted_time_ratio(kind, a, b)
+            )
+        }
+        _ => format!(
+            "t_half not measured (the front did not move in {} of {} and {} of {} runs)",
+            fa.len() - ta.len(),
+            fa.len(),
+            fb.len() - tb.len(),
+            fb.len()
         ),
+    };
+    criteria.extend([
         Criterion::judge(
             "front gap",
             "of the box length",
@@ -1158,17 +1169,16 @@ fn compare_flows(
             case.kinetic_energy_tolerance,
             known("kinetic energy gap"),
         ),
-    ];
+    ]);
     Some(Comparison::judged(
         &scene.name,
         kind,
         "dynamics",
         what,
         format!(
-            "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {}); \
-             gaps, largest over time (mean): front {:.3} ({:.3}) of the box length, wall height \
-             {:.3} ({:.3}) of the initial height, kinetic energy {:.3} ({:.3}) of the peak",
-            predicted_time_ratio(kind, a, b),
+            "{t_half_text}; gaps, largest over time (mean): front {:.3} ({:.3}) of the box \
+             length, wall height {:.3} ({:.3}) of the initial height, kinetic energy {:.3} \
+             ({:.3}) of the peak",
             gap.front_max,
             gap.front_mean,
             gap.wall_height_max,
