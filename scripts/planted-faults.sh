@@ -20,6 +20,13 @@ out="$base/planted-faults"
 rm -rf "$out"
 mkdir -p "$out"
 
+# Without the reference codes (runs skipped: no root to install them) there is nothing to
+# compare against: said, not failed.
+if python3 -c "import json,sys; s=json.load(open(sys.argv[1])); sys.exit(0 if all(r['status']=='skipped' for r in s['runs'] if r['code']!='cgdem') else 1)" "$base/summary.json"; then
+    echo "note: reference codes not installed (their smoke runs were skipped); planted faults not checked"
+    exit 0
+fi
+
 # The unchanged run: no red row, every amber row a declared known difference.
 python3 - "$base/summary.json" <<'PY'
 import json, sys
