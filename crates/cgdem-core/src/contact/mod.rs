@@ -7,12 +7,14 @@
 
 pub mod cohesion;
 pub mod damping;
+mod history;
 pub mod normal;
 pub mod rolling;
 pub mod tangential;
 
+pub use history::PairHistory;
+
 use crate::math::{Real, Vec3};
-use crate::neighbor::PairHistory;
 
 /// Geometry and kinematics of one interacting pair, seen from particle `i`.
 #[derive(Clone, Copy, Debug)]

@@ -8,11 +8,10 @@ pub use hertz_history_wall::HertzHistoryWall;
 pub use hertz_wall::HertzWall;
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
-use crate::contact::Contact;
+use crate::contact::{Contact, PairHistory};
 use crate::geometry::FinitePlane;
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
-use crate::neighbor::PairHistory;
 
 /// One particle touching one wall, seen from the particle.
 #[derive(Clone, Copy, Debug)]
