@@ -5,6 +5,7 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod code;
 pub mod dynamics;
 pub mod history;
 pub mod lammps;

@@ -10,7 +10,7 @@ pub mod hertz;
 pub mod postprocess;
 pub mod runner;
 
-pub use deck::{write_deck, Deck, DeckError, DeckPlan};
+pub use deck::{Deck, DeckError, DeckPlan};
 pub use dump::{read_dump, DumpError, Frame};
 pub use hertz::write_hertz_deck;
 pub use postprocess::{postprocess, write_summary, PostprocessError};
@@ -18,38 +18,45 @@ pub use runner::{find_lmp, run_deck, RunStatus, RunnerOptions, INSTALL_HINT};
 
 use std::path::Path;
 
+use crate::code::Code;
 use cgdem_core::run::RunSummary;
-use cgdem_core::scene::Scene;
+use cgdem_core::scene::{ContactSettings, Scene};
 
-/// The reference code a deck is written for and run by.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ReferenceCode {
-    /// LAMMPS (`lmp`): the seed's WCA model and the Hertz family.
-    #[default]
-    Lammps,
-    /// LIGGGHTS (`liggghts`): the Hertz family with LIGGGHTS's own keywords.
-    Liggghts,
-}
-
-impl ReferenceCode {
-    pub fn name(self) -> &'static str {
-        match self {
-            ReferenceCode::Lammps => "LAMMPS",
-            ReferenceCode::Liggghts => "LIGGGHTS",
-        }
+/// The LAMMPS deck for a scene (already coarse-grained): the seed's WCA model (`deck`) or the
+/// Hertz family (`hertz`, `pair_style granular hertz/material`, reference/MAPPING.md).
+pub fn write_deck(
+    scene: &Scene,
+    particles: &cgdem_core::particles::Particles,
+    dt: cgdem_core::math::Real,
+) -> Result<Deck, DeckError> {
+    match scene.contact {
+        ContactSettings::Wca { .. } => deck::write_wca_deck(scene, particles, dt),
+        ContactSettings::Hertz(_) => write_hertz_deck(scene, particles, dt),
     }
 }
 
 /// How `run_reference` runs: the code, the runner's settings and the two choices a user makes.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct ReferenceOptions {
-    pub code: ReferenceCode,
+    /// `Code::Lammps` or `Code::Liggghts`.
+    pub code: Code,
     pub runner: RunnerOptions,
     /// Write the deck even if the time step exceeds the stable limit.
     pub force_dt: bool,
     /// Do not run: post-process the outputs already in `out` (of a stopped run, say). The
     /// deck there must be the one this scene writes, so the outputs belong to it.
     pub postprocess_only: bool,
+}
+
+impl Default for ReferenceOptions {
+    fn default() -> Self {
+        ReferenceOptions {
+            code: Code::Lammps,
+            runner: RunnerOptions::default(),
+            force_dt: false,
+            postprocess_only: false,
+        }
+    }
 }
 
 /// What `run_reference` did.
@@ -79,8 +86,9 @@ pub fn run_reference(
     let particles =
         cgdem_core::run::initial_particles_clear_of_bodies(scene).map_err(|e| e.to_string())?;
     let deck = match options.code {
-        ReferenceCode::Lammps => write_deck(scene, &particles, dt),
-        ReferenceCode::Liggghts => crate::liggghts::write_deck(scene, &particles, dt),
+        Code::Lammps => write_deck(scene, &particles, dt),
+        Code::Liggghts => crate::liggghts::write_deck(scene, &particles, dt),
+        Code::Cgdem => return Err("cgdem is not a reference code".into()),
     }
     .map_err(|e| e.to_string())?;
     let status = if options.postprocess_only {
@@ -98,8 +106,8 @@ pub fn run_reference(
         deck.write_to(out)
             .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
         match options.code {
-            ReferenceCode::Lammps => run_deck(out, &options.runner),
-            ReferenceCode::Liggghts => crate::liggghts::run_deck(out, &options.runner),
+            Code::Liggghts => crate::liggghts::run_deck(out, &options.runner),
+            _ => run_deck(out, &options.runner),
         }
     };
     let mut run = ReferenceRun {
@@ -128,7 +136,7 @@ pub fn run_reference(
     if let RunStatus::TimedOut { after_s, .. } = &run.status {
         summary.warnings.push(format!(
             "{} killed after {after_s:.0} s (time limit): partial run",
-            options.code.name()
+            options.code.label()
         ));
     }
     write_summary(&summary, out).map_err(|e| e.to_string())?;
