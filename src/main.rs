@@ -249,7 +249,8 @@ struct ReferenceArgs {
 
 fn reference_run(code: ReferenceCommand) -> Result<ExitCode, String> {
     use cgdem_harness::code::Code;
-    use cgdem_harness::lammps::{self, ReferenceOptions, RunStatus, RunnerOptions};
+    use cgdem_harness::lammps::{RunStatus, RunnerOptions};
+    use cgdem_harness::reference::{run_reference, ReferenceOptions};
     let (code, args) = match code {
         ReferenceCommand::Lammps(args) => (Code::Lammps, args),
         ReferenceCommand::Liggghts(args) => (Code::Liggghts, args),
@@ -287,7 +288,7 @@ fn reference_run(code: ReferenceCommand) -> Result<ExitCode, String> {
         force_dt,
         postprocess_only,
     };
-    let run = lammps::run_reference(&scene, &out, &options)?;
+    let run = run_reference(&scene, &out, &options)?;
     if let Some(w) = &run.dt_warning {
         eprintln!("warning: {w}");
     }

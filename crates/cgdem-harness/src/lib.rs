@@ -10,6 +10,7 @@ pub mod dynamics;
 pub mod history;
 pub mod lammps;
 pub mod liggghts;
+pub mod reference;
 pub mod report;
 pub mod screw;
 pub mod stability;

@@ -595,7 +595,8 @@ fn run_reference_code(
     dir: &Path,
     validate: &ValidateOptions,
 ) -> Result<bool, RunOutcome> {
-    use super::lammps::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
+    use super::lammps::{RunStatus, RunnerOptions};
+    use super::reference::{run_reference, ReferenceOptions};
     let reference = match code {
         Code::Liggghts => Code::Liggghts,
         _ => Code::Lammps,
