@@ -199,7 +199,7 @@ enum Command {
     /// with cgdem's analysis into the same outputs).
     Reference {
         #[command(subcommand)]
-        code: ReferenceCode,
+        code: ReferenceCommand,
     },
     /// Geometry tools: the seed's screw-feeder meshes and the SDF accuracy study.
     Geometry {
@@ -209,7 +209,7 @@ enum Command {
 }
 
 #[derive(Subcommand)]
-enum ReferenceCode {
+enum ReferenceCommand {
     /// LAMMPS (`lmp` on PATH or $CGDEM_LMP): the seed's WCA model (reference/lammps/SEED_MODEL.md)
     /// and Hertz scenes (reference/MAPPING.md).
     Lammps(ReferenceArgs),
@@ -257,13 +257,15 @@ struct ReferenceArgs {
     postprocess_only: bool,
 }
 
-fn reference_run(code: ReferenceCode) -> Result<ExitCode, String> {
-    use cgdem_harness::lammps::{self, ReferenceOptions, RunStatus, RunnerOptions};
+fn reference_run(code: ReferenceCommand) -> Result<ExitCode, String> {
+    use cgdem_harness::code::Code;
+    use cgdem_harness::lammps::{RunStatus, RunnerOptions};
+    use cgdem_harness::reference::{run_reference, ReferenceOptions};
     let (code, args) = match code {
-        ReferenceCode::Lammps(args) => (lammps::ReferenceCode::Lammps, args),
-        ReferenceCode::Liggghts(args) => (lammps::ReferenceCode::Liggghts, args),
+        ReferenceCommand::Lammps(args) => (Code::Lammps, args),
+        ReferenceCommand::Liggghts(args) => (Code::Liggghts, args),
     };
-    let name = code.name();
+    let name = code.label();
     let ReferenceArgs {
         case,
         lambda,
@@ -296,7 +298,7 @@ fn reference_run(code: ReferenceCode) -> Result<ExitCode, String> {
         force_dt,
         postprocess_only,
     };
-    let run = lammps::run_reference(&scene, &out, &options)?;
+    let run = run_reference(&scene, &out, &options)?;
     if let Some(w) = &run.dt_warning {
         eprintln!("warning: {w}");
     }

@@ -26,6 +26,7 @@ use cgdem_core::particles::Particles;
 use cgdem_core::run::{hertz_history_wall, hertz_law};
 use cgdem_core::scene::{ContactSettings, Scene};
 use cgdem_core::simulation::{NeighborSettings, World};
+use cgdem_harness::code::Code;
 use cgdem_harness::lammps::deck::Deck;
 use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
 use cgdem_harness::liggghts;
@@ -132,13 +133,6 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         trajectory.push(record(&world));
     }
     trajectory
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Code {
-    Cgdem,
-    Liggghts,
-    Lammps,
 }
 
 /// None when the code's binary is absent (the comparison is then skipped with a message).

@@ -8,10 +8,10 @@ use cgdem_core::particles::Particles;
 use cgdem_core::scene::Scene;
 use cgdem_core::simulation::{NeighborSettings, World};
 use cgdem_core::walls::{WallSet, WcaWall};
-use cgdem_harness::lammps::{
-    self, run_reference, ReferenceCode, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
-};
+use cgdem_harness::code::Code;
+use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
 use cgdem_harness::liggghts;
+use cgdem_harness::reference::{run_reference, ReferenceOptions, ReferenceRun};
 
 /// The seed's coke parameters (paper A sec. 3), coarse-grained by `lambda`.
 pub struct Coke {
@@ -155,14 +155,14 @@ pub fn collide(world: &mut World<SeedModel, WcaWall>, contact_distance: Real) ->
 /// None (after saying so) when the code is not installed. The run must complete; returns it
 /// with its directory.
 pub fn completed_reference_run(
-    code: ReferenceCode,
+    code: Code,
     scene: &Scene,
     dir: &str,
     timeout_s: u64,
 ) -> Option<(ReferenceRun, std::path::PathBuf)> {
     let found = match code {
-        ReferenceCode::Lammps => lammps::find_lmp(),
-        ReferenceCode::Liggghts => liggghts::find_liggghts(),
+        Code::Cgdem | Code::Lammps => lammps::find_lmp(),
+        Code::Liggghts => liggghts::find_liggghts(),
     };
     if let Err(reason) = found {
         println!(

@@ -7,7 +7,8 @@ use std::path::Path;
 
 use cgdem_core::geometry::screw_feeder::ScrewFeederSpec;
 use cgdem_core::scene::{Override, Scene};
-use cgdem_harness::lammps::{self, read_dump, ReferenceCode};
+use cgdem_harness::code::Code;
+use cgdem_harness::lammps::{self, read_dump};
 
 use crate::common::completed_reference_run;
 
@@ -25,8 +26,7 @@ fn lammps_turns_a_particle_screw_and_conveys_grains_inside_its_casing() {
     .map(|o| Override::parse(o, Path::new("test")).unwrap())
     .collect();
     let scene = Scene::load_with_overrides(&file, &overrides).expect("scene");
-    let Some((run, dir)) =
-        completed_reference_run(ReferenceCode::Lammps, &scene, "reference_screw", 300)
+    let Some((run, dir)) = completed_reference_run(Code::Lammps, &scene, "reference_screw", 300)
     else {
         return;
     };

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 
 use cgdem_core::run::SampleTrigger;
 use cgdem_core::scene::Scene;
-use cgdem_harness::lammps::{self, read_dump, ReferenceCode, RunStatus, RunnerOptions};
+use cgdem_harness::code::Code;
+use cgdem_harness::lammps::{self, read_dump, RunStatus, RunnerOptions};
 use cgdem_harness::liggghts;
 
 use crate::common::completed_reference_run;
@@ -16,7 +17,7 @@ fn scene() -> Scene {
         .expect("scene")
 }
 
-fn check(code: ReferenceCode) {
+fn check(code: Code) {
     let dir = format!("reference_stages/{}", code.name().to_lowercase());
     let Some((run, dir)) = completed_reference_run(code, &scene(), &dir, 120) else {
         return;
@@ -79,12 +80,12 @@ fn check(code: ReferenceCode) {
 
 #[test]
 fn liggghts_runs_a_multi_stage_hertz_deck() {
-    check(ReferenceCode::Liggghts);
+    check(Code::Liggghts);
 }
 
 #[test]
 fn lammps_runs_a_multi_stage_hertz_deck() {
-    check(ReferenceCode::Lammps);
+    check(Code::Lammps);
 }
 
 /// Regression: after `unfix` and a `run pre no`, LAMMPS walks its old fix list, so without the
@@ -93,10 +94,10 @@ fn lammps_runs_a_multi_stage_hertz_deck() {
 /// polynomial to the walls' damping (0.60055). One bead, no gravity, thrown at the end wall
 /// after the gate (a wall fix defined before it) is removed: it must rebound as from one wall
 /// set up once, as in LIGGGHTS (`tests/hertz_golden.rs`: 0.4999769 for this material).
-fn end_wall_rebound(code: ReferenceCode) {
+fn end_wall_rebound(code: Code) {
     let found = match code {
-        ReferenceCode::Lammps => lammps::find_lmp(),
-        ReferenceCode::Liggghts => liggghts::find_liggghts(),
+        Code::Cgdem | Code::Lammps => lammps::find_lmp(),
+        Code::Liggghts => liggghts::find_liggghts(),
     };
     if let Err(reason) = found {
         println!("skipped {}: {reason}", code.name());
@@ -131,8 +132,8 @@ fn end_wall_rebound(code: ReferenceCode) {
     particles.velocity[0] = cgdem_core::math::Vec3::new(1.0, 0.0, 0.0);
     let dt = 1e-6;
     let deck = match code {
-        ReferenceCode::Lammps => lammps::write_deck(&scene, &particles, dt),
-        ReferenceCode::Liggghts => liggghts::write_deck(&scene, &particles, dt),
+        Code::Cgdem | Code::Lammps => lammps::write_deck(&scene, &particles, dt),
+        Code::Liggghts => liggghts::write_deck(&scene, &particles, dt),
     }
     .expect("deck");
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
@@ -145,8 +146,8 @@ fn end_wall_rebound(code: ReferenceCode) {
         timeout: std::time::Duration::from_secs(60),
     };
     let status = match code {
-        ReferenceCode::Lammps => lammps::run_deck(&dir, &options),
-        ReferenceCode::Liggghts => liggghts::run_deck(&dir, &options),
+        Code::Cgdem | Code::Lammps => lammps::run_deck(&dir, &options),
+        Code::Liggghts => liggghts::run_deck(&dir, &options),
     };
     assert!(matches!(status, RunStatus::Completed { .. }), "{status:?}");
     let frames = read_dump(&dir.join("traj.dump")).expect("dump");
@@ -161,10 +162,10 @@ fn end_wall_rebound(code: ReferenceCode) {
 
 #[test]
 fn lammps_applies_each_remaining_wall_once_after_an_unfix() {
-    end_wall_rebound(ReferenceCode::Lammps);
+    end_wall_rebound(Code::Lammps);
 }
 
 #[test]
 fn liggghts_applies_each_remaining_wall_once_after_an_unfix() {
-    end_wall_rebound(ReferenceCode::Liggghts);
+    end_wall_rebound(Code::Liggghts);
 }

@@ -5,10 +5,12 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod code;
 pub mod dynamics;
 pub mod history;
 pub mod lammps;
 pub mod liggghts;
+pub mod reference;
 pub mod report;
 pub mod screw;
 pub mod stability;

@@ -10,30 +10,7 @@ use super::verdict::KnownDifference;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::{Override, Scene, SceneError};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Code {
-    Cgdem,
-    Lammps,
-    Liggghts,
-}
-
-impl Code {
-    pub fn name(self) -> &'static str {
-        match self {
-            Code::Cgdem => "cgdem",
-            Code::Lammps => "lammps",
-            Code::Liggghts => "liggghts",
-        }
-    }
-
-    /// The code a suite file names: "cgdem", "lammps" or "liggghts".
-    pub fn from_name(name: &str) -> Option<Code> {
-        [Code::Cgdem, Code::Lammps, Code::Liggghts]
-            .into_iter()
-            .find(|c| c.name() == name)
-    }
-}
+pub use crate::code::Code;
 
 /// The scene of a suite entry: its file with the overrides applied, named after the
 /// variant (`aor_collapse-smooth-walls`) when there is one.

@@ -841,12 +841,13 @@ fn run_reference_code(
     dir: &Path,
     validate: &ValidateOptions,
 ) -> Result<bool, RunOutcome> {
-    use super::lammps::{run_reference, ReferenceCode, ReferenceOptions, RunStatus, RunnerOptions};
+    use super::lammps::{RunStatus, RunnerOptions};
+    use super::reference::{run_reference, ReferenceOptions};
     let reference = match code {
-        Code::Liggghts => ReferenceCode::Liggghts,
-        _ => ReferenceCode::Lammps,
+        Code::Liggghts => Code::Liggghts,
+        _ => Code::Lammps,
     };
-    if reference == ReferenceCode::Liggghts
+    if reference == Code::Liggghts
         && matches!(
             scene.contact,
             cgdem_core::scene::ContactSettings::Wca { .. }
@@ -857,7 +858,7 @@ fn run_reference_code(
                 .into(),
         ));
     }
-    let name = reference.name();
+    let name = reference.label();
     let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
     let mut options = ReferenceOptions {

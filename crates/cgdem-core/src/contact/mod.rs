@@ -7,12 +7,14 @@
 
 pub mod cohesion;
 pub mod damping;
+mod history;
 pub mod normal;
 pub mod rolling;
 pub mod tangential;
 
+pub use history::PairHistory;
+
 use crate::math::{Real, Vec3};
-use crate::neighbor::PairHistory;
 
 /// Geometry and kinematics of one interacting pair, seen from particle `i`.
 #[derive(Clone, Copy, Debug)]
@@ -163,6 +165,18 @@ pub trait PairLaw: Send + Sync {
     ) -> Real;
 }
 
+/// Elastic plus damping normal force (positive pushes apart): the normal and damping slots
+/// together, for pairs and for walls (a wall being a partner of infinite radius and mass).
+#[inline(always)]
+pub fn normal_force<N: NormalModel, D: DampingModel>(
+    normal: &N,
+    damping: &D,
+    contact: &Contact,
+) -> Real {
+    let elastic = normal.response(contact);
+    elastic.force + damping.force(contact, &elastic)
+}
+
 /// A contact law assembled from five slots.
 #[derive(Clone, Debug)]
 pub struct ContactLaw<N, D, T, R, C> {
@@ -220,8 +234,7 @@ where
             };
         }
         // The normal part first: friction and rolling need |F_n|.
-        let elastic = self.normal.response(contact);
-        let normal_force = elastic.force + self.damping.force(contact, &elastic);
+        let normal_force = normal_force(&self.normal, &self.damping, contact);
         let tangential = self
             .tangential
             .force(contact, normal_force, &mut history.0, dt);

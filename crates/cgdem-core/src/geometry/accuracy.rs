@@ -4,6 +4,9 @@ use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::time::Instant;
 
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
 use super::aabb::Aabb;
 use super::analytic::{Cylinder, Sdf, Sphere};
 use super::bvh::Bvh;
@@ -13,34 +16,24 @@ use super::triangle_distance::TriangleFeature;
 use super::winding_number::FastWindingNumber;
 use crate::math::{Real, Vec3};
 
-/// Small deterministic generator (SplitMix64) so accuracy runs are reproducible without a
-/// dependency.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
+/// A seeded generator (`Pcg64`, as insertion uses) so accuracy runs are reproducible.
+pub fn seeded_rng(seed: u64) -> Pcg64 {
+    Pcg64::seed_from_u64(seed)
+}
 
-impl SplitMix64 {
-    pub fn new(seed: u64) -> SplitMix64 {
-        SplitMix64(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
+/// Random numbers and points for the accuracy study and the geometry tests, from any `rand`
+/// generator.
+pub trait RandomPoints: Rng {
     /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> Real {
-        (self.next_u64() >> 11) as Real * (1.0 / (1u64 << 53) as Real)
+    fn uniform(&mut self) -> Real {
+        self.gen::<Real>()
     }
 
-    pub fn range(&mut self, lo: Real, hi: Real) -> Real {
+    fn range(&mut self, lo: Real, hi: Real) -> Real {
         lo + (hi - lo) * self.uniform()
     }
 
-    pub fn vec_in_cube(&mut self, half: Real) -> Vec3 {
+    fn vec_in_cube(&mut self, half: Real) -> Vec3 {
         Vec3::new(
             self.range(-half, half),
             self.range(-half, half),
@@ -48,7 +41,7 @@ impl SplitMix64 {
         )
     }
 
-    pub fn vec_in_box(&mut self, b: Aabb) -> Vec3 {
+    fn vec_in_box(&mut self, b: Aabb) -> Vec3 {
         Vec3::new(
             self.range(b.min.x, b.max.x),
             self.range(b.min.y, b.max.y),
@@ -56,6 +49,8 @@ impl SplitMix64 {
         )
     }
 }
+
+impl<R: Rng + ?Sized> RandomPoints for R {}
 
 /// Sphere centred at the origin from a subdivided icosahedron: 20 * 4^subdivisions triangles,
 /// vertices on the sphere, outward oriented.
@@ -392,7 +387,7 @@ impl Truth for MeshTruth<'_> {
 
 /// Random points on the mesh surface (area-weighted) pushed along the face normal by up to
 /// `band` either way.
-fn band_samples(mesh: &TriMesh, band: Real, n: usize, rng: &mut SplitMix64) -> Vec<Vec3> {
+fn band_samples(mesh: &TriMesh, band: Real, n: usize, rng: &mut Pcg64) -> Vec<Vec3> {
     let mut cumulative = Vec::with_capacity(mesh.triangles.len());
     let mut total = 0.0;
     for t in 0..mesh.triangles.len() {
@@ -453,7 +448,7 @@ pub fn sdf_accuracy(
         let start = Instant::now();
         let grid = SdfGrid::from_mesh(&mesh, h, 3.0 * h)?;
         let build_seconds = start.elapsed().as_secs_f64();
-        let mut rng = SplitMix64::new(seed);
+        let mut rng = seeded_rng(seed);
         let (mut max_err, mut sum_sq, mut count) = (0.0 as Real, 0.0, 0usize);
         let mut angles = Vec::new();
         for p in band_samples(&mesh, 2.0 * h, samples, &mut rng) {

@@ -234,7 +234,7 @@ impl<A: Sdf, B: Sdf> Sdf for Difference<A, B> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::accuracy::SplitMix64;
+    use crate::geometry::accuracy::{seeded_rng, RandomPoints};
 
     fn assert_close(a: Real, b: Real) {
         assert!((a - b).abs() < 1e-12, "{a} != {b}");
@@ -264,7 +264,7 @@ mod tests {
     fn cone_reduces_to_cylinder_with_equal_radii_and_matches_slant_distance() {
         let cone = Cone::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0, 2.0);
         let cyl = Cylinder::new(Vec3::ZERO, Vec3::Z, 1.0, 2.0);
-        let mut rng = SplitMix64::new(1);
+        let mut rng = seeded_rng(1);
         for _ in 0..200 {
             let p = rng.vec_in_cube(3.0);
             assert!((cone.distance(p) - cyl.distance(p)).abs() < 1e-12);

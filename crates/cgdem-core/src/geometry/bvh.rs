@@ -198,13 +198,13 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::accuracy::{sphere_mesh, SplitMix64};
+    use crate::geometry::accuracy::{seeded_rng, sphere_mesh, RandomPoints};
 
     #[test]
     fn bvh_nearest_matches_brute_force_over_all_triangles() {
         let mut mesh = sphere_mesh(1.0, 3);
         // Jitter the vertices so that ties between triangles are rare and the test is sharp.
-        let mut rng = SplitMix64::new(3);
+        let mut rng = seeded_rng(3);
         for v in &mut mesh.vertices {
             *v += rng.vec_in_cube(0.02);
         }

@@ -344,7 +344,7 @@ fn grid_layout(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::accuracy::{cylinder_mesh, sphere_mesh, SplitMix64};
+    use crate::geometry::accuracy::{cylinder_mesh, seeded_rng, sphere_mesh, RandomPoints};
     use crate::geometry::analytic::{Cylinder, Sphere};
 
     /// Random points within `band` of the analytic surface, as (point, exact distance).
@@ -355,7 +355,7 @@ mod tests {
         n: usize,
         seed: u64,
     ) -> Vec<(Vec3, Real)> {
-        let mut rng = SplitMix64::new(seed);
+        let mut rng = seeded_rng(seed);
         let mut out = Vec::with_capacity(n);
         while out.len() < n {
             let p = rng.vec_in_box(bounds);
@@ -432,7 +432,7 @@ mod tests {
             max: Vec3::splat(1.0),
         };
         let grid = SdfGrid::from_sdf(&plane, bounds, 0.13, 0.0).expect("valid grid");
-        let mut rng = SplitMix64::new(2);
+        let mut rng = seeded_rng(2);
         for _ in 0..200 {
             let p = rng.vec_in_box(bounds);
             let (d, n) = grid.query(p).expect("inside");

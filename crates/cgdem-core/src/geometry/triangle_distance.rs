@@ -65,11 +65,11 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, T
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::accuracy::SplitMix64;
+    use crate::geometry::accuracy::{seeded_rng, RandomPoints};
 
     #[test]
     fn closest_point_on_triangle_matches_brute_force_sampling() {
-        let mut rng = SplitMix64::new(7);
+        let mut rng = seeded_rng(7);
         for _ in 0..300 {
             let a = rng.vec_in_cube(1.0);
             let b = rng.vec_in_cube(1.0);

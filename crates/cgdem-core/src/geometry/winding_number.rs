@@ -150,14 +150,14 @@ impl<'a> FastWindingNumber<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::accuracy::{cylinder_mesh, sphere_mesh, SplitMix64};
+    use crate::geometry::accuracy::{cylinder_mesh, seeded_rng, sphere_mesh, RandomPoints};
 
     #[test]
     fn winding_number_is_one_inside_and_zero_outside_a_closed_sphere() {
         let mesh = sphere_mesh(1.0, 3);
         let bvh = Bvh::new(&mesh);
         let fast = FastWindingNumber::new(&bvh);
-        let mut rng = SplitMix64::new(11);
+        let mut rng = seeded_rng(11);
         for _ in 0..400 {
             let p = rng.vec_in_cube(2.0);
             let r = p.length();
@@ -192,7 +192,7 @@ mod tests {
         assert_eq!(mesh.check_topology().open_edges.len(), 3);
         let bvh = Bvh::new(&mesh);
         let fast = FastWindingNumber::new(&bvh);
-        let mut rng = SplitMix64::new(5);
+        let mut rng = seeded_rng(5);
         let mut checked = 0;
         for _ in 0..2000 {
             let p = rng.vec_in_cube(1.6);

@@ -9,4 +9,4 @@ mod cell_grid;
 mod verlet_list;
 
 pub use cell_grid::CellGrid;
-pub use verlet_list::{brute_force_pairs, DisplacementCheck, Pair, PairHistory, VerletList};
+pub use verlet_list::{brute_force_pairs, DisplacementCheck, Pair, VerletList};

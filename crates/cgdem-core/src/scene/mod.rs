@@ -1,10 +1,13 @@
 //! Scene files: TOML read into raw structs, then validated once into typed settings.
 
+mod cg_rule;
 mod error;
 mod overrides;
 mod raw;
 mod validate;
 
+pub use crate::analysis::conveying::ConveyingSettings;
+pub use cg_rule::CoarseGrainRule;
 pub use error::SceneError;
 pub use overrides::Override;
 
@@ -237,31 +240,6 @@ pub struct BodySettings {
     pub start_stage: Option<String>,
 }
 
-/// Screw-conveyor measurements (paper A Eq. 7) during one stage.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ConveyingSettings {
-    pub stage: String,
-    /// The screw body (its rpm gives n_s).
-    pub body: String,
-    /// Start-up time discarded at the beginning of the stage, s.
-    pub discard: Real,
-    /// Blocks for the standard error of the mass flow.
-    pub blocks: u32,
-    pub outer_diameter: Real,
-    pub shaft_diameter: Real,
-    pub pitch: Real,
-    /// Casing bore radius: particles with centres inside it count for the fill ratio.
-    pub bore_radius: Real,
-    /// Axial range (along x, the screw axis) where the fill ratio is measured.
-    pub fill_x: [Real; 2],
-    /// Axial position of the plane the mass flow is measured through (inside the screw
-    /// section, downstream of the inlet); `None`: at the outlet, from the deleted mass alone.
-    pub flow_x: Option<Real>,
-    /// Box where the bulk density is measured (centres inside count).
-    pub bulk_lo: Vec3,
-    pub bulk_hi: Vec3,
-}
-
 /// Porosity and pore sizes of a poured bed (paper B sec. 3), measured when `stage` ends.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PackingSettings {
@@ -346,7 +324,7 @@ pub struct Scene {
     /// Coarse-graining level already applied (1 = the original system).
     pub lambda: u32,
     /// The rule by which it was coarse-grained.
-    pub cg_rule: crate::coarse_graining::CoarseGrainRule,
+    pub cg_rule: CoarseGrainRule,
     pub bodies: Vec<BodySettings>,
     /// Particles whose centre enters one of these boxes (lo, hi) are deleted.
     pub deletions: Vec<(Vec3, Vec3)>,

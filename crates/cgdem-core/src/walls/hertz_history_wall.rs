@@ -23,24 +23,20 @@
 
 use super::{HertzWall, WallContact, WallLaw};
 use crate::contact::damping::liggghts_damping_factor;
+use crate::contact::normal_force;
+use crate::contact::tangential::Mindlin;
+use crate::contact::TangentialModel;
 use crate::math::{Real, Vec3};
 
 #[derive(Clone, Debug)]
-pub struct HertzHistoryWallSpecies {
-    pub y_eff: Real,
-    pub g_eff: Real,
-    /// `2 sqrt(5/6) |beta(e_w)|`.
-    pub damping_factor: Real,
-    pub friction: Real,
+pub struct HertzHistoryWall {
+    /// The stateless law for bodies and the time step; its normal and damping slots give the
+    /// normal force here too.
+    pub stateless: HertzWall,
+    /// The pair's tangential slot, tables by the particle's species.
+    pub tangential: Mindlin,
     /// epsd2's `mu_r`; 0 = no rolling spring.
     pub rolling_friction: Real,
-}
-
-#[derive(Clone, Debug)]
-pub struct HertzHistoryWall {
-    pub species: Vec<HertzHistoryWallSpecies>,
-    /// The stateless law for bodies and the time step.
-    pub stateless: HertzWall,
 }
 
 impl HertzHistoryWall {
@@ -54,17 +50,13 @@ impl HertzHistoryWall {
     ) -> Self {
         let y_eff: Vec<Real> = moduli.iter().map(|m| m.0).collect();
         HertzHistoryWall {
-            species: moduli
-                .iter()
-                .map(|&(y_eff, g_eff)| HertzHistoryWallSpecies {
-                    y_eff,
-                    g_eff,
-                    damping_factor: liggghts_damping_factor(restitution),
-                    friction,
-                    rolling_friction,
-                })
-                .collect(),
             stateless: HertzWall::new(&y_eff, restitution, friction, 0.0, characteristic_velocity),
+            tangential: Mindlin {
+                g_eff: moduli.iter().map(|m| m.1).collect(),
+                damping_factor: vec![liggghts_damping_factor(restitution); moduli.len()],
+                friction: vec![friction; moduli.len()],
+            },
+            rolling_friction,
         }
     }
 }
@@ -90,38 +82,24 @@ impl WallLaw for HertzHistoryWall {
         (shear, rolling): &mut (Vec3, Vec3),
         dt: Real,
     ) -> (Vec3, Vec3) {
-        let s = &self.species[c.species];
         let n = c.normal;
         let delta = c.radius - c.distance;
-        let a = (c.radius * delta).sqrt();
         let normal_speed = c.relative_velocity.dot(n);
-        let normal_force = 4.0 / 3.0 * s.y_eff * a * delta
-            - s.damping_factor * (2.0 * s.y_eff * a * c.mass).sqrt() * normal_speed;
-        let load = normal_force.abs();
-
         let arm = c.radius - 0.5 * delta;
         let slip = c.relative_velocity - normal_speed * n + arm * n.cross(omega);
-        *shear += slip * dt;
-        *shear -= shear.dot(n) * n;
-        let k_t = 8.0 * s.g_eff * a;
-        let mut tangential = -k_t * *shear;
-        let cap = s.friction * load;
-        let size = tangential.length();
-        if size > cap {
-            if size > 0.0 {
-                tangential *= cap / size;
-                *shear = -tangential / k_t;
-            }
-        } else {
-            tangential -= s.damping_factor * (k_t * c.mass).sqrt() * slip;
-        }
+        let contact = c.as_pair(c.relative_velocity, normal_speed, slip);
+        let stateless = &self.stateless;
+        let normal_force = normal_force(&stateless.normal, &stateless.damping, &contact);
+        let tangential = self.tangential.force(&contact, normal_force, shear, dt);
         let mut torque = (-arm * n).cross(tangential);
 
-        if s.rolling_friction > 0.0 {
+        if self.rolling_friction > 0.0 {
+            let a = (c.radius * delta).sqrt();
+            let k_t = 8.0 * self.tangential.g_eff[c.species] * a;
             let w = omega * (arm / c.distance);
             let w_t = w - w.dot(n) * n;
             *rolling += k_t * c.radius * c.radius * dt * w_t;
-            let limit = s.rolling_friction * c.radius * load;
+            let limit = self.rolling_friction * c.radius * normal_force.abs();
             let size = rolling.length();
             if size > limit {
                 *rolling *= limit / size;

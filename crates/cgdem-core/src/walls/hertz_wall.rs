@@ -1,8 +1,10 @@
 //! Hertz particle-wall law: the particle law with the wall's radius taken as infinite, so
 //! `R_eff = r` and `m_eff = m`, and `1/Y_eff = (1 - nu_p^2)/Y_p + (1 - nu_w^2)/Y_w`.
 //!
-//! **Normal.** `F_n = (4/3) Y_eff sqrt(r delta) delta`, `delta = r - h` (h the centre-to-plane
-//! distance), with the LIGGGHTS restitution dashpot `-2 sqrt(5/6) |beta(e_w)| sqrt(S_n m) v_n`.
+//! **Normal.** The pair's slots `normal::Hertz` and `damping::HertzDamping` with the wall as a
+//! partner of infinite radius and mass (`WallContact::as_pair`): `F_n = (4/3) Y_eff sqrt(r
+//! delta) delta`, `delta = r - h` (h the centre-to-plane distance), with the LIGGGHTS
+//! restitution dashpot `-2 sqrt(5/6) |beta(e_w)| sqrt(S_n m) v_n`.
 //!
 //! Used with paper B's laws (`rolling = "constant_torque"`, `yang`); scenes with LIGGGHTS's
 //! keywords (`tangential = "history"`, rolling none or epsd2) get `HertzHistoryWall`, whose
@@ -19,24 +21,22 @@
 //! along the normal), capped to at most halve `|w|` in one step.
 
 use super::{WallContact, WallLaw};
-use crate::contact::damping::liggghts_damping_factor;
+use crate::contact::damping::HertzDamping;
 use crate::contact::normal::Hertz;
+use crate::contact::{normal_force, DampingModel};
 use crate::math::{Real, Vec3};
 
-#[derive(Clone, Debug)]
-pub struct HertzWallSpecies {
-    pub y_eff: Real,
-    /// `2 sqrt(5/6) |beta(e_w)|`.
-    pub damping_factor: Real,
-    pub friction: Real,
-    pub rolling_friction: Real,
-}
-
+/// The normal and damping slots of the pair law (tables by the particle's species, the wall
+/// as a partner of infinite radius and mass), with the wall's friction laws beside them.
 #[derive(Clone, Debug)]
 pub struct HertzWall {
-    pub species: Vec<HertzWallSpecies>,
-    /// Impact speed at which the contact is linearized for the time step (see `Hertz`).
-    pub characteristic_velocity: Real,
+    /// `Y_eff` of the particle-wall pair per species, and the impact speed at which the
+    /// contact is linearized for the time step.
+    pub normal: Hertz,
+    /// `2 sqrt(5/6) |beta(e_w)|` per species.
+    pub damping: HertzDamping,
+    pub friction: Real,
+    pub rolling_friction: Real,
 }
 
 impl HertzWall {
@@ -48,16 +48,13 @@ impl HertzWall {
         characteristic_velocity: Real,
     ) -> Self {
         HertzWall {
-            species: y_eff
-                .iter()
-                .map(|&y_eff| HertzWallSpecies {
-                    y_eff,
-                    damping_factor: liggghts_damping_factor(restitution),
-                    friction,
-                    rolling_friction,
-                })
-                .collect(),
-            characteristic_velocity,
+            normal: Hertz {
+                y_eff: y_eff.to_vec(),
+                characteristic_velocity,
+            },
+            damping: HertzDamping::from_restitution(&vec![restitution; y_eff.len()]),
+            friction,
+            rolling_friction,
         }
     }
 }
@@ -76,42 +73,36 @@ impl WallLaw for HertzWall {
 
     #[inline(always)]
     fn force_and_torque(&self, c: &WallContact, omega: Vec3, dt: Real) -> (Vec3, Vec3) {
-        let s = &self.species[c.species];
         let n = c.normal;
-        let delta = c.radius - c.distance;
-        let a = (c.radius * delta).sqrt();
-        let stiffness = 2.0 * s.y_eff * a;
         let arm = -n * c.distance; // centre to contact point
         let v = c.relative_velocity + omega.cross(arm);
         let normal_speed = v.dot(n);
-        let normal_force = 4.0 / 3.0 * s.y_eff * a * delta
-            - s.damping_factor * (stiffness * c.mass).sqrt() * normal_speed;
+        let tangential_velocity = v - normal_speed * n;
+        let contact = c.as_pair(v, normal_speed, tangential_velocity);
+        let normal_force = normal_force(&self.normal, &self.damping, &contact);
         let load = normal_force.max(0.0);
         let mut force = normal_force * n;
         let mut torque = Vec3::ZERO;
-        let tangential_velocity = v - normal_speed * n;
         let slip = tangential_velocity.length();
         if slip > 0.0 {
             let no_reversal = (2.0 / 7.0) * c.mass * slip / (2.0 * dt);
-            let friction = -(s.friction * load).min(no_reversal) / slip * tangential_velocity;
+            let friction = -(self.friction * load).min(no_reversal) / slip * tangential_velocity;
             force += friction;
             torque += arm.cross(friction);
         }
-        if s.rolling_friction > 0.0 {
+        if self.rolling_friction > 0.0 {
             let w = omega - omega.dot(n) * n;
             let spin = w.length();
             if spin > 0.0 {
                 let no_reversal = spin * 0.4 * c.mass * c.radius * c.radius / (2.0 * dt);
-                torque -= (s.rolling_friction * c.radius * load).min(no_reversal) / spin * w;
+                torque -= (self.rolling_friction * c.radius * load).min(no_reversal) / spin * w;
             }
         }
         (force, torque)
     }
 
     fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real) {
-        let s = &self.species[species];
-        let delta = Hertz::max_overlap(s.y_eff, radius, mass, self.characteristic_velocity);
-        let k = 2.0 * s.y_eff * (radius * delta).sqrt();
-        (k, s.damping_factor * (k * mass).sqrt())
+        let k = self.normal.stiffness_at_impact(species, radius, mass);
+        (k, self.damping.linear_coefficient(species, k, mass))
     }
 }

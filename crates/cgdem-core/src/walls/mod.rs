@@ -4,14 +4,14 @@ mod hertz_history_wall;
 mod hertz_wall;
 mod wca_wall;
 
-pub use hertz_history_wall::{HertzHistoryWall, HertzHistoryWallSpecies};
-pub use hertz_wall::{HertzWall, HertzWallSpecies};
+pub use hertz_history_wall::HertzHistoryWall;
+pub use hertz_wall::HertzWall;
 pub use wca_wall::{restitution_damping_ratio, WcaWall, WcaWallSpecies};
 
+use crate::contact::{Contact, PairHistory};
 use crate::geometry::FinitePlane;
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
-use crate::neighbor::PairHistory;
 
 /// One particle touching one wall, seen from the particle.
 #[derive(Clone, Copy, Debug)]
@@ -25,6 +25,36 @@ pub struct WallContact {
     pub relative_velocity: Vec3,
     pub radius: Real,
     pub mass: Real,
+}
+
+impl WallContact {
+    /// The contact as the pair slots see it: the wall is a partner of infinite radius and
+    /// mass (as in LIGGGHTS), so `R_eff = r`, `m_eff = m`, and the overlap is `r - h`.
+    /// `relative_velocity` is the particle's against the wall, as the law takes it (with or
+    /// without the spin), split into `normal_speed` and `tangential_velocity` by the caller.
+    #[inline(always)]
+    pub fn as_pair(
+        &self,
+        relative_velocity: Vec3,
+        normal_speed: Real,
+        tangential_velocity: Vec3,
+    ) -> Contact {
+        Contact {
+            species_pair: self.species,
+            normal: self.normal,
+            distance: self.distance,
+            overlap: self.radius - self.distance,
+            radius_i: self.radius,
+            radius_j: Real::INFINITY,
+            r_eff: self.radius,
+            inv_mass_i: 1.0 / self.mass,
+            inv_mass_j: 0.0,
+            m_eff: self.mass,
+            relative_velocity,
+            normal_speed,
+            tangential_velocity,
+        }
+    }
 }
 
 /// A particle-wall contact law.

@@ -23,6 +23,7 @@
 
 use std::fmt::Write as _;
 
+use crate::code::Code;
 use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
 use cgdem_core::scene::{ContactSettings, Scene, StageEnd};
@@ -32,6 +33,7 @@ use cgdem_core::walls::restitution_damping_ratio;
 pub const DECK_FILE: &str = "deck.in";
 pub const DATA_FILE: &str = "particles.data";
 pub const TRAJECTORY_FILE: &str = "traj.dump";
+pub const LOG_FILE: &str = "log.lammps";
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum DeckError {
@@ -97,6 +99,48 @@ pub(crate) fn boundary_line(scene: &Scene) -> String {
         }
     };
     format!("boundary        {} {} {}\n", flag(0), flag(1), flag(2))
+}
+
+/// The first words of a deck's header comment: `# LAMMPS input written by cgdem 0.1.0 from
+/// case.toml (scene `name``; the caller closes it.
+pub(crate) fn written_by(code: Code, scene: &Scene) -> String {
+    format!(
+        "# {} input written by cgdem {} from {} (scene `{}`",
+        code.label(),
+        env!("CARGO_PKG_VERSION"),
+        scene.source.display(),
+        scene.name
+    )
+}
+
+/// The set-up every deck starts with, after its header: SI units, spheres with a diameter
+/// (`sphere` in LAMMPS, `granular` in LIGGGHTS), the boundary, `newton off` with ghost
+/// velocities communicated, and the data file.
+pub(crate) fn preamble(code: Code, scene: &Scene) -> String {
+    let (atom_style, communicate) = match code {
+        Code::Liggghts => ("granular", "communicate     single vel yes"),
+        _ => ("sphere", "comm_modify     vel yes"),
+    };
+    let mut d =
+        format!("units           si\natom_style      {atom_style}\natom_modify     map array\n");
+    d += &boundary_line(scene);
+    let _ = writeln!(d, "newton          off\n{communicate}");
+    let _ = writeln!(d, "read_data       {DATA_FILE}");
+    d
+}
+
+/// The neighbour list: a skin of `skin_fraction` largest diameters, rebuilt when needed
+/// (LIGGGHTS checks every step by default and takes only the delay).
+pub(crate) fn neighbor_lines(code: Code, scene: &Scene) -> String {
+    let mut d = format!(
+        "neighbor        {} bin\n",
+        g(scene.skin_fraction * scene.max_diameter())
+    );
+    d += match code {
+        Code::Liggghts => "neigh_modify    delay 0\n",
+        _ => "neigh_modify    every 1 delay 0 check yes\n",
+    };
+    d
 }
 
 /// Frozen species (LAMMPS and LIGGGHTS alike): the `nve/sphere` fix's group, and the lines
@@ -420,7 +464,7 @@ pub(crate) fn removal_pads(scene: &Scene, fixes_per_wall: usize) -> String {
 
 /// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`:
 /// the seed's WCA model here, a Hertz scene by `hertz::write_hertz_deck`.
-pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
+pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let ContactSettings::Wca {
         epsilon,
@@ -429,8 +473,9 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         gamma_t,
     } = scene.contact
     else {
-        // Hertz: `pair_style granular hertz/material`, mapped in reference/MAPPING.md.
-        return super::hertz::write_hertz_deck(scene, particles, dt);
+        return Err(unsupported(
+            "not the seed's WCA model: Hertz scenes get `hertz::write_hertz_deck`".into(),
+        ));
     };
     if gamma_n <= 0.0 {
         return Err(unsupported(
@@ -473,20 +518,10 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         scene.species.len(),
     );
 
-    let mut d = String::new();
-    let _ = writeln!(
-        d,
-        "# LAMMPS input written by cgdem {} from {} (scene `{}`, lambda = {}).",
-        env!("CARGO_PKG_VERSION"),
-        scene.source.display(),
-        scene.name,
-        scene.lambda
-    );
+    let mut d = written_by(Code::Lammps, scene);
+    let _ = writeln!(d, ", lambda = {}).", scene.lambda);
     let _ = writeln!(d, "# Model lines: reference/lammps/SEED_MODEL.md. Do not edit: rewrite with `cgdem reference lammps`.");
-    d += "units           si\natom_style      sphere\natom_modify     map array\n";
-    d += &boundary_line(scene);
-    d += "newton          off\ncomm_modify     vel yes\n";
-    let _ = writeln!(d, "read_data       {DATA_FILE}");
+    d += &preamble(Code::Lammps, scene);
     // Diameter rc for the granular contact range; mass from the species' own diameter.
     for (t, m) in masses.iter().enumerate() {
         let _ = writeln!(
@@ -512,12 +547,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     );
     let _ = writeln!(d, "pair_coeff      * * granular hooke 0.0 {} damping velocity tangential linear_nohistory {} 1.0e8", g(gamma_n), g(gamma_t / gamma_n));
     d += "pair_modify     pair lj/cut shift yes\n";
-    let _ = writeln!(
-        d,
-        "neighbor        {} bin",
-        g(scene.skin_fraction * scene.max_diameter())
-    );
-    d += "neigh_modify    every 1 delay 0 check yes\n";
+    d += &neighbor_lines(Code::Lammps, scene);
     d += "fix             integ all nve\n";
     let gravity = scene.gravity;
     if gravity.length() > 0.0 {
@@ -598,7 +628,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         files: Vec::new(),
         plan: DeckPlan {
             code: "lammps",
-            log_file: super::runner::LOG_FILE,
+            log_file: LOG_FILE,
             notes: vec!["LAMMPS caps wall friction with the wall dashpot force only, cgdem with WCA + dashpot (reference/lammps/SEED_MODEL.md claim 11)".into()],
             dt,
             dump_every,
@@ -618,7 +648,7 @@ mod tests {
             .join("validation/cases/screw_feeder_nightly.toml");
         let scene = Scene::load(&path).unwrap();
         assert!(matches!(scene.contact, ContactSettings::Wca { .. }));
-        let err = write_deck(&scene, &Particles::new(false), 1e-6).unwrap_err();
+        let err = write_wca_deck(&scene, &Particles::new(false), 1e-6).unwrap_err();
         let message = err.to_string();
         assert!(message.contains("[[body]]"), "{message}");
         assert!(message.contains("screw_feeder_nightly.toml"), "{message}");
@@ -638,7 +668,7 @@ mod tests {
             s.mass(),
         );
         let dt = 1e-6;
-        let deck = write_deck(&scene, &particles, dt).unwrap();
+        let deck = write_wca_deck(&scene, &particles, dt).unwrap();
         assert_eq!(deck.plan.dump_every, 10_000);
         let d = &deck.input;
         assert!(d.contains("boundary        f p f"));

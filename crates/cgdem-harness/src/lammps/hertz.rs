@@ -18,10 +18,11 @@
 use std::fmt::Write as _;
 
 use super::deck::{
-    block_region, boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines,
-    unfix_wall, Deck, DeckError, DeckPlan, Periodic, StageDumps, StageHooks, DATA_FILE,
-    TRAJECTORY_FILE,
+    block_region, data_file, frozen_lines, g, kinetic_energy_lines, neighbor_lines, preamble,
+    stage_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, Periodic, StageDumps,
+    StageHooks, LOG_FILE, TRAJECTORY_FILE,
 };
+use crate::code::Code;
 use cgdem_core::contact::damping::restitution_beta;
 use cgdem_core::contact::normal::{Hertz, Material};
 use cgdem_core::math::Real;
@@ -178,18 +179,9 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     );
 
     let mut files = Vec::new();
-    let mut d = String::new();
-    let _ = writeln!(
-        d,
-        "# LAMMPS input written by cgdem {} from {} (scene `{}`): Hertz, reference/MAPPING.md.",
-        env!("CARGO_PKG_VERSION"),
-        scene.source.display(),
-        scene.name
-    );
-    d += "units           si\natom_style      sphere\natom_modify     map array\n";
-    d += &boundary_line(scene);
-    d += "newton          off\ncomm_modify     vel yes\n";
-    let _ = writeln!(d, "read_data       {DATA_FILE}");
+    let mut d = written_by(Code::Lammps, scene);
+    d += "): Hertz, reference/MAPPING.md.\n";
+    d += &preamble(Code::Lammps, scene);
     d += "pair_style      granular\n";
     let _ = writeln!(
         d,
@@ -206,12 +198,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         g(h.friction),
         rolling(y_eff, g_eff, s0.radius() * 0.5, s0.mass() * 0.5)
     );
-    let _ = writeln!(
-        d,
-        "neighbor        {} bin",
-        g(scene.skin_fraction * scene.max_diameter())
-    );
-    d += "neigh_modify    every 1 delay 0 check yes\n";
+    d += &neighbor_lines(Code::Lammps, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
     let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
@@ -359,7 +346,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         files,
         plan: DeckPlan {
             code: "lammps",
-            log_file: super::runner::LOG_FILE,
+            log_file: LOG_FILE,
             notes,
             dt,
             dump_every,

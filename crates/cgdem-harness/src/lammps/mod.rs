@@ -1,7 +1,7 @@
 //! LAMMPS (29 Sep 2021) as a reference for the seed model (and, `hertz`, the Hertz family); how
 //! the model is expressed in LAMMPS and what it cannot reproduce is in
-//! `reference/lammps/SEED_MODEL.md` and `reference/MAPPING.md`. `run_reference` also runs
-//! LIGGGHTS (`harness::liggghts`): both codes share the stage lines, runner and post-processing.
+//! `reference/lammps/SEED_MODEL.md` and `reference/MAPPING.md`. LIGGGHTS (`harness::liggghts`)
+//! shares the stage lines, runner and post-processing; `harness::reference` runs either.
 
 mod bodies;
 pub mod deck;
@@ -10,128 +10,23 @@ pub mod hertz;
 pub mod postprocess;
 pub mod runner;
 
-pub use deck::{write_deck, Deck, DeckError, DeckPlan};
+pub use deck::{Deck, DeckError, DeckPlan};
 pub use dump::{read_dump, DumpError, Frame};
 pub use hertz::write_hertz_deck;
 pub use postprocess::{postprocess, write_summary, PostprocessError};
 pub use runner::{find_lmp, run_deck, RunStatus, RunnerOptions, INSTALL_HINT};
 
-use std::path::Path;
+use cgdem_core::scene::{ContactSettings, Scene};
 
-use cgdem_core::run::RunSummary;
-use cgdem_core::scene::Scene;
-
-/// The reference code a deck is written for and run by.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ReferenceCode {
-    /// LAMMPS (`lmp`): the seed's WCA model and the Hertz family.
-    #[default]
-    Lammps,
-    /// LIGGGHTS (`liggghts`): the Hertz family with LIGGGHTS's own keywords.
-    Liggghts,
-}
-
-impl ReferenceCode {
-    pub fn name(self) -> &'static str {
-        match self {
-            ReferenceCode::Lammps => "LAMMPS",
-            ReferenceCode::Liggghts => "LIGGGHTS",
-        }
-    }
-}
-
-/// How `run_reference` runs: the code, the runner's settings and the two choices a user makes.
-#[derive(Clone, Debug, Default)]
-pub struct ReferenceOptions {
-    pub code: ReferenceCode,
-    pub runner: RunnerOptions,
-    /// Write the deck even if the time step exceeds the stable limit.
-    pub force_dt: bool,
-    /// Do not run: post-process the outputs already in `out` (of a stopped run, say). The
-    /// deck there must be the one this scene writes, so the outputs belong to it.
-    pub postprocess_only: bool,
-}
-
-/// What `run_reference` did.
-#[derive(Debug)]
-pub struct ReferenceRun {
-    pub status: RunStatus,
-    /// Present when LAMMPS completed or timed out (a partial run) and post-processing worked.
-    pub summary: Option<RunSummary>,
-    pub n_particles: usize,
-    pub dt: cgdem_core::math::Real,
-    /// The time-step warning when `force_dt` let an unstable step through.
-    pub dt_warning: Option<String>,
-    /// Why a timed-out run has no summary (its partial outputs could not be post-processed).
-    pub partial_error: Option<String>,
-}
-
-/// Writes the deck for `scene` (already coarse-grained) into `out`, runs the reference code
-/// (`options.code`) there and post-processes its dumps into cgdem's output files. Returns how the run ended, with the
-/// summary when there is one (also for a timed-out, partial run).
-pub fn run_reference(
+/// The LAMMPS deck for a scene (already coarse-grained): the seed's WCA model (`deck`) or the
+/// Hertz family (`hertz`, `pair_style granular hertz/material`, reference/MAPPING.md).
+pub fn write_deck(
     scene: &Scene,
-    out: &Path,
-    options: &ReferenceOptions,
-) -> Result<ReferenceRun, String> {
-    let (dt, scales, dt_warning) =
-        cgdem_core::run::time_step(scene, options.force_dt).map_err(|e| e.to_string())?;
-    let particles =
-        cgdem_core::run::initial_particles_clear_of_bodies(scene).map_err(|e| e.to_string())?;
-    let deck = match options.code {
-        ReferenceCode::Lammps => write_deck(scene, &particles, dt),
-        ReferenceCode::Liggghts => crate::liggghts::write_deck(scene, &particles, dt),
+    particles: &cgdem_core::particles::Particles,
+    dt: cgdem_core::math::Real,
+) -> Result<Deck, DeckError> {
+    match scene.contact {
+        ContactSettings::Wca { .. } => deck::write_wca_deck(scene, particles, dt),
+        ContactSettings::Hertz(_) => write_hertz_deck(scene, particles, dt),
     }
-    .map_err(|e| e.to_string())?;
-    let status = if options.postprocess_only {
-        let path = out.join(deck::DECK_FILE);
-        let previous = std::fs::read_to_string(&path)
-            .map_err(|e| format!("--postprocess-only: cannot read {}: {e}", path.display()))?;
-        if previous != deck.input {
-            return Err(format!(
-                "--postprocess-only: {} was not written for this case, lambda and seed",
-                path.display()
-            ));
-        }
-        RunStatus::Completed { wall_s: f64::NAN }
-    } else {
-        deck.write_to(out)
-            .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
-        match options.code {
-            ReferenceCode::Lammps => run_deck(out, &options.runner),
-            ReferenceCode::Liggghts => crate::liggghts::run_deck(out, &options.runner),
-        }
-    };
-    let mut run = ReferenceRun {
-        status,
-        summary: None,
-        n_particles: particles.len(),
-        dt,
-        dt_warning,
-        partial_error: None,
-    };
-    let wall_s = match &run.status {
-        RunStatus::Completed { wall_s } => *wall_s,
-        RunStatus::TimedOut { after_s, .. } => *after_s,
-        _ => return Ok(run),
-    };
-    let ranks = options.runner.np.unwrap_or(1) as usize;
-    let mut summary = match postprocess(scene, out, &deck.plan, &scales, wall_s, ranks) {
-        Ok(summary) => summary,
-        // A partial run keeps its status; why it has no summary goes with it.
-        Err(e) if matches!(run.status, RunStatus::TimedOut { .. }) => {
-            run.partial_error = Some(e.to_string());
-            return Ok(run);
-        }
-        Err(e) => return Err(e.to_string()),
-    };
-    if let RunStatus::TimedOut { after_s, .. } = &run.status {
-        summary.warnings.push(format!(
-            "{} killed after {after_s:.0} s (time limit): partial run",
-            options.code.name()
-        ));
-    }
-    write_summary(&summary, out).map_err(|e| e.to_string())?;
-    run.summary = Some(summary);
-    Ok(run)
 }

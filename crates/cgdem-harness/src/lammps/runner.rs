@@ -8,9 +8,9 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use super::deck::DECK_FILE;
+pub use super::deck::LOG_FILE;
 
 pub const INSTALL_HINT: &str = "bash scripts/install-references.sh";
-pub const LOG_FILE: &str = "log.lammps";
 
 #[derive(Clone, Debug)]
 pub struct RunnerOptions {

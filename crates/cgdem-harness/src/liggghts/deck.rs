@@ -14,9 +14,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::code::Code;
 use crate::lammps::deck::{
-    block_region, boundary_line, data_file, frozen_lines, g, kinetic_energy_lines, stage_lines,
-    unfix_wall, Deck, DeckError, DeckPlan, StageDumps, StageHooks, DATA_FILE,
+    block_region, data_file, frozen_lines, g, kinetic_energy_lines, neighbor_lines, preamble,
+    stage_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, StageDumps, StageHooks,
 };
 use crate::lammps::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
 use cgdem_core::math::Real;
@@ -75,24 +76,10 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         format!("{n_types} {}", v.join(" "))
     };
 
-    let mut d = String::new();
-    let _ = writeln!(
-        d,
-        "# LIGGGHTS input written by cgdem {} from {} (scene `{}`).",
-        env!("CARGO_PKG_VERSION"),
-        scene.source.display(),
-        scene.name
-    );
-    d += "units           si\natom_style      granular\natom_modify     map array\n";
-    d += &boundary_line(scene);
-    d += "newton          off\ncommunicate     single vel yes\n";
-    let _ = writeln!(d, "read_data       {DATA_FILE}");
-    let _ = writeln!(
-        d,
-        "neighbor        {} bin",
-        g(scene.skin_fraction * scene.max_diameter())
-    );
-    d += "neigh_modify    delay 0\n";
+    let mut d = written_by(Code::Liggghts, scene);
+    d += ").\n";
+    d += &preamble(Code::Liggghts, scene);
+    d += &neighbor_lines(Code::Liggghts, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
     // LIGGGHTS refuses E > 1e9 Pa in SI units unless told the particles are hard (steel).

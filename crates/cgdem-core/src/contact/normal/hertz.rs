@@ -49,6 +49,13 @@ impl Hertz {
         (15.0 * m_eff * v * v / (16.0 * y_eff * r_eff.sqrt())).powf(0.4)
     }
 
+    /// `S_n` at the largest overlap of an undamped impact at `characteristic_velocity`.
+    pub fn stiffness_at_impact(&self, species_pair: usize, r_eff: Real, m_eff: Real) -> Real {
+        let y = self.y_eff[species_pair];
+        let delta = Hertz::max_overlap(y, r_eff, m_eff, self.characteristic_velocity);
+        2.0 * y * (r_eff * delta).sqrt()
+    }
+
     /// Duration of an undamped Hertz impact, `2.87 (m_eff^2 / (R_eff Y_eff^2 v))^(1/5)`.
     pub fn contact_time(y_eff: Real, r_eff: Real, m_eff: Real, v: Real) -> Real {
         2.868 * (m_eff * m_eff / (r_eff * y_eff * y_eff * v)).powf(0.2)
@@ -77,10 +84,8 @@ impl NormalModel for Hertz {
         radius_j: Real,
         m_eff: Real,
     ) -> Real {
-        let y = self.y_eff[species_pair];
         let r_eff = radius_i * radius_j / (radius_i + radius_j);
-        let delta = Hertz::max_overlap(y, r_eff, m_eff, self.characteristic_velocity);
-        2.0 * y * (r_eff * delta).sqrt()
+        self.stiffness_at_impact(species_pair, r_eff, m_eff)
     }
 
     /// `(8/15) Y_eff sqrt(R_eff) delta^(5/2)`, the integral of the force over the overlap.

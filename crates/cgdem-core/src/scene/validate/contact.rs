@@ -1,0 +1,395 @@
+//! `[contact]` (one function per model and per Hertz sub-model), `[wall_contact]` and
+//! `[[wall]]`.
+
+use super::super::raw::*;
+use super::super::*;
+use super::Checker;
+use crate::math::TWO_POW_ONE_SIXTH;
+
+/// `[contact]`: `model = "wca"` or `"hertz"`.
+pub(super) fn contact(
+    c: &Checker,
+    rc: &RawContact,
+    species: &[Species],
+) -> Result<ContactSettings, SceneError> {
+    match rc.model.as_str() {
+        "hertz" => Ok(ContactSettings::Hertz(hertz_contact(c, rc)?)),
+        "wca" => wca_contact(c, rc, species),
+        other => Err(c.invalid(
+            "contact.model",
+            format!("\"{other}\""),
+            "\"wca\" (the seed's model) or \"hertz\"",
+        )),
+    }
+}
+
+/// `[contact] model = "wca"`: the seed's WCA repulsion with viscous damping.
+fn wca_contact(
+    c: &Checker,
+    rc: &RawContact,
+    species: &[Species],
+) -> Result<ContactSettings, SceneError> {
+    for (field, set) in [
+        ("youngs_modulus", rc.youngs_modulus.is_some()),
+        ("poisson_ratio", rc.poisson_ratio.is_some()),
+        ("restitution", rc.restitution.is_some()),
+        ("friction", rc.friction.is_some()),
+        ("rolling_friction", rc.rolling_friction.is_some()),
+        ("damping", rc.damping.is_some()),
+        ("gamma_n_yang", rc.gamma_n_yang.is_some()),
+        ("tangential", rc.tangential.is_some()),
+        ("rolling", rc.rolling.is_some()),
+        ("cohesion", rc.cohesion.is_some()),
+        ("hamaker_constant", rc.hamaker_constant.is_some()),
+        ("h_min", rc.h_min.is_some()),
+        ("cohesion_cutoff", rc.cohesion_cutoff.is_some()),
+        (
+            "characteristic_velocity",
+            rc.characteristic_velocity.is_some(),
+        ),
+    ] {
+        if set {
+            return Err(c.invalid(
+                format!("contact.{field}"),
+                "set",
+                "only with model = \"hertz\"; the wca model takes epsilon, sigma, gamma_n, gamma_t",
+            ));
+        }
+    }
+    let epsilon = c.positive(
+        "contact.epsilon",
+        c.required("contact.epsilon", rc.epsilon, "the WCA energy, J")?,
+    )?;
+    let sigma = c.positive(
+        "contact.sigma",
+        c.required("contact.sigma", rc.sigma, "the WCA length, m")?,
+    )?;
+    let gamma_n = c.non_negative(
+        "contact.gamma_n",
+        c.required("contact.gamma_n", rc.gamma_n, "the normal dashpot, kg/s")?,
+    )?;
+    let gamma_t = c.non_negative(
+        "contact.gamma_t",
+        c.required(
+            "contact.gamma_t",
+            rc.gamma_t,
+            "the tangential dashpot, kg/s",
+        )?,
+    )?;
+    // The WCA cut-off 2^(1/6) sigma is the particle diameter (paper A); a mismatch
+    // would make particles touch before or after they repel. Frozen species (e.g. a
+    // body's particles) get sigma mixed by the mean diameter of each pair instead.
+    for s in species.iter().filter(|s| !s.frozen) {
+        let rc = TWO_POW_ONE_SIXTH * sigma;
+        if (rc / s.diameter - 1.0).abs() > 0.01 {
+            return Err(c.invalid("contact.sigma", sigma, format!("2^(1/6) sigma within 1% of the diameter of species `{}` ({} m), i.e. sigma near {:.6e}", s.name, s.diameter, s.diameter / TWO_POW_ONE_SIXTH)));
+        }
+    }
+    Ok(ContactSettings::Wca {
+        epsilon,
+        sigma,
+        gamma_n,
+        gamma_t,
+    })
+}
+
+pub(super) fn poisson(c: &Checker, field: &str, nu: f64) -> Result<f64, SceneError> {
+    if nu.is_finite() && (-1.0..0.5).contains(&nu) {
+        Ok(nu)
+    } else {
+        Err(c.invalid(field, nu, "-1 <= poisson_ratio < 0.5"))
+    }
+}
+
+/// `[contact] model = "hertz"`: keywords as in LIGGGHTS/LAMMPS.
+fn hertz_contact(c: &Checker, rc: &RawContact) -> Result<HertzSettings, SceneError> {
+    for (field, set) in [
+        ("epsilon", rc.epsilon.is_some()),
+        ("sigma", rc.sigma.is_some()),
+        ("gamma_n", rc.gamma_n.is_some()),
+        ("gamma_t", rc.gamma_t.is_some()),
+    ] {
+        if set {
+            return Err(c.invalid(
+                format!("contact.{field}"),
+                "set",
+                "only with model = \"wca\"; for Yang damping use gamma_n_yang",
+            ));
+        }
+    }
+    let youngs_modulus = c.positive(
+        "contact.youngs_modulus",
+        c.required(
+            "contact.youngs_modulus",
+            rc.youngs_modulus,
+            "Young's modulus of the particles, Pa",
+        )?,
+    )?;
+    let poisson_ratio = poisson(
+        c,
+        "contact.poisson_ratio",
+        c.required(
+            "contact.poisson_ratio",
+            rc.poisson_ratio,
+            "Poisson's ratio of the particles",
+        )?,
+    )?;
+    let friction = c.non_negative(
+        "contact.friction",
+        c.required(
+            "contact.friction",
+            rc.friction,
+            "the Coulomb friction coefficient",
+        )?,
+    )?;
+    let rolling_friction = c.non_negative(
+        "contact.rolling_friction",
+        rc.rolling_friction.unwrap_or(0.0),
+    )?;
+    let (damping, restitution) = hertz_damping(c, rc)?;
+    let tangential = tangential(c, rc)?;
+    let rolling = rolling(c, rc, rolling_friction)?;
+    let cohesion = cohesion(c, rc)?;
+    Ok(HertzSettings {
+        youngs_modulus,
+        poisson_ratio,
+        restitution,
+        friction,
+        rolling_friction,
+        damping,
+        tangential,
+        rolling,
+        cohesion,
+        characteristic_velocity: c.positive(
+            "contact.characteristic_velocity",
+            rc.characteristic_velocity.unwrap_or(1.0),
+        )?,
+    })
+}
+
+/// `damping = "hertz" | "yang"` and the restitution that goes (only) with the first.
+fn hertz_damping(c: &Checker, rc: &RawContact) -> Result<(HertzDampingKind, Real), SceneError> {
+    let damping = match rc.damping.as_deref().unwrap_or("hertz") {
+        "hertz" => {
+            if rc.gamma_n_yang.is_some() {
+                return Err(c.invalid(
+                    "contact.gamma_n_yang",
+                    "set",
+                    "only with damping = \"yang\"",
+                ));
+            }
+            HertzDampingKind::Restitution
+        }
+        "yang" => HertzDampingKind::Yang {
+            gamma_n: c.non_negative(
+                "contact.gamma_n_yang",
+                c.required(
+                    "contact.gamma_n_yang",
+                    rc.gamma_n_yang,
+                    "the Yang damping time gamma_n, s",
+                )?,
+            )?,
+        },
+        other => {
+            return Err(c.invalid(
+                "contact.damping",
+                format!("\"{other}\""),
+                "\"hertz\" (LIGGGHTS restitution-based, default) or \"yang\" (paper B Eq. 4)",
+            ))
+        }
+    };
+    let restitution = match (damping, rc.restitution) {
+        (HertzDampingKind::Restitution, None) => {
+            return Err(c.invalid(
+                "contact.restitution",
+                "missing",
+                "the coefficient of restitution, 0 < e <= 1",
+            ))
+        }
+        (_, Some(e)) if !(e > 0.0 && e <= 1.0) => {
+            return Err(c.invalid("contact.restitution", e, "0 < e <= 1"))
+        }
+        (HertzDampingKind::Yang { .. }, Some(_)) => {
+            return Err(c.invalid(
+                "contact.restitution",
+                "set",
+                "not with damping = \"yang\" (its damping is gamma_n_yang)",
+            ))
+        }
+        (_, e) => e.unwrap_or(1.0),
+    };
+    Ok((damping, restitution))
+}
+
+/// `tangential = "history" | "yang"`.
+fn tangential(c: &Checker, rc: &RawContact) -> Result<TangentialKind, SceneError> {
+    match rc.tangential.as_deref().unwrap_or("history") {
+        "history" => Ok(TangentialKind::History),
+        "yang" => Ok(TangentialKind::Yang),
+        other => Err(c.invalid(
+            "contact.tangential",
+            format!("\"{other}\""),
+            "\"history\" (LIGGGHTS tangential history, default) or \"yang\" (paper B Eq. 5)",
+        )),
+    }
+}
+
+/// `rolling = "none" | "constant_torque" | "epsd2"`; a rolling model needs a friction > 0.
+fn rolling(
+    c: &Checker,
+    rc: &RawContact,
+    rolling_friction: Real,
+) -> Result<RollingKind, SceneError> {
+    let rolling = match rc.rolling.as_deref().unwrap_or("none") {
+        "none" => RollingKind::None,
+        "constant_torque" => RollingKind::ConstantTorque,
+        "epsd2" => RollingKind::Epsd2,
+        other => return Err(c.invalid(
+            "contact.rolling",
+            format!("\"{other}\""),
+            "\"none\", \"constant_torque\" (paper B Eq. 10) or \"epsd2\" (LIGGGHTS rolling spring)",
+        )),
+    };
+    if rolling != RollingKind::None && rolling_friction == 0.0 {
+        return Err(c.invalid(
+            "contact.rolling_friction",
+            rolling_friction,
+            "> 0 when rolling is not \"none\"",
+        ));
+    }
+    Ok(rolling)
+}
+
+/// `cohesion = "none" | "vdw"` with the van der Waals parameters only for the second.
+fn cohesion(c: &Checker, rc: &RawContact) -> Result<CohesionKind, SceneError> {
+    match rc.cohesion.as_deref().unwrap_or("none") {
+        "none" => {
+            for (field, set) in [
+                ("hamaker_constant", rc.hamaker_constant.is_some()),
+                ("h_min", rc.h_min.is_some()),
+                ("cohesion_cutoff", rc.cohesion_cutoff.is_some()),
+            ] {
+                if set {
+                    return Err(c.invalid(
+                        format!("contact.{field}"),
+                        "set",
+                        "only with cohesion = \"vdw\"",
+                    ));
+                }
+            }
+            Ok(CohesionKind::None)
+        }
+        "vdw" => {
+            let h_min = c.positive(
+                "contact.h_min",
+                c.required(
+                    "contact.h_min",
+                    rc.h_min,
+                    "the van der Waals cut-off gap, m (e.g. 4e-10)",
+                )?,
+            )?;
+            let cutoff = match rc.cohesion_cutoff {
+                Some(x) if x.is_finite() && x > h_min => Some(x),
+                Some(x) => {
+                    return Err(c.invalid(
+                        "contact.cohesion_cutoff",
+                        x,
+                        format!("a gap > h_min = {h_min} m"),
+                    ))
+                }
+                None => None,
+            };
+            Ok(CohesionKind::VanDerWaals {
+                hamaker_constant: c.positive(
+                    "contact.hamaker_constant",
+                    c.required(
+                        "contact.hamaker_constant",
+                        rc.hamaker_constant,
+                        "the Hamaker constant, J",
+                    )?,
+                )?,
+                h_min,
+                cutoff,
+            })
+        }
+        other => Err(c.invalid(
+            "contact.cohesion",
+            format!("\"{other}\""),
+            "\"none\" or \"vdw\" (van der Waals, paper B Eq. 7-8)",
+        )),
+    }
+}
+
+/// `[wall_contact]`: required when the scene has walls; inert defaults otherwise.
+pub(super) fn wall_contact(
+    c: &Checker,
+    raw: Option<&RawWallContact>,
+    has_walls: bool,
+) -> Result<WallContactSettings, SceneError> {
+    match raw {
+        Some(w) => {
+            if !(w.restitution > 0.0 && w.restitution <= 1.0) {
+                return Err(c.invalid("wall_contact.restitution", w.restitution, "0 < e <= 1"));
+            }
+            let youngs_modulus = match w.youngs_modulus {
+                Some(y) => Some(c.positive("wall_contact.youngs_modulus", y)?),
+                None => None,
+            };
+            let poisson_ratio = match w.poisson_ratio {
+                Some(nu) => Some(poisson(c, "wall_contact.poisson_ratio", nu)?),
+                None => None,
+            };
+            Ok(WallContactSettings {
+                restitution: w.restitution,
+                friction: c.non_negative("wall_contact.friction", w.friction)?,
+                youngs_modulus,
+                poisson_ratio,
+                rolling_friction: c.non_negative(
+                    "wall_contact.rolling_friction",
+                    w.rolling_friction.unwrap_or(0.0),
+                )?,
+            })
+        }
+        None if !has_walls => Ok(WallContactSettings {
+            restitution: 1.0,
+            friction: 0.0,
+            youngs_modulus: None,
+            poisson_ratio: None,
+            rolling_friction: 0.0,
+        }),
+        None => Err(c.invalid(
+            "wall_contact",
+            "missing",
+            "a [wall_contact] table with restitution and friction when the scene has walls",
+        )),
+    }
+}
+
+/// `[[wall]]`: planes by a point and a non-zero normal, names unique.
+pub(super) fn walls(c: &Checker, raw: &[RawWall]) -> Result<Vec<WallSettings>, SceneError> {
+    let mut walls = Vec::new();
+    for (k, w) in raw.iter().enumerate() {
+        let point = c.vector(&format!("wall[{k}].point"), w.point)?;
+        let normal = c.vector(&format!("wall[{k}].normal"), w.normal)?;
+        if normal.length() == 0.0 {
+            return Err(c.invalid(
+                format!("wall[{k}].normal"),
+                format!("{:?}", w.normal),
+                "a non-zero vector",
+            ));
+        }
+        if walls.iter().any(|x: &WallSettings| x.name == w.name) {
+            return Err(c.invalid(
+                format!("wall[{k}].name"),
+                &w.name,
+                "a name not used by another wall",
+            ));
+        }
+        walls.push(WallSettings {
+            name: w.name.clone(),
+            point,
+            normal: normal.normalize(),
+        });
+    }
+    Ok(walls)
+}
