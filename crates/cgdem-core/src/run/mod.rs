@@ -22,7 +22,7 @@ use crate::contact::{PairLaw, SeedModel};
 use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, SdfGrid};
 use crate::guard::{GuardKind, GuardPeaks, GuardSettings, GuardTrip};
 use crate::insertion::{insert_random_where, lattice_sites, InsertionFailed};
-use crate::io::{vtk::VtkSeries, write_atomic};
+use crate::io::{vtk::VtkOutput, write_atomic};
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 use crate::scene::{ContactSettings, InsertAmount, ReposeSettings, Scene, StageEnd};
@@ -653,7 +653,7 @@ fn execute<L: PairLaw, W: WallLaw>(
     writeln!(timeseries, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{},mechanical_energy_j", if conveying_body.is_some() { ",fill_ratio,bulk_density_kg_m3,passed_mass_kg" } else { "" }).map_err(|e| output_error(&timeseries_path, e))?;
     let mut vtk = if scene.output.vtk_interval > 0.0 {
         Some(
-            VtkSeries::new(&out.join("vtk"), "particles")
+            VtkOutput::for_scene(&out.join("vtk"), scene)
                 .map_err(|e| output_error(&out.join("vtk"), e))?,
         )
     } else {
@@ -891,7 +891,7 @@ fn execute<L: PairLaw, W: WallLaw>(
                 if world.time + 0.5 * dt >= next_frame {
                     next_frame += scene.output.vtk_interval;
                     series
-                        .write_frame(&world.particles, world.time)
+                        .write_frame(&world)
                         .map_err(|e| output_error(&out.join("vtk"), e))?;
                 }
             }

@@ -298,6 +298,8 @@ pub struct Stage {
 pub struct OutputSettings {
     /// Simulated seconds between VTK frames; 0 = none.
     pub vtk_interval: Real,
+    /// Also write the pair contacts as lines (`vtk/contacts.pvd`) with each VTK frame.
+    pub vtk_contact_network: bool,
     /// Simulated seconds between time-series rows.
     pub timeseries_interval: Real,
 }

@@ -221,6 +221,7 @@ pub struct RawStage {
 #[serde(deny_unknown_fields)]
 pub struct RawOutput {
     pub vtk_interval: Option<f64>,
+    pub vtk_contact_network: Option<bool>,
     pub timeseries_interval: Option<f64>,
 }
 

@@ -786,6 +786,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         stages,
         output: OutputSettings {
             vtk_interval,
+            vtk_contact_network: output.and_then(|o| o.vtk_contact_network).unwrap_or(false),
             timeseries_interval,
         },
         repose,
