@@ -162,6 +162,9 @@ pub struct Insertion {
     pub seed: u64,
     /// Initial velocity of every particle inserted, m/s.
     pub velocity: Vec3,
+    /// Initial angular velocity of every particle inserted, rad/s (LIGGGHTS `set ... omega`);
+    /// only with a contact law that rotates particles (Hertz).
+    pub omega: Vec3,
     /// Overlap allowed between inserted particles, as a fraction of the sum of their radii
     /// (0: none; stability tests use it to start from a compressed packing).
     pub overlap: Real,

@@ -181,6 +181,7 @@ pub struct RawInsertion {
     pub seed: u64,
     pub mesh: Option<String>,
     pub velocity: Option<[f64; 3]>,
+    pub omega: Option<[f64; 3]>,
     pub overlap: Option<f64>,
     pub lattice: Option<String>,
     pub spacing: Option<f64>,
