@@ -647,6 +647,7 @@ fn main() -> ExitCode {
                 Ok(pool) => pool,
                 Err(code) => return code,
             };
+            let mut figures = Vec::new();
             let result = pool.install(|| {
                 load_scene(&case, &set, variant.as_deref(), seed)
                     .and_then(|scene| {
@@ -702,9 +703,13 @@ fn main() -> ExitCode {
                             keep_going,
                             ..Default::default()
                         };
-                        run(&scene, &options)
-                            .map(|summary| (summary, out_dir))
-                            .map_err(|e| e.to_string())
+                        let summary = run(&scene, &options).map_err(|e| e.to_string())?;
+                        // A figure that cannot be drawn does not fail the run it shows.
+                        match cgdem_harness::report::run_figures::write_run_figures(&scene, &summary, &out_dir) {
+                            Ok(files) => figures.extend(files.into_iter().map(|f| f.png)),
+                            Err(e) => eprintln!("warning: figure not written: {e}"),
+                        }
+                        Ok((summary, out_dir))
                     })
             });
             match result {
@@ -731,6 +736,9 @@ fn main() -> ExitCode {
                             "mass flow {:.4} +- {:.4} kg/s over {:.2}..{:.2} s; fill ratio {:.3} (solid), a = {:.3} (bulk), bulk density {:.1} kg/m3, drive torque {:.2} N m; Eq. (7): {:.4} kg/s (measured a), {:.4} kg/s (a = 1)",
                             c.mass_flow_kg_s, c.mass_flow_std_error_kg_s, c.window_s[0], c.window_s[1], c.fill_ratio, c.fill_ratio_bulk, c.bulk_density_kg_m3, c.drive_torque_nm, c.eq7_mass_flow_kg_s, c.eq7_full_mass_flow_kg_s
                         );
+                    }
+                    for png in &figures {
+                        println!("figure {} (.svg, .csv beside it)", png.display());
                     }
                     println!("outputs in {}", out_dir.display());
                     ExitCode::SUCCESS

@@ -104,7 +104,9 @@ fn a_small_run_writes_summary_timeseries_profile_and_a_vtk_series() {
     let pvd = std::fs::read_to_string(dir.join("vtk/particles.pvd")).unwrap();
     let frames = pvd.matches("<DataSet").count();
     assert!(frames >= 2, "{pvd}");
-    let first = std::fs::read_to_string(dir.join("vtk/particles_000000.vtu")).unwrap();
+    // Appended raw binary: not UTF-8 past the XML header.
+    let first = std::fs::read(dir.join("vtk/particles_000000.vtu")).unwrap();
+    let first = String::from_utf8_lossy(&first);
     assert!(
         first.contains("UnstructuredGrid")
             && first.contains("radius")

@@ -4,6 +4,10 @@
 //! concrete force loop per scene: the seed's WCA scene has no rotation, no history and no
 //! cohesion in it.
 
+pub(crate) mod network;
+
+pub use network::{ContactNetwork, PairContact};
+
 use rayon::prelude::*;
 
 use crate::bodies::{Body, BodyLoad, KinematicParticles};

@@ -219,6 +219,7 @@ fn observers<'s, L: PairLaw, W: WallLaw>(
     )?));
     if scene.output.vtk_interval > 0.0 {
         list.push(Box::new(VtkFrames::new(
+            scene,
             out.join("vtk"),
             scene.output.vtk_interval,
         )?));

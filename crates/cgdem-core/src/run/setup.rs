@@ -180,6 +180,9 @@ pub fn initial_particles_with_bodies(
         for v in &mut particles.velocity[first..] {
             *v = ins.velocity;
         }
+        if let Some(angular) = particles.angular.as_mut() {
+            angular.omega[first..].fill(ins.omega);
+        }
         if species.frozen {
             for k in first..particles.len() {
                 particles.freeze(k);

@@ -165,6 +165,9 @@ pub struct Insertion {
     pub seed: u64,
     /// Initial velocity of every particle inserted, m/s.
     pub velocity: Vec3,
+    /// Initial angular velocity of every particle inserted, rad/s (LIGGGHTS `set ... omega`);
+    /// only with a contact law that rotates particles (Hertz).
+    pub omega: Vec3,
     /// Overlap allowed between inserted particles, as a fraction of the sum of their radii
     /// (0: none; stability tests use it to start from a compressed packing).
     pub overlap: Real,
@@ -276,6 +279,8 @@ pub struct Stage {
 pub struct OutputSettings {
     /// Simulated seconds between VTK frames; 0 = none.
     pub vtk_interval: Real,
+    /// Also write the pair contacts as lines (`vtk/contacts.pvd`) with each VTK frame.
+    pub vtk_contact_network: bool,
     /// Simulated seconds between time-series rows.
     pub timeseries_interval: Real,
 }

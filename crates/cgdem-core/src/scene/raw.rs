@@ -181,6 +181,7 @@ pub struct RawInsertion {
     pub seed: u64,
     pub mesh: Option<String>,
     pub velocity: Option<[f64; 3]>,
+    pub omega: Option<[f64; 3]>,
     pub overlap: Option<f64>,
     pub lattice: Option<String>,
     pub spacing: Option<f64>,
@@ -221,6 +222,7 @@ pub struct RawStage {
 #[serde(deny_unknown_fields)]
 pub struct RawOutput {
     pub vtk_interval: Option<f64>,
+    pub vtk_contact_network: Option<bool>,
     pub timeseries_interval: Option<f64>,
 }
 

@@ -3,6 +3,7 @@
 
 pub mod html;
 pub mod plot;
+pub mod run_figures;
 pub mod sdf_study;
 
 pub use html::{Cell, Report, Section, Status, Table};

@@ -1,10 +1,12 @@
-//! The VTK series (`vtk/particles.pvd` and its frames), one frame per `output.vtk_interval`.
+//! The VTK series (`vtk/particles.pvd`, `bodies.pvd`, `contacts.pvd` and their frames, see
+//! `io::vtk`), one frame per `output.vtk_interval`.
 
 use std::path::PathBuf;
 
 use crate::contact::PairLaw;
-use crate::io::vtk::VtkSeries;
+use crate::io::vtk::VtkOutput;
 use crate::math::Real;
+use crate::scene::Scene;
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
@@ -13,14 +15,14 @@ use super::{Due, Flow, Observer, StageClock};
 
 pub(crate) struct VtkFrames {
     dir: PathBuf,
-    series: VtkSeries,
+    series: VtkOutput,
     interval: Real,
     next_frame: Real,
 }
 
 impl VtkFrames {
-    pub(crate) fn new(dir: PathBuf, interval: Real) -> Result<Self, RunError> {
-        let series = VtkSeries::new(&dir, "particles").map_err(|e| output_error(&dir, e))?;
+    pub(crate) fn new(scene: &Scene, dir: PathBuf, interval: Real) -> Result<Self, RunError> {
+        let series = VtkOutput::for_scene(&dir, scene).map_err(|e| output_error(&dir, e))?;
         Ok(VtkFrames {
             dir,
             series,
@@ -38,7 +40,7 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for VtkFrames {
     fn observe(&mut self, world: &World<L, W>, _clock: &StageClock) -> Result<Flow, RunError> {
         self.next_frame += self.interval;
         self.series
-            .write_frame(&world.particles, world.time)
+            .write_frame(world)
             .map_err(|e| output_error(&self.dir, e))?;
         Ok(Flow::Continue)
     }

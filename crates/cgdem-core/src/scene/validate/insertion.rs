@@ -57,6 +57,18 @@ pub(super) fn insertions(
                 &format!("insert[{k}].velocity"),
                 ins.velocity.unwrap_or([0.0; 3]),
             )?,
+            omega: match ins.omega {
+                None => Vec3::ZERO,
+                // The seed's WCA law has no spin (particles carry no angular state).
+                Some(w) if raw.contact.model != "hertz" => {
+                    return Err(c.invalid(
+                        format!("insert[{k}].omega"),
+                        format!("{w:?}"),
+                        "no omega: the contact law does not rotate particles; an initial angular velocity needs contact.model = \"hertz\"",
+                    ))
+                }
+                Some(w) => c.vector(&format!("insert[{k}].omega"), w)?,
+            },
             overlap: match ins.overlap {
                 None => 0.0,
                 Some(f) if (0.0..=0.9).contains(&f) => f,

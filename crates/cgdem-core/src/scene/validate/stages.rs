@@ -66,6 +66,7 @@ pub(super) fn output(
     )?;
     Ok(OutputSettings {
         vtk_interval,
+        vtk_contact_network: output.and_then(|o| o.vtk_contact_network).unwrap_or(false),
         timeseries_interval,
     })
 }
