@@ -5,6 +5,8 @@
 mod bodies;
 mod cli;
 mod common;
+#[path = "../support/golden.rs"]
+mod golden;
 mod guards;
 mod physics;
 mod reference_screw;

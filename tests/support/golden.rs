@@ -6,6 +6,8 @@
 //! come from. `CGDEM_BLESS=1` (with the codes installed) rewrites the rows a test measured live
 //! instead of comparing them; the comments are kept.
 
+#![allow(dead_code)] // each test binary uses part of it
+
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Mutex;
