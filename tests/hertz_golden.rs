@@ -185,6 +185,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
     deck.write_to(&dir).expect("write deck");
     let options = RunnerOptions {
         np: None,
+        stop: None,
         timeout: std::time::Duration::from_secs(120),
     };
     let status = match code {

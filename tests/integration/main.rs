@@ -8,6 +8,7 @@ mod common;
 #[path = "../support/golden.rs"]
 mod golden;
 mod guards;
+mod interrupt;
 mod physics;
 mod reference_screw;
 mod reference_stages;

@@ -274,6 +274,7 @@ fn live_end_wall(
     deck.write_to(&dir).expect("write deck");
     let options = RunnerOptions {
         np: None,
+        stop: None,
         timeout: std::time::Duration::from_secs(60),
     };
     let status = match code {

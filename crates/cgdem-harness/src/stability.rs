@@ -423,6 +423,7 @@ pub(crate) fn run_reference(
     }
     let runner = RunnerOptions {
         np: None,
+        stop: None,
         timeout: std::time::Duration::from_secs(timeout_s),
     };
     let status = match code {

@@ -131,6 +131,9 @@ pub struct ValidateOptions {
     pub keep_going: bool,
     /// Runs of a case made at the same time (`--jobs`), sharing the threads.
     pub jobs: usize,
+    /// Raised on SIGINT/SIGTERM: runs in progress stop (cgdem at the end of a step, reference
+    /// codes with their process tree) and record why; no further run starts.
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -570,6 +573,7 @@ fn run_cgdem(
         progress: options.progress.clone(),
         force_dt: false,
         keep_going: options.keep_going,
+        stop: options.stop.clone(),
         ..Default::default()
     };
     run(&coarse, &run_options)
@@ -619,6 +623,7 @@ fn run_reference_code(
         runner: RunnerOptions {
             np: None,
             timeout: std::time::Duration::from_secs(validate.reference_timeout_s),
+            stop: validate.stop.clone(),
         },
         ..ReferenceOptions::default()
     };

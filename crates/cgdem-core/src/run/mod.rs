@@ -43,6 +43,9 @@ pub struct RunOptions {
     pub initial_state: Option<Particles>,
     /// Keep the particles at the end of the run in [`RunSummary::final_state`].
     pub keep_final_state: bool,
+    /// Raised from outside (the command's SIGINT/SIGTERM handler): the run stops at the end of
+    /// the current step, writes its outputs and returns [`RunError::Interrupted`].
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -85,6 +88,13 @@ pub enum RunError {
     Stopped {
         file: String,
         trip: Box<GuardTrip>,
+        out_dir: PathBuf,
+    },
+    #[error("{file}: run interrupted at t = {time_s:.6e} s (step {step}); the outputs written so far are kept in {}", out_dir.display())]
+    Interrupted {
+        file: String,
+        time_s: Real,
+        step: u64,
         out_dir: PathBuf,
     },
 }
@@ -619,6 +629,13 @@ fn execute<L: PairLaw, W: WallLaw>(
     });
     let mut guard_counts: Vec<(GuardKind, u64)> = Vec::new();
     let mut stopped_by: Option<GuardTrip> = None;
+    let stop_raised = || {
+        options
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+    };
+    let mut interrupted = false;
     if !bodies.is_empty() {
         world.set_bodies(bodies);
         world.set_kinematic(kinematic);
@@ -783,6 +800,18 @@ fn execute<L: PairLaw, W: WallLaw>(
                         guard_counts.push((trip.kind, 1));
                     }
                 }
+            }
+            if stop_raised() {
+                // At the end of a whole step: the outputs below describe a consistent state.
+                stages.push(StageRecord {
+                    name: stage.name.clone(),
+                    start_s: start,
+                    end_s: world.time,
+                    steps: world.steps - start_steps,
+                    ended_by: "interrupted (SIGINT/SIGTERM)".into(),
+                });
+                interrupted = true;
+                break 'stages;
             }
             for (index, region, target, done) in &mut refills {
                 let ins = &scene.insertions[*index];
@@ -1067,6 +1096,14 @@ fn execute<L: PairLaw, W: WallLaw>(
     let path = out.join("summary.json");
     let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&path, e))?;
     write_atomic(&path, json.as_bytes()).map_err(|e| output_error(&path, e))?;
+    if interrupted {
+        return Err(RunError::Interrupted {
+            file,
+            time_s: summary.simulated_s,
+            step: summary.steps,
+            out_dir: out.clone(),
+        });
+    }
     match stopped_by {
         Some(trip) => Err(RunError::Stopped {
             file,
