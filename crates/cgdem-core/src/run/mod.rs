@@ -2,6 +2,7 @@
 //! write the outputs (summary.json, timeseries.csv, profile.csv, repose.csv, VTK series).
 
 mod hertz;
+pub mod memory;
 mod progress;
 
 pub use hertz::{hertz_history_wall, hertz_law, hertz_wall, run_hertz, FromScene, SUPPORTED};
@@ -89,6 +90,12 @@ pub enum RunError {
         file: String,
         trip: Box<GuardTrip>,
         out_dir: PathBuf,
+    },
+    #[error("{file}: the run needs about {estimate}, more than the {available} this machine has available (MemAvailable in /proc/meminfo); reduce the particle count (insert amounts, lambda) or the SDF resolution (body cell_size)")]
+    NotEnoughMemory {
+        file: String,
+        estimate: String,
+        available: String,
     },
     #[error("{file}: run interrupted at t = {time_s:.6e} s (step {step}); the outputs written so far are kept in {}", out_dir.display())]
     Interrupted {
@@ -206,6 +213,7 @@ pub struct RunSummary {
 
 /// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.
 pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> {
+    check_memory(scene, options)?;
     match &scene.contact {
         ContactSettings::Wca { .. } => {
             let (law, wall_law) = seed_laws(scene);
@@ -213,6 +221,23 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> 
         }
         ContactSettings::Hertz(h) => run_hertz(scene, h, options),
     }
+}
+
+/// Refuses a scene whose estimated memory exceeds what the machine has available, before
+/// anything is allocated.
+fn check_memory(scene: &Scene, options: &RunOptions) -> Result<(), RunError> {
+    let estimate = memory::estimate(scene, options.initial_state.as_ref().map(|p| p.len()));
+    let Some(available) = memory::mem_available() else {
+        return Ok(());
+    };
+    if estimate.total() > available {
+        return Err(RunError::NotEnoughMemory {
+            file: scene.source.display().to_string(),
+            estimate: estimate.describe(),
+            available: memory::bytes(available),
+        });
+    }
+    Ok(())
 }
 
 /// The time step cgdem uses for a scene (for Hertz, the LIGGGHTS keyword combinations), with the contact time scales behind it
