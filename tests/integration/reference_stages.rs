@@ -61,12 +61,11 @@ fn check(code: ReferenceCode) {
         (0.2 - 1e-9..=0.4 + 0.011).contains(&settle_end),
         "cgdem settle end {settle_end}"
     );
-    let triggers: Vec<&str> = cg
-        .repose_samples
-        .iter()
-        .map(|s| s.trigger.as_str())
-        .collect();
-    assert_eq!(triggers, ["fixed time", "stage end"]);
+    let triggers: Vec<SampleTrigger> = cg.repose_samples.iter().map(|s| s.trigger).collect();
+    assert_eq!(
+        triggers,
+        [SampleTrigger::FixedTime, SampleTrigger::StageEnd]
+    );
     assert_eq!(
         cg.repose_samples[0].time_after_start_s,
         stored("fixed-time sample (s after stage start)")
