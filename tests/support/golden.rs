@@ -127,7 +127,7 @@ impl GoldenFile {
             Some(&stored) => {
                 let rel = (value - stored).abs() / stored.abs().max(1e-300);
                 let both_zero = value == 0.0 && stored == 0.0;
-                if !both_zero && !(rel <= LIVE_TOLERANCE) {
+                if !both_zero && (rel.is_nan() || rel > LIVE_TOLERANCE) {
                     self.drift.push(format!(
                         "{case}: {quantity}: {code} live {value:e} vs stored {stored:e} (rel. diff {rel:.3e})"
                     ));

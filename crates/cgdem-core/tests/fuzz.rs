@@ -187,7 +187,7 @@ fn ascii_stl() -> impl Strategy<Value = Vec<u8>> {
             for (numbers, replace) in facets {
                 let mut v = numbers.into_iter();
                 let mut next = || v.next().unwrap_or_default();
-                let mut facet = format!("facet normal 0 0 1\n outer loop\n");
+                let mut facet = "facet normal 0 0 1\n outer loop\n".to_string();
                 for _ in 0..3 {
                     facet += &format!("  vertex {} {} {}\n", next(), next(), next());
                 }
