@@ -1,6 +1,7 @@
 //! The `cgdem` command: a thin layer that turns arguments into validated settings, calls the
 //! library and reports errors as messages with a non-zero exit code.
 
+mod interrupt;
 mod progress_bar;
 
 use std::path::PathBuf;
@@ -257,6 +258,31 @@ struct ReferenceArgs {
     postprocess_only: bool,
 }
 
+/// The SIGINT/SIGTERM handlers of the commands that poll the stop flag (a failure to install
+/// them leaves the default action, ending the process, and says so).
+fn install_interrupt() -> Option<interrupt::Interrupt> {
+    match interrupt::Interrupt::install() {
+        Ok(i) => Some(i),
+        Err(e) => {
+            eprintln!("warning: SIGINT/SIGTERM handlers not installed ({e}): an interrupt ends cgdem at once");
+            None
+        }
+    }
+}
+
+/// The exit code 130/143 after a signal stopped the command, with what was kept.
+fn interrupted(
+    interrupt: &Option<interrupt::Interrupt>,
+    kept: &std::path::Path,
+) -> Option<ExitCode> {
+    let (name, code) = interrupt.as_ref()?.received()?;
+    eprintln!(
+        "interrupted by {name}: stopped; the outputs written so far are kept in {}",
+        kept.display()
+    );
+    Some(code)
+}
+
 fn reference_run(code: ReferenceCommand) -> Result<ExitCode, String> {
     use cgdem_harness::code::Code;
     use cgdem_harness::lammps::{RunStatus, RunnerOptions};
@@ -289,16 +315,25 @@ fn reference_run(code: ReferenceCommand) -> Result<ExitCode, String> {
             name.to_lowercase()
         ))
     });
+    let interrupt = install_interrupt();
     let options = ReferenceOptions {
         code,
         runner: RunnerOptions {
             np,
             timeout: std::time::Duration::from_secs(timeout),
+            stop: interrupt.as_ref().map(|i| i.flag()),
         },
         force_dt,
         postprocess_only,
     };
-    let run = run_reference(&scene, &out, &options)?;
+    let run = run_reference(&scene, &out, &options);
+    if let Some(code) = interrupted(&interrupt, &out) {
+        if let Err(e) = &run {
+            eprintln!("{e}");
+        }
+        return Ok(code);
+    }
+    let run = run?;
     if let Some(w) = &run.dt_warning {
         eprintln!("warning: {w}");
     }
@@ -471,6 +506,7 @@ fn main() -> ExitCode {
                 Ok(pool) => pool,
                 Err(code) => return code,
             };
+            let interrupt = install_interrupt();
             let options = cgdem_harness::validate::ValidateOptions {
                 suite: suite_path,
                 out: out.clone(),
@@ -480,10 +516,18 @@ fn main() -> ExitCode {
                 reuse,
                 keep_going,
                 jobs: usize::from(jobs),
+                stop: interrupt.as_ref().map(|i| i.flag()),
                 cgdem_faults: fault,
                 history,
             };
-            match pool.install(|| cgdem_harness::validate::validate(&options)) {
+            let result = pool.install(|| cgdem_harness::validate::validate(&options));
+            if let Some(code) = interrupted(&interrupt, &out) {
+                if let Err(e) = &result {
+                    eprintln!("error: {e}");
+                }
+                return code;
+            }
+            match result {
                 Ok(summary) => {
                     let failed = summary.comparisons.iter().filter(|c| !c.pass).count();
                     let known = summary
@@ -648,6 +692,13 @@ fn main() -> ExitCode {
                 Err(code) => return code,
             };
             let mut figures = Vec::new();
+            // Sweeps run their own options and do not poll the stop flag: a signal ends them.
+            let interrupt = if sweep.is_none() {
+                install_interrupt()
+            } else {
+                None
+            };
+            let mut out_used = None;
             let result = pool.install(|| {
                 load_scene(&case, &set, variant.as_deref(), seed)
                     .and_then(|scene| {
@@ -696,11 +747,13 @@ fn main() -> ExitCode {
                             let last = results.into_iter().last().map(|r| r.1).ok_or("empty sweep")?;
                             return Ok((last, out_dir));
                         }
+                        out_used = Some(out_dir.clone());
                         let options = RunOptions {
                             out_dir: out_dir.clone(),
                             progress: progress_bar::progress(quiet),
                             force_dt,
                             keep_going,
+                            stop: interrupt.as_ref().map(|i| i.flag()),
                             ..Default::default()
                         };
                         let summary = run(&scene, &options).map_err(|e| e.to_string())?;
@@ -712,6 +765,14 @@ fn main() -> ExitCode {
                         Ok((summary, out_dir))
                     })
             });
+            if let Some(out_dir) = &out_used {
+                if let Some(code) = interrupted(&interrupt, out_dir) {
+                    if let Err(message) = &result {
+                        eprintln!("{message}");
+                    }
+                    return code;
+                }
+            }
             match result {
                 Ok((summary, out_dir)) => {
                     println!("case {} at lambda = {}: {} particles, {} steps of {:.3e} s, {:.1} s wall time, {:.3e} particle-steps/s", summary.case, summary.lambda, summary.n_particles, summary.steps, summary.dt_s, summary.wall_s, summary.particle_steps_per_s);

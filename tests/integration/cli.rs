@@ -249,3 +249,34 @@ fn a_small_diameter_sweep_packs_a_coarse_bed_and_writes_its_tables() {
         assert!(dir.join("out").join(file).exists(), "{file} missing");
     }
 }
+
+/// A scene asking for 1e10 particles is refused before anything is allocated, at once, with
+/// the estimate and the machine's available memory.
+#[test]
+fn a_scene_needing_more_memory_than_the_machine_has_is_refused_at_once() {
+    let started = std::time::Instant::now();
+    let out = cgdem()
+        .args([
+            "run",
+            "tests/data/tiny_hertz_collapse.toml",
+            "--quiet",
+            "--set",
+            "insert[0].count=10000000000",
+            "--out",
+        ])
+        .arg(std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("memory_refused"))
+        .output()
+        .unwrap();
+    let elapsed = started.elapsed();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("tiny_hertz_collapse.toml")
+            && stderr.contains("1.000e10 particles")
+            && stderr.contains("GB")
+            && stderr.contains("MemAvailable"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(elapsed < std::time::Duration::from_secs(1), "{elapsed:?}");
+}

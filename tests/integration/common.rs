@@ -178,6 +178,7 @@ pub fn completed_reference_run(
         code,
         runner: RunnerOptions {
             np: None,
+            stop: None,
             timeout: std::time::Duration::from_secs(timeout_s),
         },
         ..ReferenceOptions::default()

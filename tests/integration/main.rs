@@ -5,7 +5,10 @@
 mod bodies;
 mod cli;
 mod common;
+#[path = "../support/golden.rs"]
+mod golden;
 mod guards;
+mod interrupt;
 mod physics;
 mod reference_screw;
 mod reference_stages;

@@ -298,6 +298,7 @@ fn with_duration(scene: &Scene, duration: Real) -> Scene {
 
 fn runner(threads: usize, options: &BenchOptions) -> RunnerOptions {
     RunnerOptions {
+        stop: None,
         np: (threads > 1).then_some(threads as u32),
         timeout: options.timeout,
     }

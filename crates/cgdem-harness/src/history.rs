@@ -373,17 +373,23 @@ pub fn since_previous(
 /// The nights recorded so far (none if the file does not exist yet).
 pub fn read_history(path: &Path) -> Result<Vec<Night>, HistoryError> {
     match std::fs::read_to_string(path) {
-        Ok(text) => serde_json::from_str(&text).map_err(|e| HistoryError::Invalid {
-            file: path.to_path_buf(),
-            what: "history file (a JSON list of nights)",
-            message: e.to_string(),
-        }),
+        Ok(text) => parse_history(&text, path),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
         Err(e) => Err(HistoryError::Unreadable {
             file: path.to_path_buf(),
             message: e.to_string(),
         }),
     }
+}
+
+/// The nights in the text of the history file `path` (named in errors, with serde's line and
+/// column).
+pub fn parse_history(text: &str, path: &Path) -> Result<Vec<Night>, HistoryError> {
+    serde_json::from_str(text).map_err(|e| HistoryError::Invalid {
+        file: path.to_path_buf(),
+        what: "history file (a JSON list of nights)",
+        message: e.to_string(),
+    })
 }
 
 fn relative_to(path: &Path, base: &Path) -> String {

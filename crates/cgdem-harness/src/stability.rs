@@ -423,6 +423,7 @@ pub(crate) fn run_reference(
     }
     let runner = RunnerOptions {
         np: None,
+        stop: None,
         timeout: std::time::Duration::from_secs(timeout_s),
     };
     let status = match code {
@@ -519,7 +520,7 @@ pub(crate) fn run_reference(
 
 /// What a LAMMPS or LIGGGHTS log says about the run's end.
 #[derive(Debug, Default, PartialEq)]
-pub(crate) struct LogFindings {
+pub struct LogFindings {
     /// The first `ERROR` line.
     pub error: Option<String>,
     /// `ERROR: Lost atoms: original N current M`: N - M.

@@ -168,6 +168,9 @@ pub struct ValidateOptions {
     pub keep_going: bool,
     /// Runs of a case made at the same time (`--jobs`), sharing the threads.
     pub jobs: usize,
+    /// Raised on SIGINT/SIGTERM: runs in progress stop (cgdem at the end of a step, reference
+    /// codes with their process tree) and record why; no further run starts.
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Planted faults (`--fault KEY=VALUE`): scene overrides applied to cgdem's runs only,
     /// after the case's own, the scene keeping its name, so that its comparisons with the
     /// reference codes show whether the verdicts can fail (scripts/planted-faults.sh).
@@ -816,6 +819,7 @@ fn run_cgdem(
         progress: options.progress.clone(),
         force_dt: false,
         keep_going: options.keep_going,
+        stop: options.stop.clone(),
         ..Default::default()
     };
     run(&coarse, &run_options)
@@ -866,6 +870,7 @@ fn run_reference_code(
         runner: RunnerOptions {
             np: None,
             timeout: std::time::Duration::from_secs(validate.reference_timeout_s),
+            stop: validate.stop.clone(),
         },
         ..ReferenceOptions::default()
     };

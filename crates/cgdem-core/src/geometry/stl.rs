@@ -64,7 +64,16 @@ fn list_edges(edges: &[EdgeDefect]) -> String {
 /// Reads an ASCII or binary STL and checks that it is a closed, consistently oriented surface.
 /// An inward-oriented but otherwise valid surface is flipped outward.
 pub fn read_stl(path: &Path) -> Result<TriMesh, StlError> {
-    let (mut mesh, report) = read_stl_unchecked(path)?;
+    let bytes = std::fs::read(path).map_err(|source| StlError::Unreadable {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    stl_from_bytes(&bytes, path)
+}
+
+/// [`read_stl`] of bytes already read from `path` (named in errors).
+pub fn stl_from_bytes(bytes: &[u8], path: &Path) -> Result<TriMesh, StlError> {
+    let (mut mesh, report) = stl_unchecked_from_bytes(bytes, path)?;
     if !report.open_edges.is_empty() {
         return Err(StlError::OpenEdges {
             path: path.to_path_buf(),
@@ -96,7 +105,15 @@ pub fn read_stl_unchecked(path: &Path) -> Result<(TriMesh, TopologyReport), StlE
         path: path.to_path_buf(),
         source,
     })?;
-    let soup = parse_stl(&bytes).map_err(|reason| StlError::NotStl {
+    stl_unchecked_from_bytes(&bytes, path)
+}
+
+/// [`read_stl_unchecked`] of bytes already read from `path` (named in errors).
+pub fn stl_unchecked_from_bytes(
+    bytes: &[u8],
+    path: &Path,
+) -> Result<(TriMesh, TopologyReport), StlError> {
+    let soup = parse_stl(bytes).map_err(|reason| StlError::NotStl {
         path: path.to_path_buf(),
         reason,
     })?;

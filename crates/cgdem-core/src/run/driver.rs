@@ -64,6 +64,8 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         particle_steps: 0,
         stages: Vec::new(),
         guard_counts: Vec::new(),
+        stop: options.stop.clone(),
+        interrupted: false,
     };
     let started = Instant::now();
     let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings)?;
@@ -125,6 +127,14 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     }
     summary.warnings = warnings.0;
     write_summary(out, &summary)?;
+    if driver.interrupted {
+        return Err(RunError::Interrupted {
+            file: summary.scene_file,
+            time_s: summary.simulated_s,
+            step: summary.steps,
+            out_dir: out.clone(),
+        });
+    }
     match stopped_by {
         Some(trip) => Err(RunError::Stopped {
             file: summary.scene_file,
@@ -267,6 +277,9 @@ struct Driver<'s> {
     stages: Vec<StageRecord>,
     /// Guards that fired under --keep-going, and how often.
     guard_counts: Vec<(GuardKind, u64)>,
+    /// `RunOptions::stop`, polled at the end of every step.
+    stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    interrupted: bool,
 }
 
 /// A top-up of the current stage: (insertion, region, particles it held at the stage start,
@@ -314,6 +327,11 @@ impl Driver<'_> {
                     return Ok(Some(trip));
                 }
             };
+            if matches!(ending, StageEnding::Interrupted) {
+                // Not a stage end: the stage-end samples are not taken.
+                self.record(stage, &clock, world, start_steps, ending);
+                return Ok(None);
+            }
             if let (StageEnd::Settled { max_duration, .. }, StageEnding::Duration(_)) =
                 (&stage.end, &ending)
             {
@@ -375,6 +393,16 @@ impl Driver<'_> {
                     ending = Ok(reason);
                     break 'steps;
                 }
+            }
+            // At the end of a whole step, its outputs written: a consistent state to keep.
+            if self
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+            {
+                self.interrupted = true;
+                ending = Ok(StageEnding::Interrupted);
+                break;
             }
         }
         drop(refills);

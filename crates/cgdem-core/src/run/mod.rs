@@ -7,6 +7,7 @@
 mod driver;
 mod hertz;
 mod laws;
+pub mod memory;
 mod observers;
 mod progress;
 mod refill;
@@ -49,6 +50,9 @@ pub struct RunOptions {
     pub initial_state: Option<Particles>,
     /// Keep the particles at the end of the run in [`RunSummary::final_state`].
     pub keep_final_state: bool,
+    /// Raised from outside (the command's SIGINT/SIGTERM handler): the run stops at the end of
+    /// the current step, writes its outputs and returns [`RunError::Interrupted`].
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -93,6 +97,19 @@ pub enum RunError {
         trip: Box<GuardTrip>,
         out_dir: PathBuf,
     },
+    #[error("{file}: the run needs about {estimate}, more than the {available} this machine has available (MemAvailable in /proc/meminfo); reduce the particle count (insert amounts, lambda) or the SDF resolution (body cell_size)")]
+    NotEnoughMemory {
+        file: String,
+        estimate: String,
+        available: String,
+    },
+    #[error("{file}: run interrupted at t = {time_s:.6e} s (step {step}); the outputs written so far are kept in {}", out_dir.display())]
+    Interrupted {
+        file: String,
+        time_s: Real,
+        step: u64,
+        out_dir: PathBuf,
+    },
 }
 
 pub(crate) fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
@@ -132,6 +149,8 @@ pub enum StageEnding {
     },
     /// A guard stopped the run.
     Guard(GuardKind),
+    /// The stop flag (SIGINT/SIGTERM) was raised: the run stopped at the end of a step.
+    Interrupted,
 }
 
 impl std::fmt::Display for StageEnding {
@@ -146,6 +165,7 @@ impl std::fmt::Display for StageEnding {
                 "kinetic energy per mass {kinetic_energy_per_mass:.3e} J/kg < {threshold:.3e} J/kg"
             ),
             StageEnding::Guard(kind) => write!(f, "stopped by the {} guard", kind.name()),
+            StageEnding::Interrupted => write!(f, "interrupted (SIGINT/SIGTERM)"),
         }
     }
 }
@@ -249,6 +269,7 @@ pub struct RunSummary {
 
 /// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.
 pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> {
+    check_memory(scene, options)?;
     struct Run<'a>(&'a Scene, &'a RunOptions);
     impl LawVisitor for Run<'_> {
         type Output = Result<RunSummary, RunError>;
@@ -257,6 +278,23 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> 
         }
     }
     with_laws(scene, Run(scene, options))?
+}
+
+/// Refuses a scene whose estimated memory exceeds what the machine has available, before
+/// anything is allocated.
+fn check_memory(scene: &Scene, options: &RunOptions) -> Result<(), RunError> {
+    let estimate = memory::estimate(scene, options.initial_state.as_ref().map(|p| p.len()));
+    let Some(available) = memory::mem_available() else {
+        return Ok(());
+    };
+    if estimate.total() > available {
+        return Err(RunError::NotEnoughMemory {
+            file: scene.source.display().to_string(),
+            estimate: estimate.describe(),
+            available: memory::bytes(available),
+        });
+    }
+    Ok(())
 }
 
 /// The time step cgdem uses for a scene, with the contact time scales behind it (the
