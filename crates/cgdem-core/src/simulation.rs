@@ -1062,14 +1062,14 @@ const OWNER_LEAF: usize = 256;
 
 /// The particle arrays the owner pass reads.
 #[derive(Clone, Copy)]
-struct ParticleState<'a> {
-    position: &'a [Vec3],
-    velocity: &'a [Vec3],
-    omega: Option<&'a [Vec3]>,
-    radius: &'a [Real],
-    mass: &'a [Real],
-    inv_mass: &'a [Real],
-    species: &'a [u16],
+pub(crate) struct ParticleState<'a> {
+    pub(crate) position: &'a [Vec3],
+    pub(crate) velocity: &'a [Vec3],
+    pub(crate) omega: Option<&'a [Vec3]>,
+    pub(crate) radius: &'a [Real],
+    pub(crate) mass: &'a [Real],
+    pub(crate) inv_mass: &'a [Real],
+    pub(crate) species: &'a [u16],
 }
 
 /// What the owner pass reads: the laws, the particles, the list, and what acts on one
@@ -1334,22 +1334,22 @@ impl Reactions<'_> {
 
 /// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
 #[derive(Clone, Copy)]
-struct Owner {
-    index: usize,
-    position: Vec3,
-    velocity: Vec3,
-    omega: Vec3,
-    radius: Real,
-    inv_mass: Real,
+pub(crate) struct Owner {
+    pub(crate) index: usize,
+    pub(crate) position: Vec3,
+    pub(crate) velocity: Vec3,
+    pub(crate) omega: Vec3,
+    pub(crate) radius: Real,
+    pub(crate) inv_mass: Real,
     /// `species_i * n_species`: the row of the species-pair tables.
-    species_row: usize,
+    pub(crate) species_row: usize,
 }
 
 /// The force of one listed pair `(i, j)` seen from its owner `i`; zero (and history reset)
 /// when out of range. Also returns the overlap and the smaller radius, for the guard.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn pair_force<L: PairLaw>(
+pub(crate) fn pair_force<L: PairLaw>(
     law: &L,
     p: &ParticleState,
     images: &[Vec3; 27],
@@ -1496,7 +1496,7 @@ fn body_force_and_torque<W: WallLaw>(
 /// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN
 /// handling, and a NaN state is the non-finite guard's business).
 #[inline(always)]
-fn larger(a: Real, b: Real) -> Real {
+pub(crate) fn larger(a: Real, b: Real) -> Real {
     if b > a {
         b
     } else {
