@@ -5,6 +5,7 @@
 mod bodies;
 mod cli;
 mod common;
+mod decomposition;
 mod guards;
 mod physics;
 mod reference_screw;

@@ -43,6 +43,8 @@ pub struct RunOptions {
     pub initial_state: Option<Particles>,
     /// Keep the particles at the end of the run in [`RunSummary::final_state`].
     pub keep_final_state: bool,
+    /// Split the box into these subdomains with ghost layers (`--grid`); None: one world.
+    pub grid: Option<crate::decomposition::GridSpec>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -630,6 +632,11 @@ fn execute<L: PairLaw, W: WallLaw>(
             .map(|&(min, max)| Aabb { min, max })
             .collect(),
     );
+    if let Some(spec) = options.grid {
+        world.set_grid(spec).map_err(|e| {
+            RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
+        })?;
+    }
     let body_columns: String = scene
         .bodies
         .iter()
