@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use cgdem_core::run::SampleTrigger;
 use cgdem_core::scene::Scene;
 use cgdem_harness::lammps::{self, read_dump, ReferenceCode, RunStatus, RunnerOptions};
 use cgdem_harness::liggghts;
@@ -40,12 +41,11 @@ fn check(code: ReferenceCode) {
     let collapse = &summary.stages[1];
     assert!((collapse.end_s - collapse.start_s - 0.2).abs() <= summary.dt_s);
     // The fixed-time sample and the stage-end sample, both measured.
-    let triggers: Vec<&str> = summary
-        .repose_samples
-        .iter()
-        .map(|s| s.trigger.as_str())
-        .collect();
-    assert_eq!(triggers, ["fixed time", "stage end"]);
+    let triggers: Vec<SampleTrigger> = summary.repose_samples.iter().map(|s| s.trigger).collect();
+    assert_eq!(
+        triggers,
+        [SampleTrigger::FixedTime, SampleTrigger::StageEnd]
+    );
     assert!((summary.repose_samples[0].time_after_start_s - 0.1).abs() < 1e-12);
     for file in [
         "timeseries.csv",

@@ -1,4 +1,5 @@
-//! cgdem: a discrete-element solver for powders and granular flow, with coarse-graining.
+//! cgdem-core: the cgdem solver, a discrete-element method for powders and granular flow, with
+//! coarse-graining.
 //!
 //! The solver core (particles, neighbour search, contact slots, walls, integration,
 //! coarse-graining, scenes) never depends on the validation harness or on plotting.

@@ -1,7 +1,8 @@
 //! Laws for `[contact] model = "hertz"`: each slot built from the scene's settings, and the
 //! short list of combinations that are compiled (each its own force loop).
 
-use super::{execute, RunError, RunOptions, RunSummary};
+use super::laws::LawVisitor;
+use super::RunError;
 use crate::contact::cohesion::{vdw_reach, NoCohesion, VanDerWaals};
 use crate::contact::damping::{liggghts_damping_factor, HertzDamping, YangDamping};
 use crate::contact::normal::{Hertz, Material};
@@ -200,124 +201,62 @@ pub fn hertz_history_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall 
     )
 }
 
-fn run_with<D, T, R, C>(
-    scene: &Scene,
-    h: &HertzSettings,
-    options: &RunOptions,
-) -> Result<RunSummary, RunError>
-where
-    D: DampingModel + FromScene,
-    T: TangentialModel + FromScene,
-    R: RollingModel + FromScene,
-    C: CohesionModel + FromScene,
-{
-    execute(
-        scene,
-        hertz_law::<D, T, R, C>(scene, h),
-        hertz_wall(scene, h),
-        options,
-    )
+/// The compiled combinations: each line is the keywords a scene gives (damping, tangential,
+/// rolling, cohesion), the slots they compile to, the wall law (LIGGGHTS's history wall for
+/// its keywords) and the name listed in errors. `SUPPORTED` and the dispatch are both made
+/// from this one list.
+macro_rules! compiled_hertz_laws {
+    ($( ($d:pat, $t:pat, $r:pat, $c:pat) => <$D:ty, $T:ty, $R:ty, $C:ty>, $wall:ident, $name:literal; )*) => {
+        /// The compiled combinations, as (damping, tangential, rolling, cohesion) keywords.
+        pub const SUPPORTED: &[&str] = &[$($name),*];
+
+        /// Calls `visitor` with the one compiled law that matches the scene's keywords.
+        pub(super) fn with_hertz_laws<V: LawVisitor>(
+            scene: &Scene,
+            h: &HertzSettings,
+            visitor: V,
+        ) -> Result<V::Output, RunError> {
+            #[allow(unused_imports)]
+            use CohesionKind::{None as NoVdw, VanDerWaals as Vdw};
+            #[allow(unused_imports)]
+            use HertzDampingKind::{Restitution, Yang};
+            type K = TangentialKind;
+            match (h.damping, h.tangential, h.rolling, h.cohesion) {
+                $( ($d, $t, $r, $c) => Ok(visitor.visit(
+                    hertz_law::<$D, $T, $R, $C>(scene, h),
+                    $wall(scene, h),
+                )), )*
+                (d, t, r, c) => Err(RunError::Unsupported {
+                    file: scene.source.display().to_string(),
+                    combination: format!("{d:?}/{t:?}/{r:?}/{c:?}"),
+                    supported: SUPPORTED.join(", "),
+                }),
+            }
+        }
+    };
 }
 
-/// `run_with` for the LIGGGHTS keywords (`tangential = "history"`, rolling none or epsd2):
-/// the walls are LIGGGHTS's, with the same springs (`hertz_history_wall`).
-fn run_liggghts<R, C>(
-    scene: &Scene,
-    h: &HertzSettings,
-    options: &RunOptions,
-) -> Result<RunSummary, RunError>
-where
-    R: RollingModel + FromScene,
-    C: CohesionModel + FromScene,
-{
-    execute(
-        scene,
-        hertz_law::<HertzDamping, Mindlin, R, C>(scene, h),
-        hertz_history_wall(scene, h),
-        options,
-    )
-}
-
-/// The time step `run_hertz` takes for a scene with LIGGGHTS's keywords (`damping = "hertz"`,
-/// `tangential = "history"`, rolling none or epsd2, no cohesion: the reference decks' scenes),
-/// with its contact time scales. The rolling slot does not enter the linearized contacts.
-pub fn time_step(
-    scene: &Scene,
-    h: &HertzSettings,
-    force_dt: bool,
-) -> Result<(Real, crate::timestep::Timescales, Option<String>), RunError> {
-    match (h.damping, h.tangential, h.rolling, h.cohesion) {
-        (
-            HertzDampingKind::Restitution,
-            TangentialKind::History,
-            RollingKind::None | RollingKind::Epsd2,
-            CohesionKind::None,
-        ) => super::time_step_for(
-            scene,
-            &hertz_law::<HertzDamping, Mindlin, NoRolling, NoCohesion>(scene, h),
-            &hertz_history_wall(scene, h),
-            force_dt,
-        ),
-        (d, t, r, c) => Err(RunError::NotAvailable(format!(
-            "{}: the time step is computed ahead of the run only for damping = \"hertz\", tangential = \"history\", rolling = \"none\" or \"epsd2\", no cohesion (the reference decks' keywords), not {d:?}/{t:?}/{r:?}/{c:?}",
-            scene.source.display()
-        ))),
-    }
-}
-
-/// The compiled combinations, as (damping, tangential, rolling, cohesion) keywords.
-pub const SUPPORTED: &[&str] = &[
-    "hertz/history/none/none",
-    "hertz/history/constant_torque/none",
-    "hertz/history/constant_torque/vdw",
-    "hertz/history/epsd2/none",
-    "hertz/history/epsd2/vdw",
-    "yang/yang/none/none",
-    "yang/yang/constant_torque/vdw (paper B)",
-];
-
-/// Runs a Hertz scene with the one compiled law that matches its keywords.
-pub fn run_hertz(
-    scene: &Scene,
-    h: &HertzSettings,
-    options: &RunOptions,
-) -> Result<RunSummary, RunError> {
-    use CohesionKind::{None as NoVdw, VanDerWaals as Vdw};
-    use HertzDampingKind::{Restitution, Yang};
-    type K = TangentialKind;
-    match (h.damping, h.tangential, h.rolling, h.cohesion) {
-        (Restitution, K::History, RollingKind::None, NoVdw) => {
-            run_liggghts::<NoRolling, NoCohesion>(scene, h, options)
-        }
-        (Restitution, K::History, RollingKind::ConstantTorque, NoVdw) => {
-            run_with::<HertzDamping, Mindlin, ConstantTorque, NoCohesion>(scene, h, options)
-        }
-        (Restitution, K::History, RollingKind::ConstantTorque, Vdw { .. }) => {
-            run_with::<HertzDamping, Mindlin, ConstantTorque, VanDerWaals>(scene, h, options)
-        }
-        (Restitution, K::History, RollingKind::Epsd2, NoVdw) => {
-            run_liggghts::<Epsd2, NoCohesion>(scene, h, options)
-        }
-        (Restitution, K::History, RollingKind::Epsd2, Vdw { .. }) => {
-            run_liggghts::<Epsd2, VanDerWaals>(scene, h, options)
-        }
-        (Yang { .. }, K::Yang, RollingKind::None, NoVdw) => {
-            run_with::<YangDamping, YangTangential, NoRolling, NoCohesion>(scene, h, options)
-        }
-        (Yang { .. }, K::Yang, RollingKind::ConstantTorque, Vdw { .. }) => {
-            run_with::<YangDamping, YangTangential, ConstantTorque, VanDerWaals>(scene, h, options)
-        }
-        (d, t, r, c) => Err(RunError::Unsupported {
-            file: scene.source.display().to_string(),
-            combination: format!("{d:?}/{t:?}/{r:?}/{c:?}"),
-            supported: SUPPORTED.join(", "),
-        }),
-    }
+compiled_hertz_laws! {
+    (Restitution, K::History, RollingKind::None, NoVdw)
+        => <HertzDamping, Mindlin, NoRolling, NoCohesion>, hertz_history_wall, "hertz/history/none/none";
+    (Restitution, K::History, RollingKind::ConstantTorque, NoVdw)
+        => <HertzDamping, Mindlin, ConstantTorque, NoCohesion>, hertz_wall, "hertz/history/constant_torque/none";
+    (Restitution, K::History, RollingKind::ConstantTorque, Vdw { .. })
+        => <HertzDamping, Mindlin, ConstantTorque, VanDerWaals>, hertz_wall, "hertz/history/constant_torque/vdw";
+    (Restitution, K::History, RollingKind::Epsd2, NoVdw)
+        => <HertzDamping, Mindlin, Epsd2, NoCohesion>, hertz_history_wall, "hertz/history/epsd2/none";
+    (Restitution, K::History, RollingKind::Epsd2, Vdw { .. })
+        => <HertzDamping, Mindlin, Epsd2, VanDerWaals>, hertz_history_wall, "hertz/history/epsd2/vdw";
+    (Yang { .. }, K::Yang, RollingKind::None, NoVdw)
+        => <YangDamping, YangTangential, NoRolling, NoCohesion>, hertz_wall, "yang/yang/none/none";
+    (Yang { .. }, K::Yang, RollingKind::ConstantTorque, Vdw { .. })
+        => <YangDamping, YangTangential, ConstantTorque, VanDerWaals>, hertz_wall, "yang/yang/constant_torque/vdw (paper B)";
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::RunOptions;
 
     #[test]
     fn an_uncompiled_combination_is_refused_with_the_supported_list() {
@@ -328,14 +267,13 @@ mod tests {
             panic!("not hertz")
         };
         h.tangential = TangentialKind::Yang; // with the LIGGGHTS dashpot: not on the list
-        let h = h.clone();
         let options = RunOptions {
             out_dir: std::env::temp_dir().join("cgdem-unsupported"),
             force_dt: false,
             keep_going: false,
             ..Default::default()
         };
-        let message = run_hertz(&scene, &h, &options).unwrap_err().to_string();
+        let message = super::super::run(&scene, &options).unwrap_err().to_string();
         assert!(
             message.contains("not compiled") && message.contains("yang/yang/constant_torque/vdw"),
             "{message}"

@@ -12,7 +12,7 @@ use cgdem_core::analysis::heap::{self, HeapProfile};
 use cgdem_core::io::write_atomic;
 use cgdem_core::math::{Real, Vec3};
 use cgdem_core::run::{
-    headline_sample, profile_csv, repose_csv, ReposeSample, RunSummary, StageRecord,
+    headline_sample, profile_csv, repose_csv, ReposeSample, RunSummary, SampleTrigger, StageRecord,
 };
 use cgdem_core::scene::{ConveyingSettings, Scene};
 use cgdem_core::timestep::Timescales;
@@ -316,7 +316,7 @@ pub fn postprocess(
                 r,
                 max_diameter,
                 *t,
-                "fixed time",
+                SampleTrigger::FixedTime,
             ));
             final_profile = Some(profile);
         }
@@ -340,7 +340,7 @@ pub fn postprocess(
                         r,
                         max_diameter,
                         t,
-                        "stage end",
+                        SampleTrigger::StageEnd,
                     ));
                     final_profile = Some(profile);
                 }

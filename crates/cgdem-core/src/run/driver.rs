@@ -1,0 +1,448 @@
+//! The stage driver: builds the world for a scene's laws, runs its stages step by step (wall
+//! removals, body starts, top-ups, guards, progress) and calls the output observers when
+//! they are due; the summary is assembled from what they measured.
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::bodies::KinematicParticles;
+use crate::contact::PairLaw;
+use crate::geometry::Aabb;
+use crate::guard::{GuardKind, GuardSettings, GuardTrip};
+use crate::io::write_atomic;
+use crate::math::Real;
+use crate::particles::Particles;
+use crate::scene::{Scene, Stage, StageEnd};
+use crate::simulation::{NeighborSettings, World};
+use crate::timestep::Timescales;
+use crate::walls::WallLaw;
+
+use super::observers::{
+    ConveyingMeter, Flow, Observer, PackingMeter, ReposeMeter, Scheduled, StageClock, TimeSeries,
+    VtkFrames, Warnings,
+};
+use super::refill::RefillRegion;
+use super::setup::{build_bodies, initial_particles_with_bodies, scene_walls};
+use super::{
+    describe_repose_rule, output_error, progress, time_step_for, Progress, RunError, RunOptions,
+    RunProgress, RunSummary, StageEnding, StageRecord,
+};
+
+/// Runs a scene with its concrete laws and writes its outputs into `options.out_dir`.
+pub(crate) fn execute<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    law: L,
+    wall_law: W,
+    options: &RunOptions,
+) -> Result<RunSummary, RunError> {
+    let out = &options.out_dir;
+    std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
+    let (dt, scales, warning) = time_step_for(scene, &law, &wall_law, options.force_dt)?;
+    let mut warnings = Warnings::default();
+    if let Some(w) = warning {
+        warnings.push(w);
+    }
+    let (mut world, n_inserted, n_body_particles) =
+        build_world(scene, law, wall_law, dt, &scales, options)?;
+    let mut observers = observers(scene, out)?;
+    let mut driver = Driver {
+        scene,
+        dt,
+        progress: match &options.progress {
+            Some(Progress(reporter)) => reporter.start(total_steps(scene, dt)),
+            None => Box::new(progress::Silent),
+        },
+        keep_going: options.keep_going,
+        refill_regions: scene
+            .insertions
+            .iter()
+            .enumerate()
+            .filter(|(_, ins)| ins.refill.is_some())
+            .map(|(k, ins)| RefillRegion::new(scene, k, ins).map(|r| (k, r)))
+            .collect::<Result<_, _>>()?,
+        refilled: 0,
+        particle_steps: 0,
+        stages: Vec::new(),
+        guard_counts: Vec::new(),
+    };
+    let started = Instant::now();
+    let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings)?;
+    driver.progress.finish();
+    let wall_s = started.elapsed().as_secs_f64();
+    for (kind, count) in driver.guard_counts.iter().filter(|(_, count)| *count > 1) {
+        warnings.push(format!(
+            "--keep-going: the {} guard fired in {count} steps",
+            kind.name()
+        ));
+    }
+    if world.lost > 0 {
+        warnings.push(format!(
+            "{} particles left the box through a bounded face and were removed",
+            world.lost
+        ));
+    }
+    let mut summary = RunSummary {
+        case: scene.name.clone(),
+        code: "cgdem".into(),
+        lambda: scene.lambda,
+        cg_rule: scene.cg_rule,
+        n_particles: world.particles.len(),
+        n_particles_inserted: n_inserted,
+        n_particles_refilled: driver.refilled,
+        n_body_particles,
+        lost_particles: world.lost,
+        steps: world.steps,
+        dt_s: dt,
+        contact_period_s: scales.shortest_period,
+        stable_dt_s: scales.stable_limit,
+        simulated_s: world.time,
+        wall_s,
+        particle_steps: driver.particle_steps,
+        particle_steps_per_s: driver.particle_steps as Real / wall_s.max(1e-9),
+        threads: rayon::current_num_threads(),
+        repose_angle_deg: None,
+        repose_fit_r2: None,
+        repose_rule: describe_repose_rule(scene),
+        runout_m: None,
+        repose_samples: Vec::new(),
+        stages: std::mem::take(&mut driver.stages),
+        deleted_particles: world.deleted,
+        deleted_mass_kg: world.deleted_mass,
+        conveying: None,
+        packing: None,
+        warnings: Vec::new(),
+        stopped_by: stopped_by.clone(),
+        guard_peaks: Some(world.guard_peaks()),
+        scene_file: scene.source.display().to_string(),
+        scene_digest: scene.digest(),
+        cgdem_version: env!("CARGO_PKG_VERSION").into(),
+        final_state: options.keep_final_state.then(|| world.particles.clone()),
+        memory: Some(world.memory_use()),
+    };
+    for o in &mut observers {
+        o.observer()
+            .finish(&world, stopped_by.is_some(), &mut summary, &mut warnings)?;
+    }
+    summary.warnings = warnings.0;
+    write_summary(out, &summary)?;
+    match stopped_by {
+        Some(trip) => Err(RunError::Stopped {
+            file: summary.scene_file,
+            trip: Box::new(trip),
+            out_dir: out.clone(),
+        }),
+        None => Ok(summary),
+    }
+}
+
+/// The world at the start of the run, with the particles inserted (or given), bodies,
+/// walls, deletion regions and guards; with the inserted and body particle counts.
+fn build_world<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    law: L,
+    wall_law: W,
+    dt: Real,
+    scales: &Timescales,
+    options: &RunOptions,
+) -> Result<(World<L, W>, usize, usize), RunError> {
+    let (bodies, body_sites) = build_bodies(scene, &wall_law)?;
+    let (particles, kinematic): (Particles, Vec<KinematicParticles>) = match &options.initial_state
+    {
+        // A given state carries no particle-built bodies (the bench's heap has none).
+        Some(_) if !body_sites.is_empty() => {
+            return Err(RunError::NotAvailable(format!(
+                "{}: starting from a given state is not supported with particle-built bodies",
+                scene.source.display()
+            )))
+        }
+        Some(state) => (state.clone(), Vec::new()),
+        None => initial_particles_with_bodies(scene, L::NEEDS_ROTATION, &bodies, &body_sites)?,
+    };
+    let n_inserted = particles.len();
+    let n_body_particles = kinematic.iter().map(|k| k.reference.len()).sum();
+    let neighbor = NeighborSettings {
+        skin: scene.skin_fraction * scene.max_diameter(),
+        resort_every: scene.resort_every,
+    };
+    let mut world = World::new(
+        particles,
+        scene.domain.clone(),
+        scene_walls(scene),
+        law,
+        wall_law,
+        scene.species.len(),
+        scene.gravity,
+        dt,
+        neighbor,
+    )
+    .with_integrator(scene.integrator);
+    world.set_guard_settings(GuardSettings {
+        stable_dt: scales.stable_limit,
+        // With --keep-going guards only warn: lost particles are removed, as with "warn".
+        stop_on_lost: scene.stop_on_lost && !options.keep_going,
+        ..GuardSettings::default()
+    });
+    if !bodies.is_empty() {
+        world.set_bodies(bodies);
+        world.set_kinematic(kinematic);
+    }
+    world.set_delete_regions(
+        scene
+            .deletions
+            .iter()
+            .map(|&(min, max)| Aabb { min, max })
+            .collect(),
+    );
+    if let Some(spec) = options.grid {
+        world.set_grid(spec).map_err(|e| {
+            RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
+        })?;
+    }
+    Ok((world, n_inserted, n_body_particles))
+}
+
+/// The observers the scene's outputs need, in the order they see each step.
+fn observers<'s, L: PairLaw, W: WallLaw>(
+    scene: &'s Scene,
+    out: &Path,
+) -> Result<Vec<Scheduled<'s, L, W>>, RunError> {
+    let conveying = scene.conveying.as_ref().and_then(|c| {
+        scene
+            .bodies
+            .iter()
+            .position(|b| b.name == c.body)
+            .map(|k| (c, k))
+    });
+    let mut list: Vec<Box<dyn Observer<L, W> + 's>> = Vec::new();
+    if let Some((c, k)) = conveying {
+        list.push(Box::new(ConveyingMeter::new(scene, c, k)));
+    }
+    list.push(Box::new(TimeSeries::new(
+        scene,
+        out.join("timeseries.csv"),
+        conveying,
+    )?));
+    if scene.output.vtk_interval > 0.0 {
+        list.push(Box::new(VtkFrames::new(
+            out.join("vtk"),
+            scene.output.vtk_interval,
+        )?));
+    }
+    if let Some(rule) = &scene.repose {
+        list.push(Box::new(ReposeMeter::new(scene, rule, out.to_path_buf())));
+    }
+    if let Some(settings) = &scene.packing {
+        list.push(Box::new(PackingMeter::new(
+            scene,
+            settings,
+            out.to_path_buf(),
+        )));
+    }
+    Ok(list.into_iter().map(Scheduled::new).collect())
+}
+
+/// Steps for the progress display: every stage at its longest.
+fn total_steps(scene: &Scene, dt: Real) -> u64 {
+    let total: Real = scene
+        .stages
+        .iter()
+        .map(|s| match s.end {
+            StageEnd::Duration(d) => d,
+            StageEnd::Settled { max_duration, .. } => max_duration,
+        })
+        .sum();
+    (total / dt).ceil() as u64
+}
+
+fn write_summary(out: &Path, summary: &RunSummary) -> Result<(), RunError> {
+    let path = out.join("summary.json");
+    let json = serde_json::to_string_pretty(summary).map_err(|e| output_error(&path, e))?;
+    write_atomic(&path, json.as_bytes()).map_err(|e| output_error(&path, e))
+}
+
+struct Driver<'s> {
+    scene: &'s Scene,
+    dt: Real,
+    progress: Box<dyn RunProgress>,
+    keep_going: bool,
+    refill_regions: Vec<(usize, RefillRegion)>,
+    refilled: u64,
+    particle_steps: u64,
+    stages: Vec<StageRecord>,
+    /// Guards that fired under --keep-going, and how often.
+    guard_counts: Vec<(GuardKind, u64)>,
+}
+
+/// A top-up of the current stage: (insertion, region, particles it held at the stage start,
+/// top-ups so far).
+type Refill<'r> = (usize, &'r RefillRegion, usize, u64);
+
+impl Driver<'_> {
+    /// Runs every stage; returns the guard trip that stopped the run, if one did.
+    fn run_stages<L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &mut World<L, W>,
+        observers: &mut [Scheduled<'_, L, W>],
+        warnings: &mut Warnings,
+    ) -> Result<Option<GuardTrip>, RunError> {
+        for stage in &self.scene.stages {
+            world.reset_energy_reference();
+            for name in &stage.remove_walls {
+                world.walls.remove(name);
+            }
+            for b in &self.scene.bodies {
+                if b.start_stage.as_deref() == Some(stage.name.as_str()) {
+                    world.start_body(&b.name);
+                }
+            }
+            self.progress.stage(&stage.name);
+            let clock = StageClock {
+                stage,
+                start: world.time,
+                dt: self.dt,
+            };
+            for o in observers.iter_mut() {
+                o.stage_begins(world, &clock);
+            }
+            let start_steps = world.steps;
+            let ending = match self.run_stage(world, observers, &clock, warnings)? {
+                Ok(ending) => ending,
+                Err(trip) => {
+                    self.record(
+                        stage,
+                        &clock,
+                        world,
+                        start_steps,
+                        StageEnding::Guard(trip.kind),
+                    );
+                    return Ok(Some(trip));
+                }
+            };
+            if let (StageEnd::Settled { max_duration, .. }, StageEnding::Duration(_)) =
+                (&stage.end, &ending)
+            {
+                warnings.push(format!(
+                    "stage `{}` did not settle within max_duration {max_duration} s",
+                    stage.name
+                ));
+            }
+            for o in observers.iter_mut() {
+                o.observer().stage_ends(world, &clock, warnings)?;
+            }
+            self.record(stage, &clock, world, start_steps, ending);
+        }
+        Ok(None)
+    }
+
+    /// Steps one stage until its end; `Err(trip)` when a guard stops the run.
+    #[allow(clippy::type_complexity)]
+    fn run_stage<L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &mut World<L, W>,
+        observers: &mut [Scheduled<'_, L, W>],
+        clock: &StageClock,
+        warnings: &mut Warnings,
+    ) -> Result<Result<StageEnding, GuardTrip>, RunError> {
+        let duration = match clock.stage.end {
+            StageEnd::Duration(d) => d,
+            StageEnd::Settled { max_duration, .. } => max_duration,
+        };
+        let refill_regions = std::mem::take(&mut self.refill_regions);
+        let mut refills: Vec<Refill> = refill_regions
+            .iter()
+            .filter(|(k, _)| {
+                self.scene.insertions[*k]
+                    .refill
+                    .as_ref()
+                    .is_some_and(|r| r.stage == clock.stage.name)
+            })
+            .map(|(k, region)| (*k, region, region.count(&world.particles), 0))
+            .collect();
+        let stage_steps = (duration / self.dt).round() as u64;
+        let mut ending = Ok(StageEnding::Duration(duration));
+        'steps: for k in 1..=stage_steps {
+            world.step();
+            self.particle_steps += world.particles.len() as u64;
+            if let Some(trip) = world.take_guard_trip() {
+                if !self.keep_going {
+                    ending = Err(trip);
+                    break;
+                }
+                self.count_guard(world, trip, warnings);
+            }
+            self.top_up(world, &mut refills, clock);
+            if k % 256 == 0 {
+                self.progress.advance(256);
+            }
+            for o in observers.iter_mut() {
+                if let Flow::EndStage(reason) = o.after_step(world, clock)? {
+                    ending = Ok(reason);
+                    break 'steps;
+                }
+            }
+        }
+        drop(refills);
+        self.refill_regions = refill_regions;
+        Ok(ending)
+    }
+
+    /// Under --keep-going: warn once per guard and count the rest; a new energy reference,
+    /// so the energy guard judges what follows.
+    fn count_guard<L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &mut World<L, W>,
+        trip: GuardTrip,
+        warnings: &mut Warnings,
+    ) {
+        world.reset_energy_reference();
+        match self
+            .guard_counts
+            .iter_mut()
+            .find(|(kind, _)| *kind == trip.kind)
+        {
+            Some((_, count)) => *count += 1,
+            None => {
+                warnings.push(format!("--keep-going: {trip}"));
+                self.guard_counts.push((trip.kind, 1));
+            }
+        }
+    }
+
+    /// Tops up the stage's refill regions that are due.
+    fn top_up<L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &mut World<L, W>,
+        refills: &mut [Refill],
+        clock: &StageClock,
+    ) {
+        for (index, region, target, done) in refills.iter_mut() {
+            let ins = &self.scene.insertions[*index];
+            let interval = ins.refill.as_ref().map_or(Real::INFINITY, |r| r.interval);
+            if world.time - clock.start + 0.5 * self.dt >= (*done + 1) as Real * interval {
+                *done += 1;
+                let seed = ins.seed.wrapping_add(1_000_003 * *done);
+                let added = region.top_up(&world.particles, world.bodies(), *target, seed);
+                let species = &self.scene.species[ins.species];
+                world.add_particles(ins.species as u16, &added, species.radius(), species.mass());
+                self.refilled += added.len() as u64;
+            }
+        }
+    }
+
+    fn record<L: PairLaw, W: WallLaw>(
+        &mut self,
+        stage: &Stage,
+        clock: &StageClock,
+        world: &World<L, W>,
+        start_steps: u64,
+        ending: StageEnding,
+    ) {
+        self.stages.push(StageRecord {
+            name: stage.name.clone(),
+            start_s: clock.start,
+            end_s: world.time,
+            steps: world.steps - start_steps,
+            ended_by: ending.to_string(),
+        });
+    }
+}

@@ -1,0 +1,142 @@
+//! Output observers: what a run measures and writes while its stages run. The stage driver
+//! (`super::driver`) calls each observer when it is due: dynamic dispatch once per output
+//! interval (or once per step for the few that accumulate every step), never per contact.
+//!
+//! The driver calls them in list order, so an observer that ends a stage (the time series,
+//! when the stage has settled) keeps the later ones from seeing that step.
+
+mod conveying;
+mod packing;
+mod repose;
+mod timeseries;
+mod vtk;
+
+pub(crate) use conveying::ConveyingMeter;
+pub(crate) use packing::PackingMeter;
+pub(crate) use repose::ReposeMeter;
+pub(crate) use timeseries::TimeSeries;
+pub(crate) use vtk::VtkFrames;
+
+use crate::contact::PairLaw;
+use crate::math::Real;
+use crate::scene::Stage;
+use crate::simulation::World;
+use crate::walls::WallLaw;
+
+use super::{RunError, RunSummary};
+
+/// When an observer wants to be called next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Due {
+    Never,
+    EveryStep,
+    /// At the first step with `time + dt/2 >= t` (absolute simulated time).
+    At(Real),
+    /// At the first step with `(time - stage start) + dt/2 >= t`.
+    AfterStageStart(Real),
+}
+
+impl Due {
+    /// Whether a step that ended at `time` is due (the comparison each observer's interval
+    /// was always made with, so the steps that write are the same).
+    pub(crate) fn is_due(self, time: Real, stage_start: Real, dt: Real) -> bool {
+        match self {
+            Due::Never => false,
+            Due::EveryStep => true,
+            Due::At(t) => time + 0.5 * dt >= t,
+            Due::AfterStageStart(t) => time - stage_start + 0.5 * dt >= t,
+        }
+    }
+}
+
+/// Where the driver is: the stage, when it began, the step.
+pub(crate) struct StageClock<'a> {
+    pub stage: &'a Stage,
+    pub start: Real,
+    pub dt: Real,
+}
+
+/// What an observer tells the driver after it ran.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Flow {
+    Continue,
+    /// The stage ends now (its settling condition holds), for this reason.
+    EndStage(super::StageEnding),
+}
+
+/// Warnings a run collects for `summary.json` (also printed as they arise).
+#[derive(Default)]
+pub(crate) struct Warnings(pub Vec<String>);
+
+impl Warnings {
+    pub(crate) fn push(&mut self, w: String) {
+        eprintln!("warning: {w}");
+        self.0.push(w);
+    }
+}
+
+pub(crate) trait Observer<L: PairLaw, W: WallLaw> {
+    /// A stage begins; the observer sets up what it measures in it.
+    fn stage_begins(&mut self, _world: &World<L, W>, _clock: &StageClock) {}
+    /// When this observer wants to be called next (asked after each call).
+    fn due(&self) -> Due;
+    fn observe(&mut self, world: &World<L, W>, clock: &StageClock) -> Result<Flow, RunError>;
+    /// The stage ended by its own condition (not by a guard).
+    fn stage_ends(
+        &mut self,
+        _world: &World<L, W>,
+        _clock: &StageClock,
+        _warnings: &mut Warnings,
+    ) -> Result<(), RunError> {
+        Ok(())
+    }
+    /// The run ended (`stopped`: by a guard); the observer writes its last outputs and puts
+    /// its results into the summary.
+    fn finish(
+        &mut self,
+        _world: &World<L, W>,
+        _stopped: bool,
+        _summary: &mut RunSummary,
+        _warnings: &mut Warnings,
+    ) -> Result<(), RunError> {
+        Ok(())
+    }
+}
+
+/// An observer with its cached due time, so the driver asks it only when it is due.
+pub(crate) struct Scheduled<'s, L: PairLaw, W: WallLaw> {
+    due: Due,
+    observer: Box<dyn Observer<L, W> + 's>,
+}
+
+impl<'s, L: PairLaw, W: WallLaw> Scheduled<'s, L, W> {
+    pub(crate) fn new(observer: Box<dyn Observer<L, W> + 's>) -> Self {
+        Scheduled {
+            due: observer.due(),
+            observer,
+        }
+    }
+
+    pub(crate) fn stage_begins(&mut self, world: &World<L, W>, clock: &StageClock) {
+        self.observer.stage_begins(world, clock);
+        self.due = self.observer.due();
+    }
+
+    /// Runs the observer if it is due after the step that ended at `world.time`.
+    pub(crate) fn after_step(
+        &mut self,
+        world: &World<L, W>,
+        clock: &StageClock,
+    ) -> Result<Flow, RunError> {
+        if !self.due.is_due(world.time, clock.start, clock.dt) {
+            return Ok(Flow::Continue);
+        }
+        let flow = self.observer.observe(world, clock)?;
+        self.due = self.observer.due();
+        Ok(flow)
+    }
+
+    pub(crate) fn observer(&mut self) -> &mut (dyn Observer<L, W> + 's) {
+        &mut *self.observer
+    }
+}

@@ -1,0 +1,124 @@
+//! `timeseries.csv`: one row per `output.timeseries_interval` (energies, particle count, heap
+//! front and wall height, deleted mass, body torques, conveying state); it also ends a
+//! settling stage, whose condition is judged at these rows.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+
+use crate::contact::PairLaw;
+use crate::math::Real;
+use crate::scene::{ConveyingSettings, Scene, StageEnd};
+use crate::simulation::World;
+use crate::walls::WallLaw;
+
+use super::super::{output_error, RunError, StageEnding};
+use super::conveying::conveying_sample;
+use super::repose::heap_profile;
+use super::{Due, Flow, Observer, StageClock};
+
+pub(crate) struct TimeSeries<'s> {
+    scene: &'s Scene,
+    path: PathBuf,
+    file: BufWriter<File>,
+    next_row: Real,
+    /// The conveying body's settings and index, for the conveying columns.
+    conveying: Option<(&'s ConveyingSettings, usize)>,
+    /// The stage's settling condition: (kinetic energy per mass, minimum duration).
+    settle: Option<(Real, Real)>,
+}
+
+impl<'s> TimeSeries<'s> {
+    pub(crate) fn new(
+        scene: &'s Scene,
+        path: PathBuf,
+        conveying: Option<(&'s ConveyingSettings, usize)>,
+    ) -> Result<Self, RunError> {
+        let file = File::create(&path).map_err(|e| output_error(&path, e))?;
+        let mut series = TimeSeries {
+            scene,
+            path,
+            file: BufWriter::new(file),
+            next_row: 0.0,
+            conveying,
+            settle: None,
+        };
+        let body_columns: String = scene
+            .bodies
+            .iter()
+            .map(|b| format!(",axial_torque_{}_nm", b.name))
+            .collect();
+        let conveying_columns = if conveying.is_some() {
+            ",fill_ratio,bulk_density_kg_m3,passed_mass_kg"
+        } else {
+            ""
+        };
+        writeln!(series.file, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{conveying_columns},mechanical_energy_j")
+            .map_err(|e| output_error(&series.path, e))?;
+        Ok(series)
+    }
+}
+
+impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
+    fn stage_begins(&mut self, _world: &World<L, W>, clock: &StageClock) {
+        self.settle = match clock.stage.end {
+            StageEnd::Duration(_) => None,
+            StageEnd::Settled {
+                kinetic_energy_per_mass,
+                min_duration,
+                ..
+            } => Some((kinetic_energy_per_mass, min_duration)),
+        };
+    }
+
+    fn due(&self) -> Due {
+        Due::At(self.next_row)
+    }
+
+    fn observe(&mut self, world: &World<L, W>, clock: &StageClock) -> Result<Flow, RunError> {
+        let elapsed = world.time - clock.start;
+        self.next_row += self.scene.output.timeseries_interval;
+        let ke = world.kinetic_energy();
+        let mass = world.particles.mobile_mass();
+        let profile = heap_profile(self.scene, &world.particles);
+        let max_diameter = self.scene.max_diameter();
+        let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
+        let wall_height = profile.as_ref().map(|p| p.wall_height());
+        let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+        let mut extra = format!(",{:.9e}", world.deleted_mass);
+        for body in world.bodies() {
+            extra += &format!(",{:.6e}", body.axial_torque());
+        }
+        if let Some((c, k)) = self.conveying {
+            let sample = conveying_sample(c, &world.bodies()[k], world);
+            extra += &format!(
+                ",{:.6e},{:.6e},{:.9e}",
+                sample.fill_ratio, sample.bulk_density, sample.passed_mass
+            );
+        }
+        // Kinetic plus gravitational energy, for the stability suite's energy balance.
+        extra += &format!(",{:.9e}", world.mechanical_energy());
+        writeln!(
+            self.file,
+            "{:.9e},{},{:.9e},{:.9e},{},{},{}{extra}",
+            world.time,
+            clock.stage.name,
+            ke,
+            ke / mass.max(Real::MIN_POSITIVE),
+            world.particles.len(),
+            opt(front),
+            opt(wall_height)
+        )
+        .and_then(|()| self.file.flush())
+        .map_err(|e| output_error(&self.path, e))?;
+        if let Some((threshold, min_duration)) = self.settle {
+            if elapsed >= min_duration && ke / mass < threshold {
+                return Ok(Flow::EndStage(StageEnding::Settled {
+                    kinetic_energy_per_mass: ke / mass,
+                    threshold,
+                }));
+            }
+        }
+        Ok(Flow::Continue)
+    }
+}
