@@ -98,9 +98,9 @@ mod tests {
         forward(&mut subs, &mut buffers);
         let mut ghosts = 0;
         for (sub, old) in subs.iter().zip(&before) {
-            for k in sub.n_owned..sub.particles.len() {
+            for (k, &was) in old.iter().enumerate().skip(sub.n_owned) {
                 let id = sub.particles.id[k];
-                let expected = old[k] + moved(id);
+                let expected = was + moved(id);
                 assert!((sub.particles.position[k] - expected).length() < 1e-12);
                 assert_eq!(sub.particles.velocity[k], Vec3::splat(id as Real));
                 ghosts += 1;

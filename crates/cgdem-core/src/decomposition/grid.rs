@@ -53,11 +53,11 @@ impl std::fmt::Display for GridSpec {
 pub fn choose_counts(count: usize, extent: Vec3, periodic: [bool; 3]) -> [usize; 3] {
     let mut best = ([count, 1, 1], Real::INFINITY);
     for nx in (1..=count).rev() {
-        if count % nx != 0 {
+        if !count.is_multiple_of(nx) {
             continue;
         }
         for ny in (1..=count / nx).rev() {
-            if (count / nx) % ny != 0 {
+            if !(count / nx).is_multiple_of(ny) {
                 continue;
             }
             let n = [nx, ny, count / nx / ny];
