@@ -25,7 +25,7 @@ night="reports/nightly/${date}-${commit}"
 mkdir -p "$night"
 
 started=$(date +%s)
-"$cgdem" validate --suite nightly --out "$night" --reuse --jobs 2 "$@"
+"$cgdem" validate --suite nightly --out "$night" --reuse --jobs 2 --history reports/nightly "$@"
 echo "nightly suite: $(( $(date +%s) - started )) s wall time"
 
 # Throughput against LIGGGHTS and LAMMPS on the heap benchmark, side by side (three

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's test command (README quick start; CI runs it through .ci/run).
 # Installs what the tests need, checks formatting and lints, runs every test, then runs the
-# smoke validation suite (cgdem and LAMMPS) and checks its report in a real browser.
+# smoke validation suite (cgdem, LAMMPS, LIGGGHTS), checks its verdicts with planted faults
+# (scripts/planted-faults.sh) and its report in a real browser.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -18,7 +19,7 @@ cargo test --release --workspace
 # The smoke suite: every part of the harness on a small collapse (a few minutes).
 report=target/smoke-report
 rm -rf "$report"
-cargo run --release --quiet -- validate --suite smoke --out "$report" --quiet
+cargo run --release --quiet -- validate --suite smoke --out "$report" --quiet --jobs 2
 python3 - "$report/summary.json" <<'PY'
 import json, sys
 summary = json.load(open(sys.argv[1]))
@@ -27,6 +28,9 @@ for r in failed:
     print(f"smoke run failed: {r['code']} lambda={r['lambda']} seed={r['seed']}: {r['reason']}")
 sys.exit(1 if failed else 0)
 PY
+# The verdicts: the unchanged run has no red row (amber only where declared), and faults
+# planted in cgdem alone turn their comparisons red (about 2 minutes: cgdem's runs only).
+bash scripts/planted-faults.sh "$report"
 if [ "$(id -u)" = 0 ] || command -v chromium >/dev/null 2>&1; then
     bash scripts/check-report-in-browser.sh "$report/index.html"
 else

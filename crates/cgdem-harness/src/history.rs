@@ -228,6 +228,7 @@ pub fn add_night(
     let runs_failed = summary["runs"]
         .as_array()
         .map_or(0, |r| r.iter().filter(|r| r["status"] == "failed").count());
+    // A known difference inside its band is not a failure (its `pass` is true).
     let comparisons_failed = summary["comparisons"]
         .as_array()
         .map_or(0, |c| c.iter().filter(|c| c["pass"] == false).count());
@@ -273,6 +274,100 @@ pub fn add_night(
     };
     write_page(history_dir, &nights)?;
     Ok(flagged)
+}
+
+/// What moved since the last night recorded in `history_dir` before the night in
+/// `night_dir` (whose `cgdem validate` summary is `summary`): a sentence, then one line per
+/// metric beyond its tolerance and per comparison whose verdict changed.
+pub fn since_previous(
+    history_dir: &Path,
+    night_dir: &Path,
+    summary: &serde_json::Value,
+) -> (String, Vec<String>) {
+    let nights = match read_history(&history_dir.join("history.json")) {
+        Ok(n) => n,
+        Err(e) => {
+            return (
+                format!("Since the previous night: no history ({e})."),
+                Vec::new(),
+            )
+        }
+    };
+    let report = relative_to(night_dir, history_dir);
+    let Some(previous) = nights.iter().rev().find(|n| n.report != report) else {
+        return (
+            format!(
+                "Since the previous night: this is the first night in {}.",
+                history_dir.display()
+            ),
+            Vec::new(),
+        );
+    };
+    let current = Night {
+        metrics: night_metrics(summary),
+        ..previous.clone()
+    };
+    let mut items: Vec<String> = flags(previous, &current)
+        .iter()
+        .map(|f| {
+            format!(
+                "{}: {} -> {} (tolerance {}{})",
+                f.metric,
+                crate::verdict::fmt(f.previous),
+                crate::verdict::fmt(f.current),
+                f.tolerance,
+                if f.relative { " relative" } else { "" }
+            )
+        })
+        .collect();
+    // Verdicts then and now, by case, comparison and part (an older summary has only `pass`).
+    let verdicts = |s: &serde_json::Value| -> BTreeMap<String, String> {
+        s["comparisons"]
+            .as_array()
+            .map(|cs| {
+                cs.iter()
+                    .map(|c| {
+                        let key = format!(
+                            "{} {}, {}",
+                            c["case"].as_str().unwrap_or("?"),
+                            c["what"].as_str().unwrap_or("?"),
+                            c["part"].as_str().unwrap_or("?")
+                        );
+                        let verdict = match c["verdict"].as_str() {
+                            Some(v) => v.to_string(),
+                            None if c["pass"] == true => "pass".into(),
+                            None => "fail".into(),
+                        };
+                        (key, verdict)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let before = std::fs::read_to_string(history_dir.join(&previous.report).join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .map(|v| verdicts(&v))
+        .unwrap_or_default();
+    for (key, now) in verdicts(summary) {
+        match before.get(&key) {
+            Some(then) if *then != now => items.push(format!("{key}: {then} -> {now}")),
+            None if !before.is_empty() => items.push(format!("{key}: new ({now})")),
+            _ => {}
+        }
+    }
+    let text = format!(
+        "Since the previous night ({} {}, {}): {}",
+        previous.date,
+        previous.commit,
+        previous.report,
+        if items.is_empty() {
+            "no metric moved beyond its tolerance and no verdict changed."
+        } else {
+            "moved beyond tolerance or changed verdict:"
+        }
+    );
+    (text, items)
 }
 
 /// The nights recorded so far (none if the file does not exist yet).
@@ -501,6 +596,35 @@ mod tests {
             std::fs::read_to_string(base.join("history.json")).unwrap(),
             "[{\"truncated"
         );
+        let _ = std::fs::remove_dir_all(&base);
+    }
+
+    #[test]
+    fn the_first_screen_lists_what_moved_since_the_previous_night() {
+        let base = std::env::temp_dir().join(format!("cgdem-since-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        let night1 = base.join("night1");
+        std::fs::create_dir_all(&night1).unwrap();
+        std::fs::write(night1.join("summary.json"), summary(30.0, 1e6).to_string()).unwrap();
+        let (text, items) = since_previous(&base, &base.join("night2"), &summary(30.0, 1e6));
+        assert!(
+            text.contains("no history") || text.contains("first night"),
+            "{text}"
+        );
+        assert!(items.is_empty());
+        add_night(&base, &night1, "2026-11-01", "abc").unwrap();
+        // Same numbers: nothing moved.
+        let (text, items) = since_previous(&base, &base.join("night2"), &summary(30.4, 1e6));
+        assert!(text.contains("no metric moved"), "{text}");
+        assert!(items.is_empty(), "{items:?}");
+        // The angle moves by 3 deg (tolerance 1.5) and the comparison turns red.
+        let mut now = summary(33.0, 1e6);
+        now["comparisons"][0]["pass"] = serde_json::json!(false);
+        now["comparisons"][0]["verdict"] = serde_json::json!("fail");
+        let (_, items) = since_previous(&base, &base.join("night2"), &now);
+        assert_eq!(items.len(), 2, "{items:?}");
+        assert!(items[0].contains("repose angle: 30.0 -> 33.0"), "{items:?}");
+        assert!(items[1].ends_with("pass -> fail"), "{items:?}");
         let _ = std::fs::remove_dir_all(&base);
     }
 }

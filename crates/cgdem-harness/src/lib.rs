@@ -15,6 +15,7 @@ pub mod stability;
 pub mod suite;
 pub mod sweep;
 pub mod validate;
+pub mod verdict;
 
 /// Tests read the shipped cases and suites by their paths from the repository root, as the
 /// command does; `cargo test` starts them in this crate's folder.

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::accuracy::{AccuracySweep, RawSweep};
+use super::verdict::KnownDifference;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::{Override, Scene, SceneError};
 
@@ -124,6 +125,14 @@ pub struct SuiteCase {
     /// Largest acceptable gap between two front-position histories, as a fraction of the
     /// box length.
     pub front_tolerance: f64,
+    /// Largest acceptable gap between two wall-height histories, as a fraction of the
+    /// column's initial height.
+    pub wall_height_tolerance: f64,
+    /// Largest acceptable gap between two kinetic-energy histories, as a fraction of the
+    /// peak.
+    pub kinetic_energy_tolerance: f64,
+    /// Comparisons expected to differ, each with its reason, evidence and band.
+    pub known_differences: Vec<KnownDifference>,
     /// Scene overrides (`KEY=VALUE`) that make this case a variant of its file.
     pub overrides: Vec<Override>,
     /// The variant's name, appended to the scene's name (`aor_collapse-smooth-walls`) in run
@@ -202,6 +211,10 @@ struct RawCase {
     angle_tolerance_deg: Option<f64>,
     time_ratio_tolerance: Option<f64>,
     front_tolerance: Option<f64>,
+    wall_height_tolerance: Option<f64>,
+    kinetic_energy_tolerance: Option<f64>,
+    #[serde(default)]
+    known_difference: Vec<RawKnownDifference>,
     #[serde(default)]
     set: Vec<String>,
     variant: Option<String>,
@@ -210,6 +223,25 @@ struct RawCase {
     #[serde(default)]
     keep_going: bool,
 }
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawKnownDifference {
+    comparison: String,
+    criterion: String,
+    reason: String,
+    evidence: String,
+    band: [f64; 2],
+}
+
+/// The criteria a comparison is judged by (`verdict::Criterion::name`).
+pub const CRITERIA: [&str; 5] = [
+    "repose angle",
+    "t_half ratio",
+    "front gap",
+    "wall height gap",
+    "kinetic energy gap",
+];
 
 impl Suite {
     pub fn load(path: &Path) -> Result<Suite, SuiteError> {
@@ -295,6 +327,57 @@ impl Suite {
             let time_ratio_tolerance =
                 fraction("time_ratio_tolerance", c.time_ratio_tolerance, 0.10)?;
             let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
+            let wall_height_tolerance =
+                fraction("wall_height_tolerance", c.wall_height_tolerance, 0.05)?;
+            let kinetic_energy_tolerance =
+                fraction("kinetic_energy_tolerance", c.kinetic_energy_tolerance, 0.10)?;
+            let mut known_differences = Vec::new();
+            for (j, kd) in c.known_difference.into_iter().enumerate() {
+                let field = |f: &str| format!("case[{k}].known_difference[{j}].{f}");
+                if !CRITERIA.contains(&kd.criterion.as_str()) {
+                    return Err(invalid(
+                        field("criterion"),
+                        format!("\"{}\"", kd.criterion),
+                        "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\"",
+                    ));
+                }
+                if !(kd.band[0].is_finite() && kd.band[1].is_finite() && kd.band[0] <= kd.band[1]) {
+                    return Err(invalid(
+                        field("band"),
+                        format!("{:?}", kd.band),
+                        "[low, high], finite, low <= high, in the criterion's units",
+                    ));
+                }
+                if kd.reason.trim().is_empty() {
+                    return Err(invalid(
+                        field("reason"),
+                        "\"\"".into(),
+                        "why the codes or levels differ, in words",
+                    ));
+                }
+                // The evidence is a file of the repository (paths from its root, as `file`).
+                if !Path::new(&kd.evidence).is_file() {
+                    return Err(invalid(
+                        field("evidence"),
+                        format!("\"{}\"", kd.evidence),
+                        "an existing file, relative to the repository root, that documents the difference",
+                    ));
+                }
+                if kd.comparison.trim().is_empty() {
+                    return Err(invalid(
+                        field("comparison"),
+                        "\"\"".into(),
+                        "the start of a comparison's name, e.g. \"cgdem vs lammps\"",
+                    ));
+                }
+                known_differences.push(KnownDifference {
+                    comparison: kd.comparison,
+                    criterion: kd.criterion,
+                    reason: kd.reason,
+                    evidence: kd.evidence,
+                    band: kd.band,
+                });
+            }
             let overrides =
                 parse_variant(&c.set, c.variant.as_deref(), &format!("case[{k}]"), path)?;
             if let Some(bad) = c.rpms.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
@@ -313,6 +396,9 @@ impl Suite {
                 angle_tolerance_deg,
                 time_ratio_tolerance,
                 front_tolerance,
+                wall_height_tolerance,
+                kinetic_energy_tolerance,
+                known_differences,
                 overrides,
                 variant: c.variant,
                 rpms: c.rpms,
@@ -395,5 +481,51 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("case[0].variant"), "{e}");
+    }
+
+    #[test]
+    fn a_known_difference_needs_a_criterion_a_band_and_its_evidence() {
+        crate::at_repo_root();
+        let entry = |criterion: &str, band: &str, evidence: &str| {
+            format!(
+                "{CASE}[[case.known_difference]]\ncomparison = \"cgdem vs lammps\"\ncriterion = \"{criterion}\"\nreason = \"wall friction cap\"\nevidence = \"{evidence}\"\nband = {band}\n"
+            )
+        };
+        let ok = Suite::parse(
+            &entry(
+                "repose angle",
+                "[5.0, 25.0]",
+                "reference/lammps/SEED_MODEL.md",
+            ),
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        assert_eq!(ok.cases[0].known_differences[0].band, [5.0, 25.0]);
+        for (text, field) in [
+            (
+                entry("angle", "[5.0, 25.0]", "reference/lammps/SEED_MODEL.md"),
+                "criterion",
+            ),
+            (
+                entry(
+                    "repose angle",
+                    "[25.0, 5.0]",
+                    "reference/lammps/SEED_MODEL.md",
+                ),
+                "band",
+            ),
+            (
+                entry("repose angle", "[5.0, 25.0]", "reference/nowhere.md"),
+                "evidence",
+            ),
+        ] {
+            let e = Suite::parse(&text, Path::new("s.toml"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(&format!("case[0].known_difference[0].{field}")),
+                "{e}"
+            );
+        }
     }
 }

@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::dynamics::{flow_difference, FlowSeries};
+use super::dynamics::{flow_difference, flow_noise, FlowSeries};
 use super::suite::{Code, Suite, SuiteCase};
+use super::verdict::{combined_standard_error, mean_sd, Criterion, Verdict};
 use crate::report::{
     write_bar_chart, write_figure, Cell, Figure, Report, Series, SeriesStyle, Table,
 };
@@ -62,24 +63,60 @@ pub struct RunRecord {
     pub ratio_to_eq7: Option<f64>,
 }
 
-/// One judged comparison.
+/// One judged comparison: a pair of codes or levels, one part (final state or dynamics),
+/// judged by its criteria (`verdict::Criterion`), each with its value, noise, threshold
+/// and verdict; the comparison's verdict is its worst criterion's, named in `decided_by`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Comparison {
     pub case: String,
     /// "codes" (two codes at one level) or "levels" (one code at two levels).
     pub kind: String,
-    /// "final state" (repose angle, in degrees) or "dynamics" (characteristic-time ratio
-    /// `t_half`, judged as |ratio - 1|, and the front-history gap): a pair is similar only if
-    /// both pass.
+    /// "final state" (repose angle) or "dynamics" (t_half ratio, front, wall-height and
+    /// kinetic-energy gaps): a pair is similar only if both pass.
     pub part: String,
     pub what: String,
     /// The numbers behind the verdict, in words.
     pub detail: String,
+    /// The deciding criterion's value, physical tolerance and threshold (tolerance + k noise).
     pub difference: f64,
-    pub combined_spread: f64,
     pub tolerance: f64,
-    pub within_spread: bool,
+    pub threshold: f64,
+    /// "pass", "known difference" or "fail".
+    pub verdict: super::verdict::Verdict,
+    /// The criterion that decided the verdict.
+    pub decided_by: String,
+    pub criteria: Vec<super::verdict::Criterion>,
+    /// Not a fail (a known difference inside its band passes).
     pub pass: bool,
+}
+
+impl Comparison {
+    /// A comparison judged by `criteria`.
+    fn judged(
+        case: &str,
+        kind: &str,
+        part: &str,
+        what: &str,
+        detail: String,
+        criteria: Vec<super::verdict::Criterion>,
+    ) -> Comparison {
+        let (verdict, decided_by) = super::verdict::decide(&criteria);
+        let deciding = criteria.iter().find(|c| c.name == decided_by);
+        Comparison {
+            case: case.into(),
+            kind: kind.into(),
+            part: part.into(),
+            what: what.into(),
+            detail,
+            difference: deciding.map_or(0.0, |c| c.value),
+            tolerance: deciding.map_or(0.0, |c| c.tolerance),
+            threshold: deciding.map_or(0.0, |c| c.threshold),
+            verdict,
+            decided_by,
+            criteria,
+            pass: verdict != super::verdict::Verdict::Fail,
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -131,6 +168,13 @@ pub struct ValidateOptions {
     pub keep_going: bool,
     /// Runs of a case made at the same time (`--jobs`), sharing the threads.
     pub jobs: usize,
+    /// Planted faults (`--fault KEY=VALUE`): scene overrides applied to cgdem's runs only,
+    /// after the case's own, the scene keeping its name, so that its comparisons with the
+    /// reference codes show whether the verdicts can fail (scripts/planted-faults.sh).
+    pub cgdem_faults: Vec<String>,
+    /// A nightly history directory (`history.json`, `cgdem history`): the report's first
+    /// screen says what moved since the last night recorded there.
+    pub history: Option<PathBuf>,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -143,8 +187,9 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
     let provenance = provenance(&suite, options);
     // Cases of one scene (e.g. its two coarse-graining rules) are compared and reported
-    // together: one section, one set of figures, judged by the first case's tolerances.
-    let mut scenes: Vec<(Scene, &SuiteCase, Vec<RunRecord>)> = Vec::new();
+    // together: one section, one set of figures, judged by the first case's tolerances and
+    // by the known differences any of them declares.
+    let mut scenes: Vec<(Scene, SuiteCase, Vec<RunRecord>)> = Vec::new();
     for case in &suite.cases {
         let scene = case.load_scene().map_err(|e| ValidateError::Case {
             file: case.file.clone(),
@@ -152,8 +197,13 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         })?;
         let case_runs = run_case(&scene, case, options)?;
         match scenes.iter_mut().find(|(s, _, _)| s.name == scene.name) {
-            Some((_, _, earlier)) => earlier.extend(case_runs),
-            None => scenes.push((scene, case, case_runs)),
+            Some((_, first, earlier)) => {
+                earlier.extend(case_runs);
+                first
+                    .known_differences
+                    .extend(case.known_differences.iter().cloned());
+            }
+            None => scenes.push((scene, case.clone(), case_runs)),
         }
     }
     let screws: Vec<(&Scene, &[RunRecord])> = scenes
@@ -167,15 +217,21 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     for (scene, case, case_runs) in scenes {
         if scene.conveying.is_some() {
             // A screw case is judged by its mass flow against Eq. (7), code by code.
-            super::screw::write_screw_section(&mut report, &scene, case, &case_runs, &options.out)?;
+            super::screw::write_screw_section(
+                &mut report,
+                &scene,
+                &case,
+                &case_runs,
+                &options.out,
+            )?;
             runs.extend(case_runs);
             continue;
         }
-        let case_comparisons = compare(&scene, case, &case_runs);
+        let case_comparisons = compare(&scene, &case, &case_runs);
         write_case_section(
             &mut report,
             &scene,
-            case,
+            &case,
             &case_runs,
             &case_comparisons,
             &options.out,
@@ -205,25 +261,13 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         stability,
     };
     let intro = report.intro();
+    write_status(intro, &summary, options);
     intro.paragraph(format!(
         "{} {}",
         suite.description,
         "Each run's files are under runs/; figures have their data as CSV beside them."
     ));
-    let mut table = Table::new([
-        "case",
-        "comparison",
-        "part",
-        "what",
-        "difference",
-        "combined seed spread",
-        "tolerance",
-        "verdict",
-    ])
-    .caption("Summary: every comparison against its stated tolerance (final state: repose angle in degrees; dynamics: |t_half ratio - 1| and the front-history gap)");
-    for c in &summary.comparisons {
-        table.row(std::iter::once(Cell::text(&c.case)).chain(comparison_cells(c)));
-    }
+    let table = criteria_table(&summary.comparisons);
     let mut run_table = Table::new([
         "case",
         "code",
@@ -286,21 +330,198 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     Ok(summary)
 }
 
-/// A comparison's table cells: kind, what, difference, spread, tolerance, verdict.
-fn comparison_cells(c: &Comparison) -> [Cell; 7] {
-    [
-        Cell::text(&c.kind),
-        Cell::text(&c.part),
-        Cell::text(&c.what),
-        Cell::num(format!("{:.2}", c.difference)),
-        Cell::num(format!("{:.2}", c.combined_spread)),
-        Cell::num(format!("{:.2}", c.tolerance)),
-        if c.pass {
-            Cell::pass("pass")
-        } else {
-            Cell::fail("fail")
-        },
-    ]
+/// The row anchor of the `k`-th comparison (links from the first screen).
+fn comparison_id(k: usize) -> String {
+    format!("comparison-{}", k + 1)
+}
+
+fn verdict_cell(v: Verdict, text: String) -> Cell {
+    match v {
+        Verdict::Pass => Cell::pass(text),
+        Verdict::KnownDifference => Cell::text(text).status(crate::report::Status::Known),
+        Verdict::Fail => Cell::fail(text),
+    }
+}
+
+/// The summary table: one row per criterion of every comparison (its value, noise, seeds,
+/// physical tolerance, threshold and own verdict) and the comparison's verdict with the
+/// criterion that decided it; the first row of each comparison carries its anchor.
+fn criteria_table(comparisons: &[Comparison]) -> Table {
+    let mut table = Table::new([
+        "case",
+        "comparison",
+        "part",
+        "criterion",
+        "value",
+        "noise (SE)",
+        "seeds",
+        "tolerance",
+        "threshold",
+        "criterion verdict",
+        "row verdict",
+    ])
+    .caption(format!(
+        "Summary: every comparison by its criteria. A criterion passes when its value <= \
+         threshold = physical tolerance + {} x noise, the noise being the combined standard \
+         error of the two sides from their seeds (0 where a side has one seed); a declared \
+         known difference is judged by its band instead (amber inside, red outside). The \
+         comparison's verdict is its worst criterion's.",
+        super::verdict::K_NOISE
+    ));
+    for (k, c) in comparisons.iter().enumerate() {
+        for (j, crit) in c.criteria.iter().enumerate() {
+            let row_verdict = if crit.name == c.decided_by {
+                verdict_cell(
+                    c.verdict,
+                    format!("{} (decided by {})", c.verdict.name(), c.decided_by),
+                )
+            } else {
+                Cell::text("")
+            };
+            let threshold = match &crit.known_difference {
+                Some(kd) => format!(
+                    "band [{}, {}]",
+                    super::verdict::fmt(kd.band[0]),
+                    super::verdict::fmt(kd.band[1])
+                ),
+                None => super::verdict::fmt(crit.threshold),
+            };
+            // The reason is on the first screen and in the case's similarity table.
+            let verdict_text = match &crit.known_difference {
+                Some(kd) => format!("{} (evidence: {})", crit.verdict.name(), kd.evidence),
+                None => crit.verdict.name().to_string(),
+            };
+            let cells = [
+                Cell::text(&c.case),
+                Cell::text(&c.what),
+                Cell::text(&c.part),
+                Cell::text(format!("{} [{}]", crit.name, crit.unit)),
+                Cell::num(super::verdict::fmt(crit.value)),
+                Cell::num(super::verdict::fmt(crit.noise)),
+                Cell::num(format!("{}+{}", crit.seeds[0], crit.seeds[1])),
+                Cell::num(super::verdict::fmt(crit.tolerance)),
+                Cell::num(threshold),
+                verdict_cell(crit.verdict, verdict_text),
+                row_verdict,
+            ];
+            if j == 0 {
+                table.row_with_id(comparison_id(k), cells);
+            } else {
+                table.row(cells);
+            }
+        }
+    }
+    table
+}
+
+/// The night's status: its overall verdict, the red and amber rows (linked), failed runs,
+/// and what moved since the previous night of the history, if one is given.
+fn write_status(
+    intro: &mut crate::report::Section,
+    summary: &ValidationSummary,
+    options: &ValidateOptions,
+) {
+    use crate::report::Status;
+    let count = |v: Verdict| {
+        summary
+            .comparisons
+            .iter()
+            .filter(|c| c.verdict == v)
+            .count()
+    };
+    let (red, amber, green) = (
+        count(Verdict::Fail),
+        count(Verdict::KnownDifference),
+        count(Verdict::Pass),
+    );
+    let failed_runs: Vec<&RunRecord> = summary
+        .runs
+        .iter()
+        .filter(|r| r.status == "failed")
+        .collect();
+    let stability_failed = summary
+        .stability
+        .iter()
+        .filter(|r| r.code == Code::Cgdem && r.verdict == super::stability::Verdict::Failed)
+        .count();
+    let (status, word) = if red > 0 || !failed_runs.is_empty() || stability_failed > 0 {
+        (Status::Fail, "red")
+    } else if amber > 0 {
+        (Status::Known, "amber")
+    } else {
+        (Status::Pass, "green")
+    };
+    let mut line = format!(
+        "Status: {word}. {red} comparisons fail, {amber} are known differences inside their \
+         bands, {green} pass; {} of {} runs failed",
+        failed_runs.len(),
+        summary.runs.len()
+    );
+    if !summary.stability.is_empty() {
+        line += &format!("; {stability_failed} cgdem stability verdicts failed");
+    }
+    line.push('.');
+    intro.banner(status, line);
+    if !options.cgdem_faults.is_empty() {
+        intro.banner(
+            Status::Fail,
+            format!(
+                "Planted faults in cgdem's runs only (--fault): {}. This report checks that \
+                 the verdicts can fail; it is not a validation of cgdem.",
+                options.cgdem_faults.join(", ")
+            ),
+        );
+    }
+    let flagged: Vec<Cell> = summary
+        .comparisons
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.verdict != Verdict::Pass)
+        .map(|(k, c)| {
+            let decided = c.criteria.iter().find(|x| x.name == c.decided_by);
+            Cell::link(
+                format!(
+                    "{} ({}): {}, {}: {}",
+                    c.case,
+                    c.what,
+                    c.part,
+                    c.verdict.name(),
+                    decided.map_or(String::new(), |d| d.describe())
+                ),
+                format!("#{}", comparison_id(k)),
+            )
+        })
+        .chain(failed_runs.iter().map(|r| {
+            Cell::text(format!(
+                "run failed: {} {} lambda={} seed={}: {}",
+                r.case,
+                r.code.name(),
+                r.lambda,
+                r.seed,
+                r.reason.clone().unwrap_or_default()
+            ))
+        }))
+        .collect();
+    if !flagged.is_empty() {
+        intro.paragraph("Red and amber rows:");
+        intro.list(flagged);
+    }
+    match &options.history {
+        None => {
+            intro.paragraph(
+                "Since the previous night: no history given (`cgdem validate --history DIR`, \
+                 as scripts/nightly.sh does).",
+            );
+        }
+        Some(dir) => {
+            let value = serde_json::to_value(summary).unwrap_or_default();
+            let (text, items) = super::history::since_previous(dir, &options.out, &value);
+            intro.paragraph(text);
+            if !items.is_empty() {
+                intro.list(items.into_iter().map(Cell::text).collect());
+            }
+        }
+    }
 }
 
 fn rule_name(rule: CoarseGrainRule) -> &'static str {
@@ -386,6 +607,27 @@ fn run_case(
         Some(_) if !case.rpms.is_empty() => case.rpms.iter().map(|&r| Some(r)).collect(),
         _ => vec![None],
     };
+    // Planted faults change cgdem's scene only; it keeps its name, so its runs are compared
+    // with the reference codes' runs of the unchanged case.
+    let faulted = if options.cgdem_faults.is_empty() {
+        None
+    } else {
+        let case_error = |message: String| ValidateError::Case {
+            file: case.file.clone(),
+            message,
+        };
+        let mut overrides = case.overrides.clone();
+        for f in &options.cgdem_faults {
+            overrides.push(
+                cgdem_core::scene::Override::parse(f, Path::new("--fault"))
+                    .map_err(|e| case_error(e.to_string()))?,
+            );
+        }
+        let mut s = super::suite::load_variant(&case.file, &overrides, case.variant.as_deref())
+            .map_err(|e| case_error(e.to_string()))?;
+        s.name = scene.name.clone();
+        Some(s)
+    };
     // Alternate the codes within each seed and speed, so machine drift hits all alike.
     let mut settings = Vec::new();
     for &rule in &case.cg_rules {
@@ -403,6 +645,10 @@ fn run_case(
         &settings,
         options.jobs,
         |&(rule, lambda, seed, rpm, code)| {
+            let scene = match (&faulted, code) {
+                (Some(f), Code::Cgdem) => f,
+                _ => scene,
+            };
             let mut dir = run_dir(&options.out, scene, code, lambda, rule, seed);
             let at_speed;
             let scene = match (rpm, &scene.conveying) {
@@ -795,96 +1041,153 @@ fn predicted_time_ratio(kind: &str, a: GroupKey, b: GroupKey) -> String {
 
 fn compare(scene: &Scene, case: &SuiteCase, runs: &[RunRecord]) -> Vec<Comparison> {
     let groups = angles_by_group(runs);
-    let stats: BTreeMap<GroupKey, (f64, f64)> = groups
-        .iter()
-        .filter_map(|(k, v)| mean_spread(v).map(|s| (*k, s)))
-        .collect();
     let flows = flows_by_group(scene, runs);
-    let mut keys: Vec<GroupKey> = stats.keys().chain(flows.keys()).copied().collect();
+    let mut keys: Vec<GroupKey> = groups.keys().chain(flows.keys()).copied().collect();
     keys.sort();
     keys.dedup();
     let box_length = scene.domain.hi.x - scene.domain.lo.x;
+    let known = |what: &str, criterion: &str| {
+        case.known_differences
+            .iter()
+            .find(|k| k.applies_to(what, criterion))
+    };
     let mut out = Vec::new();
     for (kind, a, b) in comparison_pairs(&keys) {
         let what = pair_name(kind, a, b);
-        if let (Some(&sa), Some(&sb)) = (stats.get(&a), stats.get(&b)) {
-            let difference = (sa.0 - sb.0).abs();
-            let combined_spread = (sa.1 * sa.1 + sb.1 * sb.1).sqrt();
-            let within_spread = difference <= combined_spread;
-            out.push(Comparison {
-                case: scene.name.clone(),
-                kind: kind.into(),
-                part: "final state".into(),
-                what: what.clone(),
-                detail: format!(
-                    "repose angle {:.1} +- {:.1} vs {:.1} +- {:.1} deg",
-                    sa.0, sa.1, sb.0, sb.1
+        let stats = |k| groups.get(&k).and_then(|v| mean_sd(v));
+        if let (Some((ma, sa, na)), Some((mb, sb, nb))) = (stats(a), stats(b)) {
+            let angle = Criterion::judge(
+                "repose angle",
+                "deg",
+                (ma - mb).abs(),
+                combined_standard_error((sa, na), (sb, nb)),
+                [na, nb],
+                case.angle_tolerance_deg,
+                known(&what, "repose angle"),
+            );
+            out.push(Comparison::judged(
+                &scene.name,
+                kind,
+                "final state",
+                &what,
+                format!(
+                    "repose angle {ma:.1} +- {sa:.1} ({na} seeds) vs {mb:.1} +- {sb:.1} ({nb} seeds) deg"
                 ),
-                difference,
-                combined_spread,
-                tolerance: case.angle_tolerance_deg,
-                within_spread,
-                pass: within_spread || difference <= case.angle_tolerance_deg,
-            });
+                vec![angle],
+            ));
         }
         if let (Some(fa), Some(fb)) = (flows.get(&a), flows.get(&b)) {
-            if let Some(c) = compare_flows(scene, case, kind, (a, fa), (b, fb), box_length) {
-                out.push(Comparison { what, ..c });
+            if let Some(c) = compare_flows(scene, case, kind, &what, (a, fa), (b, fb), box_length) {
+                out.push(c);
             }
         }
     }
     out
 }
 
-/// The dynamics part of a comparison: the ratio of the seeds' mean `t_half` (judged against
-/// 1 within `time_ratio_tolerance`, or within the combined relative spread) and the gap
-/// between the seed-mean front histories (within `front_tolerance` of the box length).
+/// The dynamics part of a comparison, four criteria: the ratio of the seeds' mean `t_half`
+/// (judged as |ratio - 1|), and the largest gaps between the seed-mean histories of the
+/// front (of the box length), the height at the remaining wall (of its initial height) and
+/// the kinetic energy (of its peak); each against its tolerance plus `K_NOISE` times the
+/// noise the seeds show.
 fn compare_flows(
     scene: &Scene,
     case: &SuiteCase,
     kind: &str,
+    what: &str,
     (a, fa): (GroupKey, &Vec<FlowSeries>),
     (b, fb): (GroupKey, &Vec<FlowSeries>),
     box_length: f64,
 ) -> Option<Comparison> {
     let ta: Vec<f64> = fa.iter().filter_map(FlowSeries::t_half).collect();
     let tb: Vec<f64> = fb.iter().filter_map(FlowSeries::t_half).collect();
-    let (ma, sa) = mean_spread(&ta)?;
-    let (mb, sb) = mean_spread(&tb)?;
-    let ratio = mb / ma;
-    let relative_spread = ratio * ((sa / ma).powi(2) + (sb / mb).powi(2)).sqrt();
-    let difference = (ratio - 1.0).abs();
-    let within_spread = difference <= relative_spread;
     let step = FLOW_GRID_S;
     let mean_a = FlowSeries::mean(fa, step)?;
     let mean_b = FlowSeries::mean(fb, step)?;
     let gap = flow_difference(&mean_a, &mean_b, box_length, step)?;
-    let front_ok = gap.front_max <= case.front_tolerance;
-    Some(Comparison {
-        case: scene.name.clone(),
-        kind: kind.into(),
-        part: "dynamics".into(),
-        what: String::new(),
-        detail: format!(
-            "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {}); \
-             front gap max {:.3}, mean {:.3} of the box length (tolerance {}); wall height gap \
-             max {:.3}, mean {:.3} of the initial height; kinetic energy gap max {:.3}, mean {:.3} \
-             of the peak",
-            predicted_time_ratio(kind, a, b),
+    let noise = flow_noise(fa, fb, box_length, step)?;
+    let seeds = [fa.len(), fb.len()];
+    let known = |criterion: &str| {
+        case.known_differences
+            .iter()
+            .find(|k| k.applies_to(what, criterion))
+    };
+    let mut criteria = Vec::new();
+    // t_half exists only where the front moved; without it on a side, the gaps still judge.
+    let t_half_text = match (mean_sd(&ta), mean_sd(&tb)) {
+        (Some((ma, sa, na)), Some((mb, sb, nb))) => {
+            let ratio = mb / ma;
+            // Standard error of the ratio from the relative standard errors of the means.
+            let ratio_noise = ratio * combined_standard_error((sa / ma, na), (sb / mb, nb));
+            criteria.push(Criterion::judge(
+                "t_half ratio",
+                "|ratio - 1|",
+                (ratio - 1.0).abs(),
+                ratio_noise,
+                [na, nb],
+                case.time_ratio_tolerance,
+                known("t_half ratio"),
+            ));
+            format!(
+                "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {})",
+                predicted_time_ratio(kind, a, b)
+            )
+        }
+        _ => format!(
+            "t_half not measured (the front did not move in {} of {} and {} of {} runs)",
+            fa.len() - ta.len(),
+            fa.len(),
+            fb.len() - tb.len(),
+            fb.len()
+        ),
+    };
+    criteria.extend([
+        Criterion::judge(
+            "front gap",
+            "of the box length",
+            gap.front_max,
+            noise.front,
+            seeds,
+            case.front_tolerance,
+            known("front gap"),
+        ),
+        Criterion::judge(
+            "wall height gap",
+            "of the initial height",
+            gap.wall_height_max,
+            noise.wall_height,
+            seeds,
+            case.wall_height_tolerance,
+            known("wall height gap"),
+        ),
+        Criterion::judge(
+            "kinetic energy gap",
+            "of the peak",
+            gap.kinetic_energy_max,
+            noise.kinetic_energy,
+            seeds,
+            case.kinetic_energy_tolerance,
+            known("kinetic energy gap"),
+        ),
+    ]);
+    Some(Comparison::judged(
+        &scene.name,
+        kind,
+        "dynamics",
+        what,
+        format!(
+            "{t_half_text}; gaps, largest over time (mean): front {:.3} ({:.3}) of the box \
+             length, wall height {:.3} ({:.3}) of the initial height, kinetic energy {:.3} \
+             ({:.3}) of the peak",
             gap.front_max,
             gap.front_mean,
-            case.front_tolerance,
             gap.wall_height_max,
             gap.wall_height_mean,
             gap.kinetic_energy_max,
             gap.kinetic_energy_mean,
         ),
-        difference,
-        combined_spread: relative_spread,
-        tolerance: case.time_ratio_tolerance,
-        within_spread,
-        pass: (within_spread || difference <= case.time_ratio_tolerance) && front_ok,
-    })
+        criteria,
+    ))
 }
 
 /// Spacing of the common time grid on which flow histories are averaged and compared.
@@ -1082,13 +1385,21 @@ fn write_similarity(
     let figure_error = |e: crate::report::PlotError| output_error(dir, e);
     let sub = section.subsection("Similarity: final state and dynamics");
     sub.paragraph(format!(
-        "A pair of codes or levels is similar only if both its final state (repose angle within \
-         {} deg or within the combined seed spread) and its dynamics agree: the characteristic \
-         time t_half (time for the front to cover half its largest advance after the gate \
-         opens, mean over seeds) in a ratio within 1 +- {} (or within the combined spread), and \
-         the seed-mean front histories within {} of the box length at all times. The predicted \
-         time ratios are derived in reference/COARSE_GRAINING.md.",
-        case.angle_tolerance_deg, case.time_ratio_tolerance, case.front_tolerance
+        "A pair of codes or levels is similar only if both its final state and its dynamics \
+         agree. Final state: the repose angles of the seed means within {} deg. Dynamics: the \
+         characteristic time t_half (time for the front to cover half its largest advance \
+         after the gate opens, mean over seeds) in a ratio within 1 +- {}; the seed-mean \
+         histories of the front within {} of the box length, of the height at the wall within \
+         {} of its initial height and of the kinetic energy within {} of its peak, at all \
+         times. Each tolerance is widened by {} combined standard errors of the seeds (the \
+         noise); declared known differences are judged by their bands. The predicted time \
+         ratios are derived in reference/COARSE_GRAINING.md.",
+        case.angle_tolerance_deg,
+        case.time_ratio_tolerance,
+        case.front_tolerance,
+        case.wall_height_tolerance,
+        case.kinetic_energy_tolerance,
+        super::verdict::K_NOISE
     ));
     let mut table = Table::new(["pair", "final state", "dynamics", "similar", "numbers"])
         .caption("Final-state and dynamic similarity, judged separately");
@@ -1101,8 +1412,16 @@ fn write_similarity(
                 .find(|c| c.what == what && c.part == name)
         };
         let verdict = |c: Option<&Comparison>| match c {
-            Some(c) if c.pass => Cell::pass("agrees"),
-            Some(_) => Cell::fail("differs"),
+            Some(c) => verdict_cell(
+                c.verdict,
+                match c.verdict {
+                    Verdict::Pass => "agrees".to_string(),
+                    Verdict::KnownDifference => {
+                        format!("known difference ({})", c.decided_by)
+                    }
+                    Verdict::Fail => format!("differs ({})", c.decided_by),
+                },
+            ),
             None => Cell::skipped("not measured"),
         };
         let (fs, dy) = (part("final state"), part("dynamics"));
@@ -1116,9 +1435,12 @@ fn write_similarity(
         let numbers = [fs, dy]
             .iter()
             .flatten()
-            .map(|c| c.detail.clone())
+            .map(|c| {
+                let parts: Vec<String> = c.criteria.iter().map(|x| x.describe()).collect();
+                format!("{}; {}", c.detail, parts.join("; "))
+            })
             .collect::<Vec<_>>()
-            .join("; ");
+            .join(". ");
         table.row([
             Cell::text(what),
             verdict(fs),
@@ -1254,8 +1576,138 @@ fn fixed_time_angles(dir: &Path) -> Vec<(f64, f64)> {
 
 #[cfg(test)]
 mod tests {
-    use super::run_concurrently;
+    use super::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A finished run of `code` and `seed` whose collapse front moves as `front(t)` and whose
+    /// final repose angle is `angle`, written to a temporary directory.
+    fn fake_run(
+        root: &Path,
+        code: Code,
+        seed: u64,
+        angle: f64,
+        front: impl Fn(f64) -> f64,
+    ) -> RunRecord {
+        let dir = root.join(format!("{}-{seed}", code.name()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut csv =
+            String::from("time_s,stage,front_m,wall_height_m,kinetic_energy_per_mass_j_kg\n");
+        for i in 0..=50 {
+            let t = i as f64 * 0.01;
+            let ke = (t * (0.6 - t)).max(1e-6);
+            csv += &format!(
+                "{},collapse,{},{},{ke}\n",
+                1.0 + t,
+                front(t),
+                0.135 - 0.2 * (front(t) - 0.1)
+            );
+        }
+        std::fs::write(dir.join("timeseries.csv"), csv).unwrap();
+        let mut r = RunRecord {
+            case: "aor_hertz_smoke".into(),
+            code,
+            lambda: 1,
+            cg_rule: CoarseGrainRule::Seed,
+            seed,
+            status: "ok".into(),
+            reason: None,
+            dir,
+            n_particles: None,
+            steps: None,
+            wall_s: None,
+            particle_steps_per_s: None,
+            repose_angle_deg: Some(angle),
+            repose_fit_r2: None,
+            runout_m: None,
+            reused: false,
+            partial: false,
+            rpm: None,
+            mass_flow_kg_s: None,
+            mass_flow_std_error_kg_s: None,
+            fill_ratio: None,
+            bulk_density_kg_m3: None,
+            eq7_mass_flow_kg_s: None,
+            ratio_to_eq7: None,
+        };
+        r.reused = true;
+        r
+    }
+
+    fn judge(extra: &str, lammps_front: f64, lammps_angle: f64) -> Vec<Comparison> {
+        crate::at_repo_root();
+        let root = std::env::temp_dir().join(format!(
+            "cgdem-verdicts-{}-{}",
+            std::process::id(),
+            lammps_front.to_bits() ^ lammps_angle.to_bits()
+        ));
+        let text = format!(
+            "name = \"t\"\n[[case]]\nfile = \"validation/cases/aor_hertz_smoke.toml\"\ncodes = [\"cgdem\", \"lammps\"]\nlambdas = [1]\nseeds = [1, 2]\nangle_tolerance_deg = 2.0\n{extra}"
+        );
+        let suite = Suite::parse(&text, Path::new("t.toml")).unwrap();
+        let case = &suite.cases[0];
+        let scene = case.load_scene().unwrap();
+        // Fronts advancing 0.2 m in 0.5 s; seeds 0.005 m apart; the box is 0.5 m long.
+        let runs = vec![
+            fake_run(&root, Code::Cgdem, 1, 14.0, |t| 0.1 + 0.4 * t),
+            fake_run(&root, Code::Cgdem, 2, 14.4, |t| 0.105 + 0.4 * t),
+            fake_run(&root, Code::Lammps, 1, lammps_angle, move |t| {
+                0.1 + 0.4 * t + lammps_front * t
+            }),
+            fake_run(&root, Code::Lammps, 2, lammps_angle + 0.4, move |t| {
+                0.105 + 0.4 * t + lammps_front * t
+            }),
+        ];
+        let out = compare(&scene, case, &runs);
+        let _ = std::fs::remove_dir_all(&root);
+        out
+    }
+
+    #[test]
+    fn the_same_runs_pass_and_a_shifted_front_fails_by_its_own_criterion() {
+        let same = judge("", 0.0, 14.0);
+        assert_eq!(same.len(), 2, "{same:?}");
+        assert!(same.iter().all(|c| c.verdict == Verdict::Pass), "{same:?}");
+        // The front runs 0.1 m further by the end: 0.2 of the box length.
+        let moved = judge("", 0.2, 14.0);
+        let dynamics = moved.iter().find(|c| c.part == "dynamics").unwrap();
+        assert_eq!(dynamics.verdict, Verdict::Fail);
+        let front = dynamics
+            .criteria
+            .iter()
+            .find(|c| c.name == "front gap")
+            .unwrap();
+        assert!((front.value - 0.2).abs() < 1e-9, "{front:?}");
+        // Seeds 0.005 m apart on both sides: noise sqrt(2 * 0.0025^2) / 0.5 of the box.
+        assert!(
+            (front.noise - 2f64.sqrt() * 0.0025 / 0.5).abs() < 1e-9,
+            "{front:?}"
+        );
+        assert!(dynamics.decided_by == "front gap" || dynamics.decided_by == "wall height gap");
+        let angle = moved.iter().find(|c| c.part == "final state").unwrap();
+        assert_eq!(angle.verdict, Verdict::Pass);
+    }
+
+    #[test]
+    fn a_declared_difference_is_amber_in_its_band_and_red_outside() {
+        let declared = "[[case.known_difference]]\ncomparison = \"cgdem vs lammps\"\ncriterion = \"repose angle\"\nreason = \"r\"\nevidence = \"reference/lammps/SEED_MODEL.md\"\nband = [5.0, 30.0]\n";
+        let inside = judge(declared, 0.0, 29.0);
+        let angle = inside.iter().find(|c| c.part == "final state").unwrap();
+        assert_eq!(angle.verdict, Verdict::KnownDifference, "{angle:?}");
+        assert!(angle.pass);
+        let outside = judge(declared, 0.0, 50.0);
+        let angle = outside.iter().find(|c| c.part == "final state").unwrap();
+        assert_eq!(angle.verdict, Verdict::Fail, "{angle:?}");
+        // Undeclared, 15 deg is a plain failure.
+        let plain = judge("", 0.0, 29.0);
+        assert_eq!(
+            plain
+                .iter()
+                .find(|c| c.part == "final state")
+                .unwrap()
+                .verdict,
+            Verdict::Fail
+        );
+    }
 
     #[test]
     fn concurrent_runs_take_every_item_once_and_keep_the_order() {

@@ -22,6 +22,13 @@ table.kv th{background:#f6f6f6;font-weight:600}
 td.pass{background:#d9f2d9;color:#145214}
 td.fail{background:#f8d4d4;color:#7a0f0f;font-weight:600}
 td.skipped{background:#e6e6e6;color:#555}
+td.known{background:#fde3a7;color:#6b4400;font-weight:600}
+p.banner{font-size:1.25em;font-weight:700;padding:.5em .8em;border-radius:4px}
+p.banner.pass{background:#d9f2d9;color:#145214}
+p.banner.fail{background:#f8d4d4;color:#7a0f0f}
+p.banner.known{background:#fde3a7;color:#6b4400}
+p.banner.skipped{background:#e6e6e6;color:#555}
+tr:target td{outline:2px solid #0072b2}
 td.num{text-align:right;font-variant-numeric:tabular-nums}
 figure{margin:1.2em 0}
 figure img{max-width:100%;height:auto;border:1px solid #ddd}
@@ -37,6 +44,8 @@ pub enum Status {
     Pass,
     Fail,
     Skipped,
+    /// A declared known difference inside its band (amber).
+    Known,
 }
 
 impl Status {
@@ -45,6 +54,7 @@ impl Status {
             Self::Pass => "pass",
             Self::Fail => "fail",
             Self::Skipped => "skipped",
+            Self::Known => "known",
         }
     }
 }
@@ -56,6 +66,8 @@ pub struct Cell {
     pub text: String,
     pub status: Option<Status>,
     pub numeric: bool,
+    /// A link target (`#row-id` on the same page, or a relative path).
+    pub href: Option<String>,
 }
 
 impl Cell {
@@ -64,6 +76,15 @@ impl Cell {
             text: text.into(),
             status: None,
             numeric: false,
+            href: None,
+        }
+    }
+
+    /// Text that links to `href` (`#id` of a row on the page, or a relative path).
+    pub fn link(text: impl Into<String>, href: impl Into<String>) -> Self {
+        Self {
+            href: Some(href.into()),
+            ..Self::text(text)
         }
     }
 
@@ -111,6 +132,8 @@ pub struct Table {
     pub caption: Option<String>,
     pub header: Vec<String>,
     pub rows: Vec<Vec<Cell>>,
+    /// Anchors of rows (`id` attribute), by row index, for links from elsewhere on the page.
+    pub row_ids: Vec<(usize, String)>,
 }
 
 impl Table {
@@ -119,6 +142,7 @@ impl Table {
             caption: None,
             header: header.into_iter().map(Into::into).collect(),
             rows: Vec::new(),
+            row_ids: Vec::new(),
         }
     }
 
@@ -130,6 +154,16 @@ impl Table {
     pub fn row<C: Into<Cell>>(&mut self, cells: impl IntoIterator<Item = C>) -> &mut Self {
         self.rows.push(cells.into_iter().map(Into::into).collect());
         self
+    }
+
+    /// A row that links can reach as `#id`.
+    pub fn row_with_id<C: Into<Cell>>(
+        &mut self,
+        id: impl Into<String>,
+        cells: impl IntoIterator<Item = C>,
+    ) -> &mut Self {
+        self.row_ids.push((self.rows.len(), id.into()));
+        self.row(cells)
     }
 }
 
@@ -146,6 +180,10 @@ struct EmbeddedFigure {
 #[derive(Clone, Debug, PartialEq)]
 enum Block {
     Paragraph(String),
+    /// A coloured one-line status, e.g. the night's verdict.
+    Banner(Status, String),
+    /// A bulleted list of cells (text or links).
+    List(Vec<Cell>),
     KeyValues(Option<String>, Vec<(String, String)>),
     Table(Table),
     Figure(EmbeddedFigure),
@@ -169,6 +207,18 @@ impl Section {
 
     pub fn paragraph(&mut self, text: impl Into<String>) -> &mut Self {
         self.blocks.push(Block::Paragraph(text.into()));
+        self
+    }
+
+    /// A coloured status line (green pass, amber known, red fail, grey skipped).
+    pub fn banner(&mut self, status: Status, text: impl Into<String>) -> &mut Self {
+        self.blocks.push(Block::Banner(status, text.into()));
+        self
+    }
+
+    /// A bulleted list; items may be links (`Cell::link`).
+    pub fn list(&mut self, items: Vec<Cell>) -> &mut Self {
+        self.blocks.push(Block::List(items));
         self
     }
 
@@ -344,6 +394,21 @@ impl Renderer<'_> {
                 Block::Paragraph(t) => {
                     let _ = writeln!(self.out, "<p>{}</p>", escape(t));
                 }
+                Block::Banner(status, t) => {
+                    let _ = writeln!(
+                        self.out,
+                        "<p class=\"banner {}\">{}</p>",
+                        status.class(),
+                        escape(t)
+                    );
+                }
+                Block::List(items) => {
+                    self.out.push_str("<ul>\n");
+                    for c in items {
+                        let _ = writeln!(self.out, "<li>{}</li>", cell_content(c));
+                    }
+                    self.out.push_str("</ul>\n");
+                }
                 Block::KeyValues(caption, rows) => {
                     self.out.push_str("<table class=\"kv\">\n");
                     if let Some(c) = caption {
@@ -384,8 +449,13 @@ impl Renderer<'_> {
             self.out.push_str("</tr></thead>\n");
         }
         self.out.push_str("<tbody>\n");
-        for row in &t.rows {
-            self.out.push_str("<tr>");
+        for (k, row) in t.rows.iter().enumerate() {
+            match t.row_ids.iter().find(|(i, _)| *i == k) {
+                Some((_, id)) => {
+                    let _ = write!(self.out, "<tr id=\"{}\">", escape(id));
+                }
+                None => self.out.push_str("<tr>"),
+            }
             for c in row {
                 let mut classes = Vec::new();
                 if let Some(s) = c.status {
@@ -395,13 +465,13 @@ impl Renderer<'_> {
                     classes.push("num");
                 }
                 if classes.is_empty() {
-                    let _ = write!(self.out, "<td>{}</td>", escape(&c.text));
+                    let _ = write!(self.out, "<td>{}</td>", cell_content(c));
                 } else {
                     let _ = write!(
                         self.out,
                         "<td class=\"{}\">{}</td>",
                         classes.join(" "),
-                        escape(&c.text)
+                        cell_content(c)
                     );
                 }
             }
@@ -425,6 +495,14 @@ impl Renderer<'_> {
             alt = escape(&f.alt),
             cap = escape(&f.caption),
         );
+    }
+}
+
+/// A cell's text, escaped, inside a link when it has one.
+fn cell_content(c: &Cell) -> String {
+    match &c.href {
+        Some(href) => format!("<a href=\"{}\">{}</a>", escape(href), escape(&c.text)),
+        None => escape(&c.text),
     }
 }
 
@@ -657,5 +735,27 @@ mod tests {
             PathBuf::from("../data/a.csv")
         );
         assert_eq!(url_path(Path::new("a b/c#1.csv")), "a%20b/c%231.csv");
+    }
+
+    #[test]
+    fn status_lines_links_and_row_anchors_render_escaped_and_balanced() {
+        let mut report = Report::new("t");
+        let intro = report.intro();
+        intro.banner(Status::Known, "Status: amber <1 known>");
+        intro.list(vec![
+            Cell::link("row \"1\"", "#comparison-1"),
+            Cell::text("a & b"),
+        ]);
+        let mut table = Table::new(["verdict"]);
+        table.row_with_id("comparison-1", [Cell::text("x").status(Status::Known)]);
+        table.row([Cell::fail("fail")]);
+        intro.table(table);
+        let html = report.render(Path::new("."));
+        assert_balanced(&html);
+        assert!(html.contains("<p class=\"banner known\">Status: amber &lt;1 known&gt;</p>"));
+        assert!(html.contains("<li><a href=\"#comparison-1\">row &quot;1&quot;</a></li>"));
+        assert!(html.contains("<tr id=\"comparison-1\"><td class=\"known\">x</td></tr>"));
+        assert!(html.contains("<tr><td class=\"fail\">fail</td></tr>"));
+        assert!(html.contains("td.known{"), "amber has its own colour");
     }
 }
