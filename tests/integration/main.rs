@@ -5,6 +5,7 @@
 mod bodies;
 mod cli;
 mod common;
+mod decomposition;
 #[path = "../support/golden.rs"]
 mod golden;
 mod guards;

@@ -8,6 +8,7 @@ pub mod analysis;
 pub mod bodies;
 pub mod coarse_graining;
 pub mod contact;
+pub mod decomposition;
 pub mod domain;
 pub mod geometry;
 pub mod guard;

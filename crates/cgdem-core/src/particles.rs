@@ -64,6 +64,41 @@ impl Particles {
         }
     }
 
+    /// Appends a copy of particle `k` of `src` (every per-particle array; spin state when
+    /// both have it): how a particle moves to another subdomain or becomes a ghost there.
+    pub fn push_copy(&mut self, src: &Particles, k: usize) {
+        self.id.push(src.id[k]);
+        self.species.push(src.species[k]);
+        self.position.push(src.position[k]);
+        self.velocity.push(src.velocity[k]);
+        self.force.push(src.force[k]);
+        self.radius.push(src.radius[k]);
+        self.mass.push(src.mass[k]);
+        self.inv_mass.push(src.inv_mass[k]);
+        if let (Some(to), Some(from)) = (&mut self.angular, &src.angular) {
+            to.omega.push(from.omega[k]);
+            to.torque.push(from.torque[k]);
+            to.inv_inertia.push(from.inv_inertia[k]);
+        }
+    }
+
+    /// Keeps the first `n` particles.
+    pub fn truncate(&mut self, n: usize) {
+        self.id.truncate(n);
+        self.species.truncate(n);
+        self.position.truncate(n);
+        self.velocity.truncate(n);
+        self.force.truncate(n);
+        self.radius.truncate(n);
+        self.mass.truncate(n);
+        self.inv_mass.truncate(n);
+        if let Some(a) = &mut self.angular {
+            a.omega.truncate(n);
+            a.torque.truncate(n);
+            a.inv_inertia.truncate(n);
+        }
+    }
+
     /// Fixes particle `k` in place (LIGGGHTS/LAMMPS `fix freeze`): zero inverse mass and
     /// inertia, so the integrator never moves it and its contacts see an infinite mass.
     pub fn freeze(&mut self, k: usize) {

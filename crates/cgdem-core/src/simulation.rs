@@ -11,7 +11,10 @@ pub use network::{ContactNetwork, PairContact};
 use rayon::prelude::*;
 
 use crate::bodies::{Body, BodyLoad, KinematicParticles};
+use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw, PairResult};
+use crate::decomposition::step::{Decomposition, Physics};
+use crate::decomposition::{choose_counts, Grid, GridSpec, HistoryRows};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
 use crate::guard::{
@@ -90,6 +93,9 @@ pub struct World<L: PairLaw, W: WallLaw> {
     old_force: Vec<Vec3>,
     old_torque: Vec<Vec3>,
     guard: GuardState,
+    /// Subdomains with ghosts (`--grid`); when set they hold the state, and `particles` is
+    /// their owned particles side by side, refreshed every step.
+    decomposition: Option<Box<Decomposition<L::History, W::History>>>,
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
@@ -143,6 +149,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 finite: true,
                 ..Default::default()
             },
+            decomposition: None,
         };
         world.rebuild();
         world.compute_forces();
@@ -238,11 +245,26 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             return;
         }
         let next = self.particles.id.iter().max().map_or(0, |&m| m + 1);
+        let decomposed = self.decomposition.take();
+        let rows = decomposed.as_ref().map(|d| d.gathered_rows());
+        if let Some(d) = &decomposed {
+            // The wall histories live in the subdomains between rebuilds.
+            (self.particles, self.wall_history) = d.gathered();
+        }
         for (n, &x) in positions.iter().enumerate() {
             self.particles.push(species, x, radius, mass);
             *self.particles.id.last_mut().expect("just pushed") = next + n as u32;
         }
-        self.rebuild();
+        match (decomposed, rows) {
+            (Some(d), Some(mut rows)) => {
+                // Dealt out again over the same cut planes (still thick enough).
+                for _ in 0..positions.len() {
+                    rows.push(&[]);
+                }
+                self.decompose(d.grid, rows);
+            }
+            _ => self.rebuild(),
+        }
         self.compute_forces();
         self.record_kinematic_loads();
         self.reset_energy_reference();
@@ -324,6 +346,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     pub fn list_builds(&self) -> u64 {
+        if let Some(d) = &self.decomposition {
+            return d.builds;
+        }
         self.list.builds
     }
 
@@ -390,6 +415,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// One velocity-Verlet step.
     fn step_verlet(&mut self) {
+        if self.decomposition.is_some() {
+            self.step_decomposed();
+            return;
+        }
         let dt = self.dt;
         // The list's displacement test runs inside the drift, unless bodies built of
         // particles move some particles after it: then it runs once they have moved.
@@ -543,6 +572,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// Every particle's force and torque: the owner pass, then the reactions.
     pub fn compute_forces(&mut self) {
+        if self.decomposition.is_some() {
+            self.decomposed_forces(false);
+            return;
+        }
         self.owner_pass();
         let (reactions, p) = self.reactions_and_particles();
         match p.angular.as_mut() {
@@ -664,6 +697,173 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         (self.walls.walls.len() + self.bodies.len()).max(1)
     }
 
+    /// Splits the world into the subdomains of `spec` (`--grid`): from now on each steps
+    /// its own particles and ghosts. Velocity Verlet with planar walls only so far.
+    pub fn set_grid(&mut self, spec: GridSpec) -> Result<(), String> {
+        let unsupported = if self.integrator != Integrator::VelocityVerlet {
+            Some("the pcvv integrator")
+        } else if !self.bodies.is_empty() || !self.kinematic.is_empty() {
+            Some("bodies")
+        } else if !self.delete_regions.is_empty() {
+            Some("delete regions")
+        } else {
+            None
+        };
+        if let Some(what) = unsupported {
+            return Err(format!(
+                "the decomposed step does not support {what} yet (supported: velocity Verlet, planar walls, gravity, insertion); run without --grid"
+            ));
+        }
+        let p = &self.particles;
+        let counts = match spec {
+            GridSpec::Given(counts) => counts,
+            GridSpec::Auto(count) => {
+                let mut extent = self.domain.length();
+                for a in 0..3 {
+                    let (lo, hi) = p
+                        .position
+                        .iter()
+                        .fold((Real::MAX, Real::MIN), |(lo, hi), x| {
+                            (lo.min(x[a]), hi.max(x[a]))
+                        });
+                    if !self.domain.periodic[a] && hi > lo {
+                        extent[a] = hi - lo;
+                    }
+                }
+                choose_counts(count, extent, self.domain.periodic)
+            }
+        };
+        let grid = Grid::balanced(counts, &self.domain, &p.position);
+        grid.check_width(self.ghost_width())?;
+        // Histories by partner id, in the pair's canonical orientation (lower id first).
+        let mut entries = Vec::new();
+        for (pair, &h) in self.list.pairs.iter().zip(&self.history) {
+            if h == L::History::default() {
+                continue;
+            }
+            let (i, j) = (pair.i, pair.j);
+            let (id_i, id_j) = (p.id[i as usize], p.id[j as usize]);
+            let h = if id_i < id_j { h } else { h.mirrored() };
+            entries.push((i, id_j, h));
+            entries.push((j, id_i, h));
+        }
+        let rows = HistoryRows::from_entries(p.len(), entries);
+        self.decompose(grid, rows);
+        self.list = VerletList::new(self.neighbor.skin);
+        self.history = Vec::new();
+        self.reaction_force = Vec::new();
+        self.reaction_spin = Vec::new();
+        Ok(())
+    }
+
+    /// The ghost layer: largest diameter plus the law's reach plus the skin.
+    fn ghost_width(&self) -> Real {
+        let max_radius = self.particles.radius.iter().cloned().fold(0.0, Real::max);
+        2.0 * max_radius + self.law.reach() + self.neighbor.skin
+    }
+
+    /// Deals the particles out over `grid` with their histories and evaluates the forces.
+    fn decompose(&mut self, grid: Grid, rows: HistoryRows<L::History>) {
+        let slots = self.wall_slots();
+        self.wall_history
+            .resize(self.particles.len() * slots, W::History::default());
+        let decomposition = Decomposition::new(
+            grid,
+            &self.particles,
+            &self.wall_history,
+            &rows,
+            &self.domain,
+            slots,
+            self.ghost_width(),
+            self.law.reach() + self.neighbor.skin,
+            self.neighbor.skin,
+        );
+        (self.particles, self.wall_history) = decomposition.gathered();
+        self.decomposition = Some(Box::new(decomposition));
+        self.decomposed_forces(false);
+    }
+
+    /// The subdomains' grid and particle counts, when decomposed.
+    pub fn decomposition(&self) -> Option<(&Grid, Vec<usize>)> {
+        self.decomposition
+            .as_ref()
+            .map(|d| (&d.grid, d.subdomains.iter().map(|s| s.n_owned).collect()))
+    }
+
+    /// One velocity-Verlet step of the subdomains: drift, then exchange and borders if a
+    /// particle moved past half the skin or forward otherwise, then forces and the kick.
+    fn step_decomposed(&mut self) {
+        let dt = self.dt;
+        let d = self.decomposition.as_mut().expect("decomposed");
+        if d.drift_kick(dt) {
+            self.rebuild_decomposed();
+        } else {
+            d.forward();
+        }
+        self.decomposed_forces(true);
+    }
+
+    /// Forces from the current ghosts (then the closing kick if `kick`), copied with the
+    /// state into `particles`; the guard's overlaps and finiteness.
+    fn decomposed_forces(&mut self, kick: bool) {
+        let d = self.decomposition.as_mut().expect("decomposed");
+        let physics = Physics {
+            law: &self.law,
+            wall_law: &self.wall_law,
+            walls: &self.walls,
+            gravity: self.gravity,
+            n_species: self.n_species,
+            dt: self.dt,
+            wall_slots: (self.walls.walls.len() + self.bodies.len()).max(1),
+            rotates: Self::ROTATES,
+        };
+        let (pairs, walls, finite) = d.forces(&physics, kick, &mut self.particles);
+        self.guard.pair_overlap = pairs;
+        self.guard.wall_overlap = walls;
+        if kick {
+            self.guard.finite = finite;
+        }
+    }
+
+    /// `rebuild` for the subdomains: the same removal of particles that left the box (and
+    /// its accounting), then exchange, borders and lists; `particles` is laid out again.
+    fn rebuild_decomposed(&mut self) {
+        let stop_on_lost = self.guard.settings.stop_on_lost;
+        let domain = self.domain.clone();
+        let keep = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
+        let origin = self.potential_origin();
+        let d = self.decomposition.as_mut().expect("decomposed");
+        for sub in &d.subdomains {
+            let p = &sub.particles;
+            for k in 0..sub.n_owned {
+                let x = p.position[k];
+                if stop_on_lost
+                    && x.is_finite()
+                    && !domain.contains_bounded(x)
+                    && self.guard.trip.is_none()
+                {
+                    self.guard.left_box.push((p.id[k], x, p.velocity[k]));
+                }
+                if keep(x) {
+                    continue;
+                }
+                self.lost += 1;
+                let e = 0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
+                    - p.mass[k] * self.gravity.dot(x - origin);
+                if e.is_finite() {
+                    self.guard.removed_energy += e;
+                } else {
+                    self.guard.removed_non_finite.push(p.id[k]);
+                }
+            }
+        }
+        let resort = self.neighbor.resort_every > 0
+            && d.builds.is_multiple_of(self.neighbor.resort_every as u64);
+        let slots = (self.walls.walls.len() + self.bodies.len()).max(1);
+        d.rebuild(&domain, slots, &keep, resort);
+        (self.particles, self.wall_history) = d.gathered();
+    }
+
     pub fn kinetic_energy(&self) -> Real {
         self.particles.kinetic_energy()
     }
@@ -695,6 +895,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Elastic energy stored in the listed pairs (the normal law's potential); walls and
     /// bodies are not counted. The list must be current (as after a rebuild).
     pub fn pair_elastic_energy(&self) -> Real {
+        if let Some(d) = &self.decomposition {
+            return d.pair_elastic_energy(&self.law, self.n_species);
+        }
         let p = &self.particles;
         let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
         self.list
@@ -763,6 +966,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.guard.trip = if !self.guard.finite || !self.guard.removed_non_finite.is_empty() {
             Some(self.diagnose_non_finite())
         } else if self.max_overlap_fraction() > s.max_overlap_fraction {
+            if self.decomposition.is_some() {
+                // The global list (unused while decomposed) names the pair.
+                let reach = self.law.reach();
+                self.list
+                    .build(&mut self.particles, &self.domain, reach, false);
+            }
             Some(self.diagnose_overlap())
         } else if !self.guard.left_box.is_empty() {
             let left = std::mem::take(&mut self.guard.left_box);
@@ -1066,14 +1275,14 @@ const OWNER_LEAF: usize = 256;
 
 /// The particle arrays the owner pass reads.
 #[derive(Clone, Copy)]
-struct ParticleState<'a> {
-    position: &'a [Vec3],
-    velocity: &'a [Vec3],
-    omega: Option<&'a [Vec3]>,
-    radius: &'a [Real],
-    mass: &'a [Real],
-    inv_mass: &'a [Real],
-    species: &'a [u16],
+pub(crate) struct ParticleState<'a> {
+    pub(crate) position: &'a [Vec3],
+    pub(crate) velocity: &'a [Vec3],
+    pub(crate) omega: Option<&'a [Vec3]>,
+    pub(crate) radius: &'a [Real],
+    pub(crate) mass: &'a [Real],
+    pub(crate) inv_mass: &'a [Real],
+    pub(crate) species: &'a [u16],
 }
 
 /// What the owner pass reads: the laws, the particles, the list, and what acts on one
@@ -1338,22 +1547,22 @@ impl Reactions<'_> {
 
 /// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
 #[derive(Clone, Copy)]
-struct Owner {
-    index: usize,
-    position: Vec3,
-    velocity: Vec3,
-    omega: Vec3,
-    radius: Real,
-    inv_mass: Real,
+pub(crate) struct Owner {
+    pub(crate) index: usize,
+    pub(crate) position: Vec3,
+    pub(crate) velocity: Vec3,
+    pub(crate) omega: Vec3,
+    pub(crate) radius: Real,
+    pub(crate) inv_mass: Real,
     /// `species_i * n_species`: the row of the species-pair tables.
-    species_row: usize,
+    pub(crate) species_row: usize,
 }
 
 /// The force of one listed pair `(i, j)` seen from its owner `i`; zero (and history reset)
 /// when out of range. Also returns the overlap and the smaller radius, for the guard.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn pair_force<L: PairLaw>(
+pub(crate) fn pair_force<L: PairLaw>(
     law: &L,
     p: &ParticleState,
     images: &[Vec3; 27],
@@ -1500,7 +1709,7 @@ fn body_force_and_torque<W: WallLaw>(
 /// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN
 /// handling, and a NaN state is the non-finite guard's business).
 #[inline(always)]
-fn larger(a: Real, b: Real) -> Real {
+pub(crate) fn larger(a: Real, b: Real) -> Real {
     if b > a {
         b
     } else {

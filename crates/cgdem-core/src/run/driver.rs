@@ -203,6 +203,11 @@ fn build_world<L: PairLaw, W: WallLaw>(
             .map(|&(min, max)| Aabb { min, max })
             .collect(),
     );
+    if let Some(spec) = options.grid {
+        world.set_grid(spec).map_err(|e| {
+            RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
+        })?;
+    }
     Ok((world, n_inserted, n_body_particles))
 }
 

@@ -53,6 +53,8 @@ pub struct RunOptions {
     /// Raised from outside (the command's SIGINT/SIGTERM handler): the run stops at the end of
     /// the current step, writes its outputs and returns [`RunError::Interrupted`].
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Split the box into these subdomains with ghost layers (`--grid`); None: one world.
+    pub grid: Option<crate::decomposition::GridSpec>,
 }
 
 #[derive(Debug, thiserror::Error)]

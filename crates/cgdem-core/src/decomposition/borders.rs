@@ -1,0 +1,193 @@
+//! `borders` (LAMMPS `Comm::borders`): at a list rebuild, after the exchange, each subdomain
+//! lists the owned particles its neighbours need as ghosts (those within `width` of the
+//! neighbour's bounds, through the periodic image that brings them there), and each
+//! subdomain appends its ghosts: full copies of the particles, positions shifted by the
+//! image. The lists stay until the next rebuild; `forward` refreshes the ghosts' state.
+
+use rayon::prelude::*;
+
+use super::{Grid, Subdomain};
+use crate::contact::PairHistory;
+use crate::math::{Real, Vec3};
+use crate::particles::Particles;
+
+/// Owned particles (by index) that subdomain `to` keeps as ghosts, seen with `shift` added.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SendList {
+    pub to: usize,
+    pub shift: Vec3,
+    pub indices: Vec<u32>,
+}
+
+/// First half: `sub`'s send lists for ghost layers of `width`, and the ghosts packed per list.
+pub fn pack<H: PairHistory, WH: PairHistory>(
+    sub: &mut Subdomain<H, WH>,
+    grid: &Grid,
+    width: Real,
+) -> Vec<(usize, Particles)> {
+    let rotation = sub.particles.angular.is_some();
+    let p = &sub.particles;
+    let mut sends = Vec::new();
+    let mut packed = Vec::new();
+    for (to, shift) in grid.neighbours(sub.index) {
+        let (lo, hi) = grid.bounds(to);
+        let (lo, hi) = (lo - Vec3::splat(width), hi + Vec3::splat(width));
+        let mut ghosts = Particles::new(rotation);
+        let indices: Vec<u32> = (0..sub.n_owned)
+            .filter(|&k| {
+                let x = p.position[k] + shift;
+                x.cmpge(lo).all() && x.cmple(hi).all()
+            })
+            .map(|k| {
+                ghosts.push_copy(p, k);
+                *ghosts.position.last_mut().expect("just pushed") += shift;
+                k as u32
+            })
+            .collect();
+        if !indices.is_empty() {
+            sends.push(SendList { to, shift, indices });
+            packed.push((to, ghosts));
+        }
+    }
+    sub.sends = sends;
+    packed
+}
+
+/// Second half: appends to `sub` the ghosts every subdomain packed for it, in subdomain
+/// then list order, and records where they came from for `forward`.
+pub fn unpack<H: PairHistory, WH: PairHistory>(
+    sub: &mut Subdomain<H, WH>,
+    packed: &[Vec<(usize, Particles)>],
+) {
+    sub.particles.truncate(sub.n_owned);
+    sub.receives.clear();
+    for (from, lists) in packed.iter().enumerate() {
+        for (list, (to, ghosts)) in lists.iter().enumerate() {
+            if *to != sub.index {
+                continue;
+            }
+            for k in 0..ghosts.len() {
+                sub.particles.push_copy(ghosts, k);
+            }
+            sub.receives.push((from, list));
+        }
+    }
+}
+
+/// Both halves over all subdomains.
+pub fn borders<H: PairHistory, WH: PairHistory>(
+    subs: &mut [Subdomain<H, WH>],
+    grid: &Grid,
+    width: Real,
+) {
+    let packed: Vec<Vec<(usize, Particles)>> = subs
+        .par_iter_mut()
+        .map(|sub| pack(sub, grid, width))
+        .collect();
+    subs.par_iter_mut().for_each(|sub| unpack(sub, &packed));
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::decomposition::exchange::exchange;
+    use crate::domain::Domain;
+    use rand::{Rng, SeedableRng};
+
+    /// `n` particles spread over `domain`, dealt into the subdomains of `counts` by exchange.
+    pub(crate) fn decomposed(
+        domain: &Domain,
+        counts: [usize; 3],
+        n: usize,
+        seed: u64,
+    ) -> (Particles, Grid, Vec<Subdomain<(), ()>>) {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let mut p = Particles::new(false);
+        for _ in 0..n {
+            let u = Vec3::new(rng.gen(), rng.gen(), rng.gen());
+            let r = rng.gen_range(0.01..=0.03);
+            p.push(0, domain.lo + u * domain.length(), r, 1.0);
+        }
+        let grid = Grid::balanced(counts, domain, &p.position);
+        let mut subs: Vec<Subdomain<(), ()>> = (0..grid.len())
+            .map(|s| Subdomain::new(s, &grid, false))
+            .collect();
+        for k in 0..p.len() {
+            subs[0].particles.push_copy(&p, k);
+            subs[0].wall_history.push(());
+            subs[0].rows.push(&[]);
+        }
+        subs[0].n_owned = p.len();
+        exchange(&mut subs, &grid, domain, 1, &|_| true);
+        (p, grid, subs)
+    }
+
+    /// Every (id, image position) within `width` of subdomain `t`'s bounds, over the images
+    /// -1, 0, 1 of every periodic axis, except `t`'s own particles unshifted.
+    fn brute_force_ghosts(
+        p: &Particles,
+        domain: &Domain,
+        grid: &Grid,
+        t: usize,
+        width: Real,
+    ) -> Vec<(u32, [u64; 3])> {
+        let (lo, hi) = grid.bounds(t);
+        let (lo, hi) = (lo - Vec3::splat(width), hi + Vec3::splat(width));
+        let mut found = Vec::new();
+        let range = |a: usize| if domain.periodic[a] { -1..=1 } else { 0..=0 };
+        for k in 0..p.len() {
+            let x0 = domain.wrap(p.position[k]);
+            for a in range(0) {
+                for b in range(1) {
+                    for c in range(2) {
+                        let shift = Vec3::new(a as Real, b as Real, c as Real) * domain.length();
+                        let x = x0 + shift;
+                        let own = shift == Vec3::ZERO && grid.owner(x0) == t;
+                        if !own && x.cmpge(lo).all() && x.cmple(hi).all() {
+                            found.push((p.id[k], x.to_array().map(Real::to_bits)));
+                        }
+                    }
+                }
+            }
+        }
+        found.sort_unstable();
+        found
+    }
+
+    #[test]
+    fn ghosts_equal_the_brute_force_layer_with_periodic_images() {
+        let cases = [
+            ([true, false, true], [2, 2, 1]),
+            ([true; 3], [1, 2, 3]),
+            ([false; 3], [3, 1, 1]),
+            ([true, true, false], [2, 1, 1]),
+        ];
+        for (periodic, counts) in cases {
+            let domain = Domain {
+                lo: Vec3::new(-0.2, 0.1, 0.0),
+                hi: Vec3::new(0.8, 0.9, 0.9),
+                periodic,
+            };
+            let width = 0.1;
+            let (p, grid, mut subs) = decomposed(&domain, counts, 600, 3);
+            grid.check_width(width).unwrap();
+            borders(&mut subs, &grid, width);
+            for sub in &subs {
+                let mut ghosts: Vec<(u32, [u64; 3])> = (sub.n_owned..sub.particles.len())
+                    .map(|k| {
+                        let x = sub.particles.position[k];
+                        (sub.particles.id[k], x.to_array().map(Real::to_bits))
+                    })
+                    .collect();
+                ghosts.sort_unstable();
+                let expected = brute_force_ghosts(&p, &domain, &grid, sub.index, width);
+                assert!(!expected.is_empty());
+                assert_eq!(
+                    ghosts, expected,
+                    "{periodic:?} {counts:?} sub {}",
+                    sub.index
+                );
+            }
+        }
+    }
+}

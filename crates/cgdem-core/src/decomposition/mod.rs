@@ -1,0 +1,138 @@
+//! Spatial domain decomposition (LAMMPS `Comm`, comm_brick.cpp): the box is cut into a grid
+//! of subdomains, each owning the particles inside it in its own arrays, plus a layer of
+//! ghost copies of its neighbours' particles, `width` = largest diameter + contact reach +
+//! skin thick. Four phases, one file each:
+//!
+//! - [`grid`]: the subdomain grid and its cut planes (by particle count);
+//! - [`exchange`]: at a list rebuild, particles that left their subdomain move to the new
+//!   owner with every per-particle array that must travel (wall history, contact history
+//!   rows);
+//! - [`borders`]: at a list rebuild, which owned particles each neighbour needs as ghosts
+//!   (periodic faces through shifted images);
+//! - [`forward`]: every step, the ghosts' positions, velocities and spins.
+//!
+//! Pairs that cross a boundary are evaluated by both owners (newton off, as LIGGGHTS's
+//! granular pair styles), so no forces travel back; each pair is evaluated with the particle
+//! of lower id first, so both sides compute the same numbers and keep the same history.
+//! Each phase packs what travels into buffers and unpacks them on the other side: the
+//! threads here share memory, an MPI transport would send the same buffers.
+
+pub mod borders;
+pub mod exchange;
+pub mod forward;
+pub mod grid;
+pub mod list;
+pub mod step;
+
+pub use grid::{choose_counts, Grid, GridSpec};
+
+use crate::contact::PairHistory;
+use crate::math::Vec3;
+use crate::particles::Particles;
+
+/// Per owned particle, the contact histories of its pairs keyed by the partner's id (LAMMPS
+/// `fix neigh/history`'s partner lists, kept with both particles of a pair when newton is
+/// off): they travel with the particle in an exchange and seed the new list's histories.
+/// Histories are in the pair's canonical orientation (lower id first), so both copies are
+/// equal and never mirrored.
+#[derive(Clone, Debug)]
+pub struct HistoryRows<H> {
+    /// Rows of particle `k` are `rows[start[k]..start[k + 1]]`, sorted by partner id.
+    pub start: Vec<u32>,
+    pub rows: Vec<(u32, H)>,
+}
+
+impl<H> Default for HistoryRows<H> {
+    fn default() -> Self {
+        HistoryRows {
+            start: vec![0],
+            rows: Vec::new(),
+        }
+    }
+}
+
+impl<H: PairHistory> HistoryRows<H> {
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn of(&self, k: usize) -> &[(u32, H)] {
+        &self.rows[self.start[k] as usize..self.start[k + 1] as usize]
+    }
+
+    /// Appends a particle with `rows` (sorted by partner id).
+    pub fn push(&mut self, rows: &[(u32, H)]) {
+        self.rows.extend_from_slice(rows);
+        self.start.push(self.rows.len() as u32);
+    }
+
+    /// The history of the pair with `partner`, if the particle has one.
+    pub fn find(&self, k: usize, partner: u32) -> Option<H> {
+        let rows = self.of(k);
+        rows.binary_search_by_key(&partner, |r| r.0)
+            .ok()
+            .map(|at| rows[at].1)
+    }
+
+    /// Rows from per-particle lists of `(particle, partner, history)`, `n` particles.
+    pub fn from_entries(n: usize, mut entries: Vec<(u32, u32, H)>) -> Self {
+        entries.sort_unstable_by_key(|e| (e.0, e.1));
+        let mut start = vec![0u32; n + 1];
+        for e in &entries {
+            start[e.0 as usize + 1] += 1;
+        }
+        for k in 0..n {
+            start[k + 1] += start[k];
+        }
+        HistoryRows {
+            start,
+            rows: entries.into_iter().map(|e| (e.1, e.2)).collect(),
+        }
+    }
+}
+
+/// One subdomain: its bounds, its owned particles (first `n_owned` entries of `particles`)
+/// followed by its ghosts, and what it needs to rebuild and step.
+#[derive(Clone, Debug)]
+pub struct Subdomain<H, WH> {
+    pub index: usize,
+    pub lo: Vec3,
+    pub hi: Vec3,
+    pub particles: Particles,
+    pub n_owned: usize,
+    /// Per owned particle, `wall_slots` wall-contact histories (particle-major).
+    pub wall_history: Vec<WH>,
+    /// Contact histories by partner, valid from the exchange to the list build.
+    pub rows: HistoryRows<H>,
+    /// Owned particles each neighbour keeps as ghosts (built by `borders`).
+    pub sends: Vec<borders::SendList>,
+    /// The send lists this subdomain's ghosts come from, in ghost order: (subdomain, list).
+    pub receives: Vec<(usize, usize)>,
+    pub list: list::LocalList<H>,
+}
+
+impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
+    pub fn new(index: usize, grid: &Grid, with_rotation: bool) -> Self {
+        let (lo, hi) = grid.bounds(index);
+        Subdomain {
+            index,
+            lo,
+            hi,
+            particles: Particles::new(with_rotation),
+            n_owned: 0,
+            wall_history: Vec::new(),
+            rows: HistoryRows::default(),
+            sends: Vec::new(),
+            receives: Vec::new(),
+            list: list::LocalList::default(),
+        }
+    }
+
+    pub fn ghosts(&self) -> usize {
+        self.particles.len() - self.n_owned
+    }
+}
