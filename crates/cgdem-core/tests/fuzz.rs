@@ -3,36 +3,19 @@
 //! `cargo test` runs a few cases (64 per parser); `scripts/fuzz.sh` sets PROPTEST_CASES.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 
 use cgdem_core::geometry::stl::{stl_from_bytes, stl_unchecked_from_bytes};
 use cgdem_core::scene::Scene;
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+
+#[path = "../../../tests/support/fuzz_cases.rs"]
+mod fuzz_cases;
+use fuzz_cases::{config, counted};
 
 const SCENE: &str = include_str!("../../../tests/data/tiny_hertz_collapse.toml");
 const SCENE_FILE: &str = "fuzz/scene.toml";
 const STL_FILE: &str = "fuzz/body.stl";
-
-fn config() -> Config {
-    let cases = std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(64);
-    Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
-/// Counts the cases each parser ran; printed for `scripts/fuzz.sh`.
-fn counted(counter: &AtomicU64, name: &str) {
-    let n = counter.fetch_add(1, Ordering::Relaxed) + 1;
-    if n == u64::from(config().cases) {
-        println!("FUZZ | {name} | {n} cases | 0 panics");
-    }
-}
 
 /// A scene error names the file, and a field (`field \`...\``) or a line (TOML syntax).
 fn check_scene(text: &str) {

@@ -4,36 +4,20 @@
 //! `cargo test` runs a few cases (64 per parser); `scripts/fuzz.sh` sets PROPTEST_CASES.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 
 use cgdem_harness::history::{flags, night_metrics, parse_history};
 use cgdem_harness::lammps::dump::parse_dump;
 use cgdem_harness::lammps::postprocess::log_timing;
 use cgdem_harness::stability::LogFindings;
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+
+#[path = "../../../tests/support/fuzz_cases.rs"]
+mod fuzz_cases;
+use fuzz_cases::{config, counted};
 
 const DUMP_FILE: &str = "fuzz/traj.dump";
 const HISTORY_FILE: &str = "fuzz/history.json";
-
-fn config() -> Config {
-    let cases = std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(64);
-    Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
-fn counted(counter: &AtomicU64, name: &str) {
-    let n = counter.fetch_add(1, Ordering::Relaxed) + 1;
-    if n == u64::from(config().cases) {
-        println!("FUZZ | {name} | {n} cases | 0 panics");
-    }
-}
 
 static DUMP_ANY: AtomicU64 = AtomicU64::new(0);
 static DUMP_MUTATED: AtomicU64 = AtomicU64::new(0);
