@@ -63,6 +63,45 @@ pub struct RunRecord {
     pub ratio_to_eq7: Option<f64>,
 }
 
+impl RunRecord {
+    /// A run that has not failed, with nothing measured yet.
+    pub fn ok(
+        case: String,
+        code: Code,
+        lambda: u32,
+        cg_rule: CoarseGrainRule,
+        seed: u64,
+        dir: PathBuf,
+    ) -> RunRecord {
+        RunRecord {
+            case,
+            code,
+            lambda,
+            cg_rule,
+            seed,
+            status: "ok".into(),
+            reason: None,
+            dir,
+            n_particles: None,
+            steps: None,
+            wall_s: None,
+            particle_steps_per_s: None,
+            repose_angle_deg: None,
+            repose_fit_r2: None,
+            runout_m: None,
+            reused: false,
+            partial: false,
+            rpm: None,
+            mass_flow_kg_s: None,
+            mass_flow_std_error_kg_s: None,
+            fill_ratio: None,
+            bulk_density_kg_m3: None,
+            eq7_mass_flow_kg_s: None,
+            ratio_to_eq7: None,
+        }
+    }
+}
+
 /// One judged comparison: a pair of codes or levels, one part (final state or dynamics),
 /// judged by its criteria (`verdict::Criterion`), each with its value, noise, threshold
 /// and verdict; the comparison's verdict is its worst criterion's, named in `decided_by`.
@@ -746,32 +785,14 @@ pub(super) fn run_one(
     dir: &Path,
     options: &ValidateOptions,
 ) -> RunRecord {
-    let mut record = RunRecord {
-        case: scene.name.clone(),
+    let mut record = RunRecord::ok(
+        scene.name.clone(),
         code,
         lambda,
-        cg_rule: rule,
+        rule,
         seed,
-        status: "ok".into(),
-        reason: None,
-        dir: dir.to_path_buf(),
-        n_particles: None,
-        steps: None,
-        wall_s: None,
-        particle_steps_per_s: None,
-        repose_angle_deg: None,
-        repose_fit_r2: None,
-        runout_m: None,
-        reused: false,
-        partial: false,
-        rpm: None,
-        mass_flow_kg_s: None,
-        mass_flow_std_error_kg_s: None,
-        fill_ratio: None,
-        bulk_density_kg_m3: None,
-        eq7_mass_flow_kg_s: None,
-        ratio_to_eq7: None,
-    };
+        dir.to_path_buf(),
+    );
     let outcome = match code {
         Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
         Code::Lammps | Code::Liggghts => {
@@ -1609,32 +1630,15 @@ mod tests {
             );
         }
         std::fs::write(dir.join("timeseries.csv"), csv).unwrap();
-        let mut r = RunRecord {
-            case: "aor_hertz_smoke".into(),
+        let mut r = RunRecord::ok(
+            "aor_hertz_smoke".into(),
             code,
-            lambda: 1,
-            cg_rule: CoarseGrainRule::Seed,
+            1,
+            CoarseGrainRule::Seed,
             seed,
-            status: "ok".into(),
-            reason: None,
             dir,
-            n_particles: None,
-            steps: None,
-            wall_s: None,
-            particle_steps_per_s: None,
-            repose_angle_deg: Some(angle),
-            repose_fit_r2: None,
-            runout_m: None,
-            reused: false,
-            partial: false,
-            rpm: None,
-            mass_flow_kg_s: None,
-            mass_flow_std_error_kg_s: None,
-            fill_ratio: None,
-            bulk_density_kg_m3: None,
-            eq7_mass_flow_kg_s: None,
-            ratio_to_eq7: None,
-        };
+        );
+        r.repose_angle_deg = Some(angle);
         r.reused = true;
         r
     }
