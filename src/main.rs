@@ -541,7 +541,11 @@ fn main() -> ExitCode {
                         .iter()
                         .filter(|c| c.verdict == cgdem_harness::verdict::Verdict::KnownDifference)
                         .count();
-                    let runs_failed = summary.runs.iter().filter(|r| r.status == "failed").count();
+                    let runs_failed = summary
+                        .runs
+                        .iter()
+                        .filter(|r| r.status == cgdem_harness::validate::Outcome::Failed)
+                        .count();
                     let mut extra = String::new();
                     if let Some(accuracy) = &summary.accuracy {
                         extra += &format!(", {} accuracy points", accuracy.points.len());
@@ -569,7 +573,7 @@ fn main() -> ExitCode {
                         summary.suite,
                         summary.runs.len(),
                         runs_failed,
-                        summary.runs.iter().filter(|r| r.status == "skipped").count(),
+                        summary.runs.iter().filter(|r| r.status == cgdem_harness::validate::Outcome::Skipped).count(),
                         summary.comparisons.len(),
                         failed,
                         out.join("index.html").display()

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
 use cgdem_core::run;
-use cgdem_core::scene::{Scene, StageEnd};
+use cgdem_core::scene::{ContactSettings, Scene, StageEnd};
 use cgdem_core::simulation::{NeighborSettings, World};
 use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
 
@@ -83,7 +83,10 @@ fn particles(scene: &Scene, states: &[(Vec3, Vec3)]) -> Particles {
 }
 
 fn run_cgdem(scene: &Scene, initial: &Particles, dt: Real, steps: u64) -> Trajectory {
-    let (law, wall_law) = run::seed_laws(scene);
+    let ContactSettings::Wca(wca) = &scene.contact else {
+        panic!("the seed golden cases use the WCA model")
+    };
+    let (law, wall_law) = run::seed_laws(scene, wca);
     let neighbor = NeighborSettings {
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: 0,

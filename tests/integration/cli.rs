@@ -3,6 +3,8 @@
 
 use std::process::Command;
 
+use cgdem_harness::csv_table::CsvTable;
+
 fn cgdem() -> Command {
     Command::new(env!("CARGO_BIN_EXE_cgdem"))
 }
@@ -230,10 +232,9 @@ fn a_small_diameter_sweep_packs_a_coarse_bed_and_writes_its_tables() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    let table = std::fs::read_to_string(dir.join("out/porosity_vs_diameter.csv")).unwrap();
-    let row: Vec<&str> = table.lines().nth(1).unwrap().split(',').collect();
-    let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
-    let column = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+    let table = CsvTable::read(&dir.join("out/porosity_vs_diameter.csv")).unwrap();
+    let row = table.rows().next().unwrap();
+    let column = |name: &str| row.text(table.column(name).unwrap()).unwrap();
     let porosity: f64 = column("porosity").parse().unwrap();
     assert!((0.35..0.45).contains(&porosity), "porosity {porosity}");
     assert_eq!(column("settled"), "true");

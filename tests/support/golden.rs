@@ -12,6 +12,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Mutex;
 
+use cgdem_core::io::CsvBuffer;
+use cgdem_harness::csv_table::CsvTable;
+
 /// Live reference numbers must match the stored ones to this relative difference: the same
 /// version built elsewhere may round differently in the last digits, not in the sixth.
 pub const LIVE_TOLERANCE: f64 = 1e-6;
@@ -35,35 +38,37 @@ pub fn blessing() -> bool {
 }
 
 fn parse(path: &std::path::Path, text: &str) -> (Vec<String>, BTreeMap<Key, f64>) {
-    let mut comments = Vec::new();
+    // The comments are kept for blessing; the rows are read as CSV by the harness's reader.
+    let comments = text
+        .lines()
+        .filter(|l| l.starts_with('#'))
+        .map(String::from)
+        .collect();
+    let table = CsvTable::parse(path, text.as_bytes()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        table.header(),
+        ["case", "quantity", "code", "value"],
+        "{}: header",
+        path.display()
+    );
+    let column = |name: &str| table.column(name).unwrap_or_else(|e| panic!("{e}"));
+    let (case, quantity, code, value) = (
+        column("case"),
+        column("quantity"),
+        column("code"),
+        column("value"),
+    );
     let mut rows = BTreeMap::new();
-    let mut header_seen = false;
-    for (k, line) in text.lines().enumerate() {
-        let at = || format!("{}:{}", path.display(), k + 1);
-        if line.starts_with('#') {
-            comments.push(line.to_string());
-            continue;
-        }
-        if line.trim().is_empty() {
-            continue;
-        }
-        if !header_seen {
-            assert_eq!(line, "case,quantity,code,value", "{}: header", at());
-            header_seen = true;
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').collect();
-        assert_eq!(
-            fields.len(),
-            4,
-            "{}: expected case,quantity,code,value",
-            at()
+    for row in table.rows() {
+        let text = |c| row.text(c).unwrap_or_else(|e| panic!("{e}")).to_string();
+        let key = (text(case), text(quantity), text(code));
+        let value: f64 = row.parse(value).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            rows.insert(key, value).is_none(),
+            "{}:{}: duplicate row",
+            path.display(),
+            row.line()
         );
-        let value: f64 = fields[3]
-            .parse()
-            .unwrap_or_else(|e| panic!("{}: value {:?}: {e}", at(), fields[3]));
-        let key = (fields[0].into(), fields[1].into(), fields[2].into());
-        assert!(rows.insert(key, value).is_none(), "{}: duplicate row", at());
     }
     (comments, rows)
 }
@@ -153,11 +158,17 @@ impl GoldenFile {
             if !text.is_empty() {
                 text.push('\n');
             }
-            text.push_str("case,quantity,code,value\n");
+            let mut table = CsvBuffer::new(["case", "quantity", "code", "value"]);
             for ((case, quantity, code), value) in &rows {
                 // `{:e}` is the shortest form that reads back to the same f64.
-                text.push_str(&format!("{case},{quantity},{code},{value:e}\n"));
+                table.row([
+                    case.clone(),
+                    quantity.clone(),
+                    code.clone(),
+                    format!("{value:e}"),
+                ]);
             }
+            text.push_str(std::str::from_utf8(table.bytes().unwrap()).unwrap());
             std::fs::create_dir_all(self.path.parent().unwrap()).unwrap();
             std::fs::write(&self.path, text).unwrap();
             println!("blessed {} ({} rows)", self.path.display(), self.live.len());

@@ -14,7 +14,7 @@
 pub use crate::scene::CoarseGrainRule;
 use crate::scene::{
     CohesionKind, ContactSettings, HertzDampingKind, HertzSettings, InsertAmount, RollingKind,
-    Scene,
+    Scene, WcaSettings,
 };
 use crate::timestep::TimeStepRequest;
 
@@ -112,17 +112,12 @@ pub fn coarse_grain_by(
         s.diameter *= l;
     }
     out.contact = match &scene.contact {
-        ContactSettings::Wca {
-            epsilon,
-            sigma,
-            gamma_n,
-            gamma_t,
-        } => ContactSettings::Wca {
-            epsilon: *epsilon * l.powi(energy),
-            sigma: *sigma * l,
-            gamma_n: *gamma_n * l.powi(damping),
-            gamma_t: *gamma_t * l.powi(damping),
-        },
+        ContactSettings::Wca(w) => ContactSettings::Wca(WcaSettings {
+            epsilon: w.epsilon * l.powi(energy),
+            sigma: w.sigma * l,
+            gamma_n: w.gamma_n * l.powi(damping),
+            gamma_t: w.gamma_t * l.powi(damping),
+        }),
         ContactSettings::Hertz(_) if rule != CoarseGrainRule::Seed => {
             return Err(CoarseGrainError::RuleNotDefined(rule));
         }
@@ -177,17 +172,15 @@ mod tests {
 
     /// (stiffness, effective mass, damping) of the particle-particle contact.
     fn linear_pair(scene: &Scene) -> (f64, f64, f64) {
-        let ContactSettings::Wca {
-            epsilon,
-            sigma,
-            gamma_n,
-            ..
-        } = scene.contact
-        else {
+        let ContactSettings::Wca(w) = scene.contact else {
             panic!("the collapse case uses the WCA model")
         };
-        let k = WcaCoefficients { epsilon, sigma }.contact_stiffness();
-        (k, 0.5 * scene.species[0].mass(), gamma_n)
+        let k = WcaCoefficients {
+            epsilon: w.epsilon,
+            sigma: w.sigma,
+        }
+        .contact_stiffness();
+        (k, 0.5 * scene.species[0].mass(), w.gamma_n)
     }
 
     #[test]

@@ -135,6 +135,19 @@ impl Particles {
         rotating
     }
 
+    /// Reorders rows of `slots` values per particle (wall and body contact histories) as
+    /// [`Particles::permute`] reorders the particles: new row `k` is old row `order[k]`.
+    pub fn permute_rows<T: Copy>(rows: &[T], order: &[u32], slots: usize) -> Vec<T> {
+        order
+            .iter()
+            .flat_map(|&o| {
+                rows[o as usize * slots..(o as usize + 1) * slots]
+                    .iter()
+                    .copied()
+            })
+            .collect()
+    }
+
     /// Reorders every per-particle array: new index `k` holds old particle `order[k]`.
     pub fn permute(&mut self, order: &[u32]) {
         fn apply<T: Copy>(values: &mut Vec<T>, order: &[u32]) {

@@ -536,15 +536,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             // The wall history follows its particles.
             let slots = self.wall_slots();
             if self.wall_history.len() == order.len() * slots {
-                let old = std::mem::take(&mut self.wall_history);
-                self.wall_history = order
-                    .iter()
-                    .flat_map(|&o| {
-                        old[o as usize * slots..(o as usize + 1) * slots]
-                            .iter()
-                            .copied()
-                    })
-                    .collect();
+                self.wall_history = Particles::permute_rows(&self.wall_history, &order, slots);
             }
             // Compose: old index -> (after removal) -> after re-sort.
             let mut sorted_index = vec![0u32; order.len()];
@@ -620,33 +612,16 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         let n_bodies = self.bodies.len();
         self.body_loads.resize(n * n_bodies, BodyLoad::default());
-        let Particles {
-            position,
-            velocity,
+        let ForceView {
+            state,
             force,
-            radius,
-            mass,
-            inv_mass,
-            species,
-            angular,
+            torque,
             ..
-        } = &mut self.particles;
-        let (omega, torque) = match angular.as_mut() {
-            Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
-            None => (None, &mut [][..]),
-        };
+        } = ParticleState::split(&mut self.particles);
         let pass = OwnerPass {
             law: &self.law,
             wall_law: &self.wall_law,
-            state: ParticleState {
-                position,
-                velocity,
-                omega,
-                radius,
-                mass,
-                inv_mass,
-                species,
-            },
+            state,
             images: std::array::from_fn(|k| self.domain.image_shift(k as u8)),
             n_species: self.n_species,
             dt: self.dt,
@@ -1283,6 +1258,63 @@ pub(crate) struct ParticleState<'a> {
     pub(crate) mass: &'a [Real],
     pub(crate) inv_mass: &'a [Real],
     pub(crate) species: &'a [u16],
+}
+
+/// What a force pass borrows from the particles at once: the state it reads, the force and
+/// torque arrays it writes (torque empty without rotation), and the ids.
+pub(crate) struct ForceView<'a> {
+    pub(crate) id: &'a [u32],
+    pub(crate) state: ParticleState<'a>,
+    pub(crate) force: &'a mut [Vec3],
+    pub(crate) torque: &'a mut [Vec3],
+}
+
+impl<'a> ParticleState<'a> {
+    /// The state of `p`, read only.
+    pub(crate) fn of(p: &'a Particles) -> Self {
+        ParticleState {
+            position: &p.position,
+            velocity: &p.velocity,
+            omega: p.angular.as_ref().map(|a| a.omega.as_slice()),
+            radius: &p.radius,
+            mass: &p.mass,
+            inv_mass: &p.inv_mass,
+            species: &p.species,
+        }
+    }
+
+    /// `p` split into the state a force pass reads and the arrays it writes.
+    pub(crate) fn split(p: &'a mut Particles) -> ForceView<'a> {
+        let Particles {
+            id,
+            position,
+            velocity,
+            force,
+            radius,
+            mass,
+            inv_mass,
+            species,
+            angular,
+        } = p;
+        let (omega, torque) = match angular.as_mut() {
+            Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
+            None => (None, &mut [][..]),
+        };
+        ForceView {
+            id,
+            state: ParticleState {
+                position,
+                velocity,
+                omega,
+                radius,
+                mass,
+                inv_mass,
+                species,
+            },
+            force,
+            torque,
+        }
+    }
 }
 
 /// What the owner pass reads: the laws, the particles, the list, and what acts on one

@@ -16,11 +16,13 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::suite::{parse_codes, parse_variant, Code, Suite, SuiteError};
-use super::validate::{output_error, run_one, ValidateError, ValidateOptions};
+use crate::code::Code;
+use crate::csv_table::CsvTable;
 use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
+use crate::runs::{output_error, run_one, Outcome, ValidateError, ValidateOptions};
+use crate::suite_entry::{parse_codes, parse_variant, SuiteError};
 use cgdem_core::coarse_graining::CoarseGrainRule;
-use cgdem_core::io::write_atomic;
+use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::scene::{Override, Scene};
 
 /// What a point varies: the coarse-graining level or a scene key.
@@ -260,7 +262,7 @@ pub struct AccuracyPoint {
     pub setting: String,
     pub lambda: u32,
     pub seed: u64,
-    pub status: String,
+    pub status: Outcome,
     pub reason: Option<String>,
     pub dir: PathBuf,
     pub reused: bool,
@@ -443,11 +445,12 @@ pub fn profile_distance(reference: &[(f64, f64)], other: &[(f64, f64)]) -> Optio
 /// Runs every `[[accuracy]]` sweep of the suite, writes the "Error against run time" section
 /// of the report and its figures; None when the suite has no sweep.
 pub(super) fn run_sweeps(
-    suite: &Suite,
+    sweeps: &[AccuracySweep],
+    suite_file: &Path,
     options: &ValidateOptions,
     report: &mut Report,
 ) -> Result<Option<AccuracySummary>, ValidateError> {
-    if suite.accuracy.is_empty() {
+    if sweeps.is_empty() {
         return Ok(None);
     }
     let section = report.section("Error against run time");
@@ -466,8 +469,8 @@ pub(super) fn run_sweeps(
         points: Vec::new(),
         cheapest: Vec::new(),
     };
-    for sweep in &suite.accuracy {
-        let mut points = run_sweep(sweep, &suite.source, options)?;
+    for sweep in sweeps {
+        let mut points = run_sweep(sweep, suite_file, options)?;
         measure(&mut points);
         let case = points.first().map(|p| p.case.clone()).unwrap_or_default();
         let dir = options.out.join("figures").join("accuracy").join(&case);
@@ -590,7 +593,7 @@ fn run_point(
     let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
     // A run that stopped early (a guard, a time limit) measured nothing comparable.
     if record.partial {
-        record.status = "failed".into();
+        record.status = Outcome::Failed;
     }
     let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
         .ok()
@@ -598,17 +601,17 @@ fn run_point(
         .unwrap_or_default();
     // A run that lost particles (LIGGGHTS and LAMMPS drop atoms that leave the box) may end
     // without a heap or a flow to measure.
-    if record.status == "ok"
+    if record.status == Outcome::Ok
         && record.repose_angle_deg.is_none()
         && summary["conveying"]["mass_flow_kg_s"].as_f64().is_none()
     {
-        record.status = "failed".into();
+        record.status = Outcome::Failed;
         record.reason = Some(format!(
             "measured nothing: {} particles at the end",
             record.n_particles.map_or("?".into(), |n| n.to_string())
         ));
     }
-    let ok = record.status == "ok";
+    let ok = record.status == Outcome::Ok;
     let conveying = |key: &str| {
         summary["conveying"][key]
             .as_f64()
@@ -643,27 +646,23 @@ fn run_point(
     }
 }
 
+/// The run's heap profile (`profile.csv`); empty when the run wrote none or it cannot be read
+/// (the point then has no profile error).
 fn read_profile(dir: &Path) -> Vec<(f64, f64)> {
-    let Ok(text) = std::fs::read_to_string(dir.join("profile.csv")) else {
-        return Vec::new();
-    };
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let (x, h) = l.split_once(',')?;
-            Some((x.trim().parse().ok()?, h.trim().parse().ok()?))
-        })
-        .collect()
+    CsvTable::read(&dir.join("profile.csv"))
+        .and_then(|t| t.numbers(&["x_m", "height_m"]))
+        .map(|rows| rows.iter().map(|r| (r[0], r[1])).collect())
+        .unwrap_or_default()
 }
 
 /// Fills each point's errors against its code's reference run.
 fn measure(points: &mut [AccuracyPoint]) {
     let references: Vec<AccuracyPoint> = points
         .iter()
-        .filter(|p| p.series == "reference" && p.status == "ok")
+        .filter(|p| p.series == "reference" && p.status == Outcome::Ok)
         .cloned()
         .collect();
-    for p in points.iter_mut().filter(|p| p.status == "ok") {
+    for p in points.iter_mut().filter(|p| p.status == Outcome::Ok) {
         if let (Some(q), Some(eq7)) = (p.mass_flow_kg_s, p.eq7_mass_flow_kg_s) {
             p.eq7_error = Some((q / eq7 - 1.0).abs()).filter(|e| e.is_finite());
         }
@@ -740,18 +739,38 @@ fn write_sweep_section(
         .chain(measures.iter().map(|m| m.name().to_string())),
     )
     .caption("Every point: its cost and its errors");
-    let mut csv = String::from(
-        "case,code,series,knob_value,setting,lambda,seed,status,n_particles,steps,particle_steps,wall_s,repose_angle_deg,angle_error_deg,profile_distance,mass_flow_kg_s,mass_flow_error,eq7_mass_flow_kg_s,eq7_error\n",
-    );
+    let mut csv = CsvBuffer::new([
+        "case",
+        "code",
+        "series",
+        "knob_value",
+        "setting",
+        "lambda",
+        "seed",
+        "status",
+        "n_particles",
+        "steps",
+        "particle_steps",
+        "wall_s",
+        "repose_angle_deg",
+        "angle_error_deg",
+        "profile_distance",
+        "mass_flow_kg_s",
+        "mass_flow_error",
+        "eq7_mass_flow_kg_s",
+        "eq7_error",
+    ]);
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
-        let status = match p.status.as_str() {
-            "ok" if p.reused => Cell::pass("ok (reused)"),
-            "ok" => Cell::pass("ok"),
-            "skipped" => {
+        let status = match p.status {
+            Outcome::Ok if p.reused => Cell::pass("ok (reused)"),
+            Outcome::Ok => Cell::pass("ok"),
+            Outcome::Skipped => {
                 Cell::skipped(format!("skipped: {}", p.reason.clone().unwrap_or_default()))
             }
-            _ => Cell::fail(format!("failed: {}", p.reason.clone().unwrap_or_default())),
+            Outcome::Failed => {
+                Cell::fail(format!("failed: {}", p.reason.clone().unwrap_or_default()))
+            }
         };
         let result = match (p.repose_angle_deg, p.mass_flow_kg_s) {
             (Some(a), _) => format!("{a:.2} deg"),
@@ -777,16 +796,16 @@ fn write_sweep_section(
                     .map(|m| Cell::num(m.of(p).map_or("-".into(), |v| m.format(v)))),
             ),
         );
-        csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            p.case,
-            p.code.name(),
-            p.series,
-            p.value,
+        csv.row([
+            p.case.clone(),
+            p.code.name().to_string(),
+            p.series.clone(),
+            p.value.to_string(),
+            // Kept free of commas (a spreadsheet's eye reads the file too).
             p.setting.replace(',', ";"),
-            p.lambda,
-            p.seed,
-            p.status,
+            p.lambda.to_string(),
+            p.seed.to_string(),
+            p.status.to_string(),
             p.n_particles.map_or(String::new(), |n| n.to_string()),
             p.steps.map_or(String::new(), |n| n.to_string()),
             o(p.particle_steps),
@@ -798,11 +817,13 @@ fn write_sweep_section(
             o(p.mass_flow_error),
             o(p.eq7_mass_flow_kg_s),
             o(p.eq7_error),
-        );
+        ]);
     }
     std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
     let csv_path = dir.join("points.csv");
-    write_atomic(&csv_path, csv.as_bytes()).map_err(|e| output_error(&csv_path, e))?;
+    csv.bytes()
+        .and_then(|bytes| write_atomic(&csv_path, bytes))
+        .map_err(|e| output_error(&csv_path, e))?;
 
     let mut cheapest = Vec::new();
     let codes = sweep.codes();
@@ -895,7 +916,7 @@ fn measure_named(name: &str) -> Measure {
 fn candidates(code: Code, m: Measure, points: &[AccuracyPoint]) -> Vec<&AccuracyPoint> {
     points
         .iter()
-        .filter(|p| p.code == code && p.status == "ok" && p.series != "floor")
+        .filter(|p| p.code == code && p.status == Outcome::Ok && p.series != "floor")
         .filter(|p| p.series != "reference" || !m.against_reference())
         .collect()
 }
@@ -923,7 +944,7 @@ fn cheapest_setting(
     let best = cheapest_within(&cost, m.target(targets)).map(|k| found[k]);
     let reference = points
         .iter()
-        .find(|p| p.code == code && p.series == "reference" && p.status == "ok");
+        .find(|p| p.code == code && p.series == "reference" && p.status == Outcome::Ok);
     let floor = points
         .iter()
         .filter(|p| p.code == code && p.series == "floor")
@@ -996,7 +1017,7 @@ fn error_figure(
         for knob in knobs {
             let mut series: Vec<&AccuracyPoint> = points
                 .iter()
-                .filter(|p| p.code == code && p.series == knob && p.status == "ok")
+                .filter(|p| p.code == code && p.series == knob && p.status == Outcome::Ok)
                 .collect();
             series.sort_by(|a, b| a.value.total_cmp(&b.value));
             let xy: Vec<(f64, f64)> = series
@@ -1062,6 +1083,7 @@ fn error_figure(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::suite::Suite;
 
     #[test]
     fn the_pareto_front_keeps_only_points_no_cheaper_point_beats() {

@@ -14,6 +14,7 @@
 //! outcome (height and flank slope of the heap), so that the speed is compared on the same
 //! physics.
 
+use cgdem_core::io::CsvBuffer;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -235,7 +236,7 @@ fn prepare(path: &Path, options: &BenchOptions) -> Result<PreparedCase, BenchErr
     // The step every code takes: the scene's explicit one, else cgdem's choice.
     let mut dt = match (&scene.contact, scene.time_step) {
         (_, TimeStepRequest::Explicit(dt)) => Some(dt),
-        (ContactSettings::Wca { .. }, _) => Some(
+        (ContactSettings::Wca(_), _) => Some(
             cgdem_core::run::time_step(&scene, false)
                 .map_err(|e| BenchError::Case(e.to_string()))?
                 .0,
@@ -730,25 +731,37 @@ fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
     let json_path = out.join("bench.json");
     let json = serde_json::to_string_pretty(report).map_err(|e| io(&json_path, &e))?;
     cgdem_core::io::write_atomic(&json_path, json.as_bytes()).map_err(|e| io(&json_path, &e))?;
-    let mut csv = String::from("case,code,threads,repetition,status,n_particles,steps,loop_s,particle_steps_per_s,memory_mb\n");
+    let mut csv = CsvBuffer::new([
+        "case",
+        "code",
+        "threads",
+        "repetition",
+        "status",
+        "n_particles",
+        "steps",
+        "loop_s",
+        "particle_steps_per_s",
+        "memory_mb",
+    ]);
     let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for r in &report.runs {
-        csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{}\n",
-            r.case,
-            r.code.name(),
-            r.threads,
-            r.repetition,
-            r.status,
-            r.n_particles,
-            r.steps,
+        csv.row([
+            r.case.to_string(),
+            r.code.name().to_string(),
+            r.threads.to_string(),
+            r.repetition.to_string(),
+            r.status.to_string(),
+            r.n_particles.to_string(),
+            r.steps.to_string(),
             opt(r.loop_s),
             opt(r.particle_steps_per_s),
-            opt(r.memory_mb)
-        );
+            opt(r.memory_mb),
+        ]);
     }
     let csv_path = out.join("bench_runs.csv");
-    cgdem_core::io::write_atomic(&csv_path, csv.as_bytes()).map_err(|e| io(&csv_path, &e))?;
+    csv.bytes()
+        .and_then(|bytes| cgdem_core::io::write_atomic(&csv_path, bytes))
+        .map_err(|e| io(&csv_path, &e))?;
     let bars: Vec<(String, String, f64, Option<f64>)> = report
         .medians
         .iter()

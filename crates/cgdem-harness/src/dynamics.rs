@@ -5,6 +5,8 @@
 
 use std::path::Path;
 
+use crate::csv_table::CsvTable;
+
 /// One run's (or a mean over seeds') flow during the measured stage, time from its start.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FlowSeries {
@@ -20,10 +22,8 @@ impl FlowSeries {
     /// Reads the rows of `stage` from `dir/timeseries.csv`; None when the file or its
     /// columns are missing or the stage has no rows.
     pub fn read(dir: &Path, stage: &str) -> Option<FlowSeries> {
-        let text = std::fs::read_to_string(dir.join("timeseries.csv")).ok()?;
-        let mut lines = text.lines();
-        let header: Vec<&str> = lines.next()?.split(',').collect();
-        let col = |name: &str| header.iter().position(|h| *h == name);
+        let table = CsvTable::read(&dir.join("timeseries.csv")).ok()?;
+        let col = |name: &str| table.column(name).ok();
         let (t, st, x, h, ke) = (
             col("time_s")?,
             col("stage")?,
@@ -33,12 +33,12 @@ impl FlowSeries {
         );
         let mut out = FlowSeries::default();
         let mut t0 = None;
-        for line in lines {
-            let f: Vec<&str> = line.split(',').collect();
-            if f.get(st) != Some(&stage) {
+        for row in table.rows() {
+            if row.text(st).ok() != Some(stage) {
                 continue;
             }
-            let num = |k: usize| f.get(k).and_then(|v| v.parse::<f64>().ok());
+            // Rows without a front (no deposit yet) are not part of the flow.
+            let num = |c| row.parse::<f64>(c).ok();
             let (Some(time), Some(front), Some(height), Some(energy)) =
                 (num(t), num(x), num(h), num(ke))
             else {

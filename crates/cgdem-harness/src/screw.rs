@@ -7,8 +7,8 @@
 use std::path::Path;
 
 use super::suite::{Code, SuiteCase};
-use super::validate::{output_error, RunRecord, ValidateError};
 use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
+use crate::runs::{output_error, Outcome, RunRecord, ValidateError};
 use cgdem_core::scene::Scene;
 
 /// One code's points at one speed: the mean over seeds of the flow, its standard error
@@ -36,7 +36,7 @@ pub fn points_by_code(runs: &[RunRecord]) -> Vec<(Code, Vec<SpeedPoint>)> {
         for rpm in speeds {
             let at: Vec<&RunRecord> = runs
                 .iter()
-                .filter(|r| r.code == code && r.rpm == Some(rpm) && r.status == "ok")
+                .filter(|r| r.code == code && r.rpm == Some(rpm) && r.status == Outcome::Ok)
                 .filter(|r| r.mass_flow_kg_s.is_some())
                 .collect();
             if at.is_empty() {
@@ -197,11 +197,11 @@ pub fn write_screw_section(
         Cell::num(v.map_or("-".into(), |x| format!("{x:.digits$}")))
     };
     for r in runs {
-        let status = match r.status.as_str() {
-            "ok" if r.partial => Cell::skipped(r.reason.clone().unwrap_or_default()),
-            "ok" => Cell::pass("ok"),
-            "skipped" => Cell::skipped(r.reason.clone().unwrap_or_default()),
-            _ => Cell::fail(r.reason.clone().unwrap_or_default()),
+        let status = match r.status {
+            Outcome::Ok if r.partial => Cell::skipped(r.reason.clone().unwrap_or_default()),
+            Outcome::Ok => Cell::pass("ok"),
+            Outcome::Skipped => Cell::skipped(r.reason.clone().unwrap_or_default()),
+            Outcome::Failed => Cell::fail(r.reason.clone().unwrap_or_default()),
         };
         table.row([
             Cell::text(r.code.name()),

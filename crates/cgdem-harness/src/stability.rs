@@ -22,10 +22,13 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::lammps::runner::{log_tail_of, RunStatus, RunnerOptions};
-use super::suite::{parse_codes, parse_variant, Code, SuiteError};
+use crate::code::Code;
+use crate::csv_table::CsvTable;
 use crate::report::{Cell, Report, Table};
+use crate::suite_entry::{load_variant, parse_codes, parse_variant, SuiteError};
 use cgdem_core::coarse_graining::coarse_grain;
 use cgdem_core::guard::overlap_fraction;
+use cgdem_core::io::CsvBuffer;
 use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{run, RunOptions};
@@ -79,7 +82,7 @@ pub struct StabilityCase {
 
 impl StabilityCase {
     pub fn load_scene(&self) -> Result<Scene, SceneError> {
-        super::suite::load_variant(&self.file, &self.overrides, self.variant.as_deref())
+        load_variant(&self.file, &self.overrides, self.variant.as_deref())
     }
 }
 
@@ -373,7 +376,7 @@ fn not_applicable(code: Code, scene: &Scene) -> Option<String> {
             return Some("the decks have no van der Waals (Hamaker) cohesion: LAMMPS's granular pair style offers JKR/DMT, LIGGGHTS 3.8 SJKR only".into());
         }
     }
-    if code == Code::Liggghts && matches!(scene.contact, ContactSettings::Wca { .. }) {
+    if code == Code::Liggghts && matches!(scene.contact, ContactSettings::Wca(_)) {
         return Some("LIGGGHTS cannot express the seed's WCA model (model = \"wca\")".into());
     }
     None
@@ -652,22 +655,23 @@ pub(crate) fn classify(
 /// Fills the energy balance from `dir/timeseries.csv` (`mechanical_energy_j`, `n_particles`)
 /// and the scene's starting state.
 fn energy_evidence(scene: &Scene, dir: &Path, ev: &mut Evidence) {
-    let text = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap_or_default();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name);
-    let (Some(e_col), Some(n_col)) = (col("mechanical_energy_j"), col("n_particles")) else {
+    let Ok(table) = CsvTable::read(&dir.join("timeseries.csv")) else {
+        return;
+    };
+    let (Ok(e_col), Ok(n_col)) = (
+        table.column("mechanical_energy_j"),
+        table.column("n_particles"),
+    ) else {
         return;
     };
     let mut energies = Vec::new();
     let mut fewest = usize::MAX;
-    for line in lines {
-        let f: Vec<&str> = line.split(',').collect();
-        match f.get(e_col).map(|v| v.parse::<Real>()) {
-            Some(Ok(e)) if e.is_finite() => energies.push(e),
+    for row in table.rows() {
+        match row.parse::<Real>(e_col) {
+            Ok(e) if e.is_finite() => energies.push(e),
             _ => ev.non_finite = true,
         }
-        if let Some(Ok(n)) = f.get(n_col).map(|v| v.parse::<usize>()) {
+        if let Ok(n) = row.parse::<usize>(n_col) {
             fewest = fewest.min(n);
         }
     }
@@ -713,8 +717,8 @@ pub(crate) fn elastic_energy(scene: &Scene, p: &Particles) -> Real {
     type PairEnergy = Box<dyn Fn(Real, Real, Real) -> Real>;
     type WallEnergy = Box<dyn Fn(Real, Real) -> Real>;
     let (pair, wall): (PairEnergy, WallEnergy) = match &scene.contact {
-        ContactSettings::Wca { epsilon, sigma, .. } => {
-            let (eps, sigma) = (*epsilon, *sigma);
+        ContactSettings::Wca(w) => {
+            let (eps, sigma) = (w.epsilon, w.sigma);
             let phi = move |r: Real| {
                 if r >= TWO_POW_ONE_SIXTH * sigma || r <= 0.0 {
                     0.0
@@ -833,21 +837,39 @@ fn fmt(v: Option<Real>, f: impl Fn(Real) -> String) -> String {
 }
 
 fn write_csv(records: &[StabilityRecord], path: &Path) -> Result<(), String> {
-    let mut csv = String::from("case,code,verdict,particles,particles_lost,steps,dt_s,dt_over_stable,energy_start_j,elastic_start_j,energy_max_j,energy_end_j,energy_rise,energy_drift,dissipated_j,largest_overlap,overlap_measured,message\n");
+    let mut csv = CsvBuffer::new([
+        "case",
+        "code",
+        "verdict",
+        "particles",
+        "particles_lost",
+        "steps",
+        "dt_s",
+        "dt_over_stable",
+        "energy_start_j",
+        "elastic_start_j",
+        "energy_max_j",
+        "energy_end_j",
+        "energy_rise",
+        "energy_drift",
+        "dissipated_j",
+        "largest_overlap",
+        "overlap_measured",
+        "message",
+    ]);
     for r in records {
         let e = r.evidence.clone().unwrap_or_default();
         let sci = |v: Real| format!("{v:.6e}");
         let dt_ratio = (e.dt_s / e.stable_dt_s)
             .is_finite()
             .then(|| e.dt_s / e.stable_dt_s);
-        csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
-            r.case,
-            r.code.name(),
-            r.verdict.name(),
-            e.particles,
-            e.particles_lost,
-            e.steps,
+        csv.row([
+            r.case.clone(),
+            r.code.name().to_string(),
+            r.verdict.name().to_string(),
+            e.particles.to_string(),
+            e.particles_lost.to_string(),
+            e.steps.to_string(),
             if e.dt_s.is_finite() {
                 sci(e.dt_s)
             } else {
@@ -862,11 +884,13 @@ fn write_csv(records: &[StabilityRecord], path: &Path) -> Result<(), String> {
             fmt(e.energy_drift, sci),
             fmt(e.dissipated_j, sci),
             fmt(e.largest_overlap, |v| format!("{v:.4}")),
-            e.overlap_measured,
-            r.message.replace('"', "'").replace('\n', " ")
-        );
+            e.overlap_measured.to_string(),
+            // One row per line.
+            r.message.replace('\n', " "),
+        ]);
     }
-    cgdem_core::io::write_atomic(path, csv.as_bytes())
+    csv.bytes()
+        .and_then(|bytes| cgdem_core::io::write_atomic(path, bytes))
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

@@ -315,18 +315,17 @@ impl PoreSizeDistribution {
 
     /// Writes `diameter_lo,diameter_hi,fraction,cumulative` rows with a header line.
     pub fn write_csv<W: Write>(&self, mut w: W) -> io::Result<()> {
-        writeln!(w, "diameter_lo,diameter_hi,fraction,cumulative")?;
+        let mut csv =
+            crate::io::CsvBuffer::new(["diameter_lo", "diameter_hi", "fraction", "cumulative"]);
         for i in 0..self.fraction.len() {
-            writeln!(
-                w,
-                "{:e},{:e},{:e},{:e}",
-                self.bin_edges[i],
-                self.bin_edges[i + 1],
-                self.fraction[i],
-                self.cumulative[i]
-            )?;
+            csv.row([
+                format!("{:e}", self.bin_edges[i]),
+                format!("{:e}", self.bin_edges[i + 1]),
+                format!("{:e}", self.fraction[i]),
+                format!("{:e}", self.cumulative[i]),
+            ]);
         }
-        Ok(())
+        w.write_all(csv.bytes()?)
     }
 }
 

@@ -15,7 +15,7 @@ use crate::domain::{Domain, NO_IMAGE};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::{AngularState, Particles};
-use crate::simulation::{larger, pair_force, Owner, ParticleState};
+use crate::simulation::{larger, pair_force, ForceView, Owner, ParticleState};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -234,15 +234,7 @@ fn resort_by_cell<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, c
     let order = CellGrid::build(&bounded, &sub.particles.position, cell_size).items;
     sub.particles.permute(&order);
     let slots = sub.wall_history.len() / n;
-    let old = std::mem::take(&mut sub.wall_history);
-    sub.wall_history = order
-        .iter()
-        .flat_map(|&o| {
-            old[o as usize * slots..(o as usize + 1) * slots]
-                .iter()
-                .copied()
-        })
-        .collect();
+    sub.wall_history = Particles::permute_rows(&sub.wall_history, &order, slots);
     let old = std::mem::take(&mut sub.rows);
     for &o in &order {
         sub.rows.push(old.of(o as usize));
@@ -355,30 +347,12 @@ fn forces<L: PairLaw, W: WallLaw>(
     physics: &Physics<'_, L, W>,
 ) -> (Real, Real) {
     let n = sub.n_owned;
-    let Particles {
+    let ForceView {
         id,
-        position,
-        velocity,
+        state,
         force,
-        radius,
-        mass,
-        inv_mass,
-        species,
-        angular,
-    } = &mut sub.particles;
-    let (omega, torque) = match angular.as_mut() {
-        Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
-        None => (None, &mut [][..]),
-    };
-    let state = ParticleState {
-        position,
-        velocity,
-        omega,
-        radius,
-        mass,
-        inv_mass,
-        species,
-    };
+        torque,
+    } = ParticleState::split(&mut sub.particles);
     let images = [Vec3::ZERO; 27];
     let rotates = physics.rotates;
     force[..n].fill(Vec3::ZERO);

@@ -5,7 +5,7 @@
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
 use crate::math::Real;
-use crate::scene::{ContactSettings, Scene};
+use crate::scene::{ContactSettings, Scene, WcaSettings};
 use crate::walls::{WallLaw, WcaWall};
 
 use super::{hertz, RunError};
@@ -20,8 +20,8 @@ pub trait LawVisitor {
 /// error naming the supported ones ([`super::SUPPORTED`]).
 pub fn with_laws<V: LawVisitor>(scene: &Scene, visitor: V) -> Result<V::Output, RunError> {
     match &scene.contact {
-        ContactSettings::Wca { .. } => {
-            let (law, wall_law) = seed_laws(scene);
+        ContactSettings::Wca(wca) => {
+            let (law, wall_law) = seed_laws(scene, wca);
             Ok(visitor.visit(law, wall_law))
         }
         ContactSettings::Hertz(h) => hertz::with_hertz_laws(scene, h, visitor),
@@ -29,16 +29,8 @@ pub fn with_laws<V: LawVisitor>(scene: &Scene, visitor: V) -> Result<V::Output, 
 }
 
 /// The seed's particle law and wall law for a scene with `ContactSettings::Wca`.
-pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
-    let ContactSettings::Wca {
-        epsilon,
-        sigma,
-        gamma_n,
-        gamma_t,
-    } = scene.contact
-    else {
-        panic!("seed_laws needs a scene with model = \"wca\"");
-    };
+pub fn seed_laws(scene: &Scene, wca: &WcaSettings) -> (SeedModel, WcaWall) {
+    let sigma = wca.sigma;
     let n = scene.species.len();
     // `sigma` belongs to the first mobile species; a pair of other diameters gets it scaled
     // by the mean diameter (Lorentz mixing), so the cut-off `2^(1/6) sigma_ab` stays at the
@@ -50,7 +42,7 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
         .unwrap_or(&scene.species[0])
         .diameter;
     let pair = |a: usize, b: usize| WcaCoefficients {
-        epsilon,
+        epsilon: wca.epsilon,
         sigma: if scene.species[a].diameter == reference && scene.species[b].diameter == reference {
             sigma
         } else {
@@ -58,7 +50,7 @@ pub fn seed_laws(scene: &Scene) -> (SeedModel, WcaWall) {
         },
     };
     let table: Vec<WcaCoefficients> = (0..n * n).map(|ab| pair(ab / n, ab % n)).collect();
-    let law = SeedModel::seed(table, vec![gamma_n; n * n], vec![gamma_t; n * n]);
+    let law = SeedModel::seed(table, vec![wca.gamma_n; n * n], vec![wca.gamma_t; n * n]);
     let per_species: Vec<(WcaCoefficients, Real)> = scene
         .species
         .iter()

@@ -31,6 +31,7 @@ use crate::analysis::PackingSummary;
 use crate::contact::PairLaw;
 use crate::guard::{GuardKind, GuardPeaks, GuardTrip};
 use crate::insertion::InsertionFailed;
+use crate::io::CsvBuffer;
 use crate::math::Real;
 use crate::particles::Particles;
 use crate::scene::{ReposeSettings, Scene, StageEnd};
@@ -371,32 +372,36 @@ fn describe_end(end: &StageEnd) -> String {
 }
 
 /// `profile.csv`: the heap surface height per bin.
-pub fn profile_csv(profile: &HeapProfile) -> String {
-    let mut csv = String::from("x_m,height_m\n");
+pub fn profile_csv(profile: &HeapProfile) -> std::io::Result<Vec<u8>> {
+    let mut csv = CsvBuffer::new(["x_m", "height_m"]);
     for (k, h) in profile.heights.iter().enumerate() {
-        csv += &format!("{:.6e},{:.6e}\n", profile.bin_centre(k), h);
+        csv.row([format!("{:.6e}", profile.bin_centre(k)), format!("{h:.6e}")]);
     }
-    csv
+    csv.bytes().map(<[u8]>::to_vec)
 }
 
 /// `repose.csv`: the angle at each measurement.
-pub fn repose_csv(samples: &[ReposeSample]) -> String {
-    let mut csv = String::from(
-        "time_after_start_s,trigger,repose_angle_deg,repose_fit_r2,runout_m,wall_height_m\n",
-    );
+pub fn repose_csv(samples: &[ReposeSample]) -> std::io::Result<Vec<u8>> {
+    let mut csv = CsvBuffer::new([
+        "time_after_start_s",
+        "trigger",
+        "repose_angle_deg",
+        "repose_fit_r2",
+        "runout_m",
+        "wall_height_m",
+    ]);
     let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
     for s in samples {
-        csv += &format!(
-            "{},{},{},{},{:.6e},{:.6e}\n",
-            s.time_after_start_s,
-            s.trigger,
+        csv.row([
+            s.time_after_start_s.to_string(),
+            s.trigger.to_string(),
             opt(s.repose_angle_deg),
             opt(s.repose_fit_r2),
-            s.runout_m,
-            s.wall_height_m
-        );
+            format!("{:.6e}", s.runout_m),
+            format!("{:.6e}", s.wall_height_m),
+        ]);
     }
-    csv
+    csv.bytes().map(<[u8]>::to_vec)
 }
 
 /// The headline measurement: the stage-end sample when the scene asks for one, else the last

@@ -39,17 +39,22 @@ impl Species {
     }
 }
 
+/// The seed's WCA model's parameters (`model = "wca"`): the energy `epsilon` and length
+/// `sigma` of the repulsion, the normal and tangential damping `gamma_n`, `gamma_t`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WcaSettings {
+    pub epsilon: Real,
+    pub sigma: Real,
+    pub gamma_n: Real,
+    pub gamma_t: Real,
+}
+
 /// The particle-particle contact law and its parameters (one set for all species pairs).
 #[derive(Clone, Debug, PartialEq)]
 pub enum ContactSettings {
     /// The seed's model, paper A Eq. (1)-(2): WCA repulsion plus normal and tangential
     /// viscous damping.
-    Wca {
-        epsilon: Real,
-        sigma: Real,
-        gamma_n: Real,
-        gamma_t: Real,
-    },
+    Wca(WcaSettings),
     /// Hertz contact with LIGGGHTS/LAMMPS-style sub-models (paper B).
     Hertz(HertzSettings),
 }

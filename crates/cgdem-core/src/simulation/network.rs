@@ -43,15 +43,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// step earlier (a difference of order `dt` / contact time).
     pub fn contact_network(&self) -> ContactNetwork {
         let p = &self.particles;
-        let state = ParticleState {
-            position: &p.position,
-            velocity: &p.velocity,
-            omega: p.angular.as_ref().map(|a| a.omega.as_slice()),
-            radius: &p.radius,
-            mass: &p.mass,
-            inv_mass: &p.inv_mass,
-            species: &p.species,
-        };
+        let state = ParticleState::of(p);
         let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
         let pairs: Vec<PairContact> = self
             .list

@@ -466,18 +466,12 @@ pub(crate) fn removal_pads(scene: &Scene, fixes_per_wall: usize) -> String {
 /// the seed's WCA model here, a Hertz scene by `hertz::write_hertz_deck`.
 pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
-    let ContactSettings::Wca {
-        epsilon,
-        sigma,
-        gamma_n,
-        gamma_t,
-    } = scene.contact
-    else {
+    let ContactSettings::Wca(wca) = scene.contact else {
         return Err(unsupported(
             "not the seed's WCA model: Hertz scenes get `hertz::write_hertz_deck`".into(),
         ));
     };
-    if gamma_n <= 0.0 {
+    if wca.gamma_n <= 0.0 {
         return Err(unsupported(
             "gamma_n = 0: LAMMPS sets gamma_t as a multiple of gamma_n".into(),
         ));
@@ -491,7 +485,7 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
             "LAMMPS seed-model decks take planar walls only (no [[body]], no [[delete]])".into(),
         ));
     }
-    let rc = TWO_POW_ONE_SIXTH * sigma;
+    let rc = TWO_POW_ONE_SIXTH * wca.sigma;
     let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
     let wall_mass = masses[0];
     if !scene.walls.is_empty()
@@ -541,11 +535,11 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
     let _ = writeln!(
         d,
         "pair_coeff      * * lj/cut {} {} {}",
-        g(epsilon),
-        g(sigma),
+        g(wca.epsilon),
+        g(wca.sigma),
         g(rc)
     );
-    let _ = writeln!(d, "pair_coeff      * * granular hooke 0.0 {} damping velocity tangential linear_nohistory {} 1.0e8", g(gamma_n), g(gamma_t / gamma_n));
+    let _ = writeln!(d, "pair_coeff      * * granular hooke 0.0 {} damping velocity tangential linear_nohistory {} 1.0e8", g(wca.gamma_n), g(wca.gamma_t / wca.gamma_n));
     d += "pair_modify     pair lj/cut shift yes\n";
     d += &neighbor_lines(Code::Lammps, scene);
     d += "fix             integ all nve\n";
@@ -564,7 +558,7 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
     let _ = writeln!(d, "timestep        {}", g(dt));
 
     if !scene.walls.is_empty() {
-        let stiffness = 4.0 * 72.0 * epsilon / (rc * rc);
+        let stiffness = 4.0 * 72.0 * wca.epsilon / (rc * rc);
         let gamma_w = 2.0
             * restitution_damping_ratio(scene.wall_contact.restitution)
             * (stiffness * wall_mass).sqrt();
@@ -593,8 +587,8 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
                 d,
                 "fix             wlj_{0} all wall/region w_{0} lj126 {1} {2} {3}",
                 w.name,
-                g(epsilon),
-                g(0.5 * sigma),
+                g(wca.epsilon),
+                g(0.5 * wca.sigma),
                 g(0.5 * rc)
             );
             let _ = writeln!(d, "fix             wgran_{0} all wall/gran/region granular hooke 0.0 {1} damping velocity tangential linear_nohistory {2} {3} region w_{0}", w.name, g(gamma_w), g(x_t), g(scene.wall_contact.friction));
@@ -647,7 +641,7 @@ mod tests {
         let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
             .join("validation/cases/screw_feeder_nightly.toml");
         let scene = Scene::load(&path).unwrap();
-        assert!(matches!(scene.contact, ContactSettings::Wca { .. }));
+        assert!(matches!(scene.contact, ContactSettings::Wca(_)));
         let err = write_wca_deck(&scene, &Particles::new(false), 1e-6).unwrap_err();
         let message = err.to_string();
         assert!(message.contains("[[body]]"), "{message}");

@@ -26,7 +26,7 @@ pub fn write_deck(
     dt: cgdem_core::math::Real,
 ) -> Result<Deck, DeckError> {
     match scene.contact {
-        ContactSettings::Wca { .. } => deck::write_wca_deck(scene, particles, dt),
+        ContactSettings::Wca(_) => deck::write_wca_deck(scene, particles, dt),
         ContactSettings::Hertz(_) => write_hertz_deck(scene, particles, dt),
     }
 }

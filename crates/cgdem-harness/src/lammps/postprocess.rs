@@ -9,7 +9,7 @@ use super::deck::{DeckPlan, TRAJECTORY_FILE};
 use super::dump::{read_dump, DumpError, Frame};
 use cgdem_core::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
 use cgdem_core::analysis::heap::{self, HeapProfile};
-use cgdem_core::io::write_atomic;
+use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::{Real, Vec3};
 use cgdem_core::run::{
     headline_sample, profile_csv, repose_csv, ReposeSample, RunSummary, SampleTrigger, StageRecord,
@@ -230,164 +230,20 @@ pub fn postprocess(
     let dt = plan.dt;
     let traj_path = dir.join(TRAJECTORY_FILE);
     let frames = read_dump(&traj_path)?;
-    let max_diameter = scene.max_diameter();
-    let floor_z = scene.domain.lo.z;
-    let heap_profile = |p: &FrameParticles| -> Option<HeapProfile> {
-        scene.repose.as_ref().map(|r| {
-            heap::profile(
-                &p.position,
-                &p.radius,
-                r.wall_x,
-                scene.domain.hi.x,
-                floor_z,
-                r.bin_width_diameters * max_diameter,
-            )
-        })
-    };
-
-    let mut csv = String::from("time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,mechanical_energy_j\n");
-    let origin =
-        cgdem_core::simulation::potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
-    let mut last_state = None;
-    for frame in frames.iter().filter(|f| f.step > 0) {
-        let p = frame_particles(frame, scene, &traj_path)?;
-        let stage = marks
-            .iter()
-            .find(|m| {
-                frame.step > m.start && m.end.as_ref().is_none_or(|(end, _)| frame.step <= *end)
-            })
-            .map_or("", |m| m.name.as_str());
-        let ke: Real = p
-            .velocity
-            .iter()
-            .zip(&p.mass)
-            .map(|(v, m)| 0.5 * m * v.length_squared())
-            .sum::<Real>()
-            + p.rotational_energy;
-        let mass: Real = p.mass.iter().sum();
-        // Kinetic plus gravitational energy, as cgdem's `World::mechanical_energy`.
-        let potential: Real = p
-            .position
-            .iter()
-            .zip(&p.mass)
-            .map(|(&x, &m)| -m * scene.gravity.dot(x - origin))
-            .sum();
-        let profile = heap_profile(&p);
-        let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-        csv += &format!(
-            "{:.9e},{},{:.9e},{:.9e},{},{},{},{:.9e}\n",
-            frame.step as Real * dt,
-            stage,
-            ke,
-            ke / mass.max(Real::MIN_POSITIVE),
-            p.position.len(),
-            opt(profile.as_ref().map(|p| p.front(2.0 * max_diameter))),
-            opt(profile.as_ref().map(|p| p.wall_height())),
-            ke + potential
-        );
-        last_state = Some((frame.step, p));
-    }
-    let path = dir.join("timeseries.csv");
-    write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
-
+    let last_state = write_timeseries(scene, dir, &marks, &frames, &traj_path, dt)?;
     let mut warnings = plan.notes.clone();
-    let mut samples = Vec::new();
-    let mut final_profile = None;
-    for (_, t, file) in &plan.repose_dumps {
-        let path = dir.join(file);
-        if !path.exists() {
-            // A run stopped early (time limit) has only the samples it reached.
-            warnings.push(format!(
-                "no {file}: the run ended before {t} s into the stage"
-            ));
-            continue;
-        }
-        let frames = read_dump(&path)?;
-        let Some(frame) = frames.last() else {
-            return Err(PostprocessError::Content {
-                file: path,
-                message: "no frame".into(),
-            });
-        };
-        let p = frame_particles(frame, scene, &path)?;
-        if let (Some(profile), Some(r)) = (heap_profile(&p), scene.repose.as_ref()) {
-            samples.push(ReposeSample::measure(
-                &profile,
-                r,
-                max_diameter,
-                *t,
-                SampleTrigger::FixedTime,
-            ));
-            final_profile = Some(profile);
-        }
-    }
-    let mut final_profile =
-        final_profile.or_else(|| last_state.as_ref().and_then(|(_, p)| heap_profile(p)));
-    // The stage-end measurement: the last trajectory frame of the repose stage.
-    if let Some(r) = scene.repose.as_ref().filter(|r| r.at_stage_end) {
-        if let Some(mark) = marks.iter().find(|m| m.name == r.stage) {
-            let end = mark.end.as_ref().map_or(u64::MAX, |(end, _)| *end);
-            if let Some(frame) = frames
-                .iter()
-                .rev()
-                .find(|f| f.step > mark.start && f.step <= end)
-            {
-                let p = frame_particles(frame, scene, &traj_path)?;
-                if let Some(profile) = heap_profile(&p) {
-                    let t = (frame.step - mark.start) as Real * dt;
-                    samples.push(ReposeSample::measure(
-                        &profile,
-                        r,
-                        max_diameter,
-                        t,
-                        SampleTrigger::StageEnd,
-                    ));
-                    final_profile = Some(profile);
-                }
-            }
-        }
-    }
-    if let Some(profile) = &final_profile {
-        let path = dir.join("profile.csv");
-        write_atomic(&path, profile_csv(profile).as_bytes()).map_err(|e| output_error(&path, e))?;
-    }
-    if !samples.is_empty() {
-        let path = dir.join("repose.csv");
-        write_atomic(&path, repose_csv(&samples).as_bytes()).map_err(|e| output_error(&path, e))?;
-    }
-
+    let samples = write_repose(
+        scene,
+        dir,
+        plan,
+        &marks,
+        &frames,
+        last_state.as_ref().map(|(_, p)| p),
+        &mut warnings,
+    )?;
     // An unfinished stage (stopped run) ends at the last frame written.
     let last_step = frames.last().map_or(0, |f| f.step);
-    let stages: Vec<StageRecord> = marks
-        .iter()
-        .map(|m| {
-            let (end, how) = m
-                .end
-                .clone()
-                .unwrap_or((last_step.max(m.start), "did not finish".into()));
-            if how == "did not finish" {
-                warnings.push(format!(
-                    "partial run: {} stopped during stage `{}`, {:.3} s after it began",
-                    plan.code,
-                    m.name,
-                    (end - m.start) as Real * dt
-                ));
-            }
-            if how == "max_duration" {
-                warnings.push(format!(
-                    "stage `{}` did not settle within max_duration",
-                    m.name
-                ));
-            }
-            StageRecord {
-                name: m.name.clone(),
-                start_s: m.start as Real * dt,
-                end_s: end as Real * dt,
-                steps: end - m.start,
-                ended_by: how,
-            }
-        })
-        .collect();
+    let stages = stage_records(&marks, last_step, plan, &mut warnings);
     let steps = marks.last().map_or(0, |m| {
         m.end
             .as_ref()
@@ -445,6 +301,213 @@ pub fn postprocess(
         final_state: None,
         memory: None,
     })
+}
+
+/// The heap surface of one frame, measured as cgdem measures it (None without `[repose]`).
+fn frame_heap_profile(scene: &Scene, p: &FrameParticles) -> Option<HeapProfile> {
+    scene.repose.as_ref().map(|r| {
+        heap::profile(
+            &p.position,
+            &p.radius,
+            r.wall_x,
+            scene.domain.hi.x,
+            scene.domain.lo.z,
+            r.bin_width_diameters * scene.max_diameter(),
+        )
+    })
+}
+
+/// Writes `timeseries.csv`, one row per trajectory frame after step 0 (cgdem's columns);
+/// returns the last frame's step and particles.
+fn write_timeseries(
+    scene: &Scene,
+    dir: &Path,
+    marks: &[StageMark],
+    frames: &[Frame],
+    traj_path: &Path,
+    dt: Real,
+) -> Result<Option<(u64, FrameParticles)>, PostprocessError> {
+    let max_diameter = scene.max_diameter();
+    let mut csv = CsvBuffer::new([
+        "time_s",
+        "stage",
+        "kinetic_energy_j",
+        "kinetic_energy_per_mass_j_kg",
+        "n_particles",
+        "front_m",
+        "wall_height_m",
+        "mechanical_energy_j",
+    ]);
+    let origin =
+        cgdem_core::simulation::potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
+    let mut last_state = None;
+    for frame in frames.iter().filter(|f| f.step > 0) {
+        let p = frame_particles(frame, scene, traj_path)?;
+        let stage = marks
+            .iter()
+            .find(|m| {
+                frame.step > m.start && m.end.as_ref().is_none_or(|(end, _)| frame.step <= *end)
+            })
+            .map_or("", |m| m.name.as_str());
+        let ke: Real = p
+            .velocity
+            .iter()
+            .zip(&p.mass)
+            .map(|(v, m)| 0.5 * m * v.length_squared())
+            .sum::<Real>()
+            + p.rotational_energy;
+        let mass: Real = p.mass.iter().sum();
+        // Kinetic plus gravitational energy, as cgdem's `World::mechanical_energy`.
+        let potential: Real = p
+            .position
+            .iter()
+            .zip(&p.mass)
+            .map(|(&x, &m)| -m * scene.gravity.dot(x - origin))
+            .sum();
+        let profile = frame_heap_profile(scene, &p);
+        let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+        csv.row([
+            format!("{:.9e}", frame.step as Real * dt),
+            stage.to_string(),
+            format!("{ke:.9e}"),
+            format!("{:.9e}", ke / mass.max(Real::MIN_POSITIVE)),
+            p.position.len().to_string(),
+            opt(profile.as_ref().map(|p| p.front(2.0 * max_diameter))),
+            opt(profile.as_ref().map(|p| p.wall_height())),
+            format!("{:.9e}", ke + potential),
+        ]);
+        last_state = Some((frame.step, p));
+    }
+    let path = dir.join("timeseries.csv");
+    csv.bytes()
+        .and_then(|bytes| write_atomic(&path, bytes))
+        .map_err(|e| output_error(&path, e))?;
+    Ok(last_state)
+}
+
+/// The repose samples: at the fixed times of `plan`'s dumps, then (when the scene asks) at
+/// the last trajectory frame of the repose stage; writes `profile.csv` (the latest profile,
+/// else the last frame's) and `repose.csv`.
+fn write_repose(
+    scene: &Scene,
+    dir: &Path,
+    plan: &DeckPlan,
+    marks: &[StageMark],
+    frames: &[Frame],
+    last_particles: Option<&FrameParticles>,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<ReposeSample>, PostprocessError> {
+    let max_diameter = scene.max_diameter();
+    let dt = plan.dt;
+    let mut samples = Vec::new();
+    let mut final_profile = None;
+    for (_, t, file) in &plan.repose_dumps {
+        let path = dir.join(file);
+        if !path.exists() {
+            // A run stopped early (time limit) has only the samples it reached.
+            warnings.push(format!(
+                "no {file}: the run ended before {t} s into the stage"
+            ));
+            continue;
+        }
+        let frames = read_dump(&path)?;
+        let Some(frame) = frames.last() else {
+            return Err(PostprocessError::Content {
+                file: path,
+                message: "no frame".into(),
+            });
+        };
+        let p = frame_particles(frame, scene, &path)?;
+        if let (Some(profile), Some(r)) = (frame_heap_profile(scene, &p), scene.repose.as_ref()) {
+            samples.push(ReposeSample::measure(
+                &profile,
+                r,
+                max_diameter,
+                *t,
+                SampleTrigger::FixedTime,
+            ));
+            final_profile = Some(profile);
+        }
+    }
+    let mut final_profile =
+        final_profile.or_else(|| last_particles.and_then(|p| frame_heap_profile(scene, p)));
+    // The stage-end measurement: the last trajectory frame of the repose stage.
+    if let Some(r) = scene.repose.as_ref().filter(|r| r.at_stage_end) {
+        if let Some(mark) = marks.iter().find(|m| m.name == r.stage) {
+            let end = mark.end.as_ref().map_or(u64::MAX, |(end, _)| *end);
+            if let Some(frame) = frames
+                .iter()
+                .rev()
+                .find(|f| f.step > mark.start && f.step <= end)
+            {
+                let p = frame_particles(frame, scene, &dir.join(TRAJECTORY_FILE))?;
+                if let Some(profile) = frame_heap_profile(scene, &p) {
+                    let t = (frame.step - mark.start) as Real * dt;
+                    samples.push(ReposeSample::measure(
+                        &profile,
+                        r,
+                        max_diameter,
+                        t,
+                        SampleTrigger::StageEnd,
+                    ));
+                    final_profile = Some(profile);
+                }
+            }
+        }
+    }
+    if let Some(profile) = &final_profile {
+        let path = dir.join("profile.csv");
+        profile_csv(profile)
+            .and_then(|csv| write_atomic(&path, &csv))
+            .map_err(|e| output_error(&path, e))?;
+    }
+    if !samples.is_empty() {
+        let path = dir.join("repose.csv");
+        repose_csv(&samples)
+            .and_then(|csv| write_atomic(&path, &csv))
+            .map_err(|e| output_error(&path, e))?;
+    }
+    Ok(samples)
+}
+
+/// The stages as the log marks them; an unfinished one (a stopped run) ends at `last_step`.
+fn stage_records(
+    marks: &[StageMark],
+    last_step: u64,
+    plan: &DeckPlan,
+    warnings: &mut Vec<String>,
+) -> Vec<StageRecord> {
+    let dt = plan.dt;
+    marks
+        .iter()
+        .map(|m| {
+            let (end, how) = m
+                .end
+                .clone()
+                .unwrap_or((last_step.max(m.start), "did not finish".into()));
+            if how == "did not finish" {
+                warnings.push(format!(
+                    "partial run: {} stopped during stage `{}`, {:.3} s after it began",
+                    plan.code,
+                    m.name,
+                    (end - m.start) as Real * dt
+                ));
+            }
+            if how == "max_duration" {
+                warnings.push(format!(
+                    "stage `{}` did not settle within max_duration",
+                    m.name
+                ));
+            }
+            StageRecord {
+                name: m.name.clone(),
+                start_s: m.start as Real * dt,
+                end_s: end as Real * dt,
+                steps: end - m.start,
+                ended_by: how,
+            }
+        })
+        .collect()
 }
 
 /// How the atoms of a trajectory came and went, counted by id from frame to frame.

@@ -22,6 +22,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use cgdem_core::io::CsvBuffer;
 use serde::{Deserialize, Serialize};
 
 const FONT: &str = "sans-serif";
@@ -292,25 +293,14 @@ pub fn write_figure(dir: &Path, stem: &str, fig: &Figure) -> Result<FigureFiles,
     let mut files = prepared.files(dir, stem, &fig.title);
 
     let has_err = fig.series.iter().any(|s| s.y_err.is_some());
-    let mut csv = String::from(if has_err {
-        "series,x,y,y_err\n"
-    } else {
-        "series,x,y\n"
-    });
+    let mut csv = data_table(has_err);
     for s in &fig.series {
-        let label = csv_field(&s.label);
         for (i, (x, y)) in s.points.iter().enumerate() {
-            csv.push_str(&format!("{label},{x},{y}"));
-            if has_err {
-                csv.push(',');
-                if let Some(e) = s.y_err.as_ref().map(|e| e[i]) {
-                    csv.push_str(&e.to_string());
-                }
-            }
-            csv.push('\n');
+            let err = s.y_err.as_ref().map(|e| e[i]);
+            csv.row(data_row(&s.label, x.to_string(), *y, has_err, err));
         }
     }
-    write_bytes(&files.csv, csv.as_bytes())?;
+    write_table(&files.csv, csv)?;
 
     let size = (fig.width.max(200), fig.height.max(150));
     {
@@ -382,22 +372,11 @@ pub fn write_bar_chart(
     let y_range = (if lo < 0.0 { lo - pad } else { 0.0 }, hi + pad);
 
     let has_err = bars.iter().any(|b| b.3.is_some());
-    let mut csv = String::from(if has_err {
-        "series,x,y,y_err\n"
-    } else {
-        "series,x,y\n"
-    });
+    let mut csv = data_table(has_err);
     for (g, c, v, e) in bars {
-        csv.push_str(&format!("{},{},{v}", csv_field(c), csv_field(g)));
-        if has_err {
-            csv.push(',');
-            if let Some(e) = e {
-                csv.push_str(&e.to_string());
-            }
-        }
-        csv.push('\n');
+        csv.row(data_row(c, g.clone(), *v, has_err, *e));
     }
-    write_bytes(&files.csv, csv.as_bytes())?;
+    write_table(&files.csv, csv)?;
 
     let spec = BarSpec {
         title,
@@ -451,13 +430,29 @@ fn draw_err(path: &Path, e: impl fmt::Display) -> PlotError {
     }
 }
 
-/// RFC 4180 quoting when needed.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
+/// The data table beside a figure: `series,x,y` and `y_err` when some series has errors.
+fn data_table(has_err: bool) -> CsvBuffer {
+    if has_err {
+        CsvBuffer::new(["series", "x", "y", "y_err"])
     } else {
-        s.to_string()
+        CsvBuffer::new(["series", "x", "y"])
     }
+}
+
+fn data_row(series: &str, x: String, y: f64, has_err: bool, err: Option<f64>) -> Vec<String> {
+    let mut row = vec![series.to_string(), x, y.to_string()];
+    if has_err {
+        row.push(err.map_or(String::new(), |e| e.to_string()));
+    }
+    row
+}
+
+fn write_table(path: &Path, mut table: CsvBuffer) -> Result<(), PlotError> {
+    let bytes = table.bytes().map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    write_bytes(path, bytes)
 }
 
 /// Tick labels: plain decimals in [1e-3, 1e4), otherwise `2.5e-6`, and at

@@ -9,6 +9,8 @@ use cgdem_core::analysis::heap::{self, HeapProfile};
 use cgdem_core::run::RunSummary;
 use cgdem_core::scene::Scene;
 
+use crate::csv_table::CsvTable;
+
 use super::{write_figure, Figure, FigureFiles, Series, SeriesStyle};
 
 /// Writes the figures the run's measurements allow (none for a scene that measures nothing)
@@ -31,29 +33,11 @@ pub fn write_run_figures(
     Ok(files)
 }
 
-/// Reads a CSV of numbers with a header line: its rows, each cut to `columns` values.
-fn read_numbers(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    text.lines()
-        .enumerate()
-        .skip(1)
-        .filter(|(_, line)| !line.trim().is_empty())
-        .map(|(k, line)| {
-            let values: Result<Vec<f64>, _> = line
-                .split(',')
-                .take(columns)
-                .map(|v| v.trim().parse::<f64>())
-                .collect();
-            match values {
-                Ok(v) if v.len() == columns => Ok(v),
-                _ => Err(format!(
-                    "{}:{}: expected {columns} numbers, found `{line}`",
-                    path.display(),
-                    k + 1
-                )),
-            }
-        })
-        .collect()
+/// The numbers of the columns `names` of the CSV file `path`, one vector per row.
+fn read_numbers(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, String> {
+    CsvTable::read(path)
+        .and_then(|t| t.numbers(names))
+        .map_err(|e| e.to_string())
 }
 
 /// The heap profile (`profile.csv`) and the least-squares line through the bins the repose
@@ -67,7 +51,7 @@ fn heap_figure(
         return Ok(None);
     };
     let path = out_dir.join("profile.csv");
-    let rows = read_numbers(&path, 2)?;
+    let rows = read_numbers(&path, &["x_m", "height_m"])?;
     if rows.len() < 2 {
         return Ok(None);
     }
@@ -181,7 +165,10 @@ fn pore_size_figure(summary: &RunSummary, out_dir: &Path) -> Result<Option<Figur
     let Some(p) = &summary.packing else {
         return Ok(None);
     };
-    let rows = read_numbers(&out_dir.join("pore_size.csv"), 4)?;
+    let rows = read_numbers(
+        &out_dir.join("pore_size.csv"),
+        &["diameter_lo", "diameter_hi", "fraction", "cumulative"],
+    )?;
     let um = 1e6;
     let fraction: Vec<(f64, f64)> = rows
         .iter()

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::report::{write_figure, Figure, Series, SeriesStyle};
 use cgdem_core::geometry::{sdf_accuracy, AccuracyRow, ScrewFlight, TestShape};
-use cgdem_core::io::write_atomic;
+use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::Real;
 
 /// The study's shapes: sizes of the seed's screw feeder (0.1 m radius; the flight of the
@@ -48,25 +48,37 @@ pub fn write_sdf_accuracy_study(
     for shape in study_shapes() {
         rows.extend(sdf_accuracy(&shape, cell_sizes, samples, 42).map_err(|e| e.to_string())?);
     }
-    let mut csv = String::from("shape,triangles,cell_size_m,max_abs_distance_error_m,rms_distance_error_m,max_normal_error_deg,p95_normal_error_deg,memory_bytes,build_seconds,samples,normal_samples\n");
+    let mut csv = CsvBuffer::new([
+        "shape",
+        "triangles",
+        "cell_size_m",
+        "max_abs_distance_error_m",
+        "rms_distance_error_m",
+        "max_normal_error_deg",
+        "p95_normal_error_deg",
+        "memory_bytes",
+        "build_seconds",
+        "samples",
+        "normal_samples",
+    ]);
     for r in &rows {
-        csv += &format!(
-            "\"{}\",{},{:e},{:e},{:e},{:e},{:e},{},{:e},{},{}\n",
-            r.shape,
-            r.triangles,
-            r.cell_size,
-            r.max_abs_distance_error,
-            r.rms_distance_error,
-            r.max_normal_error_deg,
-            r.p95_normal_error_deg,
-            r.memory_bytes,
-            r.build_seconds,
-            r.samples,
-            r.normal_samples
-        );
+        csv.row([
+            r.shape.to_string(),
+            r.triangles.to_string(),
+            format!("{:e}", r.cell_size),
+            format!("{:e}", r.max_abs_distance_error),
+            format!("{:e}", r.rms_distance_error),
+            format!("{:e}", r.max_normal_error_deg),
+            format!("{:e}", r.p95_normal_error_deg),
+            r.memory_bytes.to_string(),
+            format!("{:e}", r.build_seconds),
+            r.samples.to_string(),
+            r.normal_samples.to_string(),
+        ]);
     }
     let csv_path = dir.join("sdf_accuracy.csv");
-    write_atomic(&csv_path, csv.as_bytes())
+    csv.bytes()
+        .and_then(|bytes| write_atomic(&csv_path, bytes))
         .map_err(|e| format!("cannot write {}: {e}", csv_path.display()))?;
     let mut written = vec![csv_path];
 

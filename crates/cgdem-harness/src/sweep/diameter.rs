@@ -28,10 +28,11 @@
 use std::path::Path;
 use std::time::Instant;
 
+use crate::csv_table::{CsvTable, TableError};
 use crate::report::{write_figure, Figure, Series, SeriesStyle};
 use cgdem_core::analysis::PackingSummary;
 use cgdem_core::contact::cohesion::{vdw_force, vdw_reach};
-use cgdem_core::io::write_atomic;
+use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::Real;
 use cgdem_core::run::{run, Progress, RunOptions, RunSummary};
 use cgdem_core::scene::{
@@ -105,7 +106,7 @@ pub fn scale_to_diameter(scene: &Scene, diameter: Real) -> Result<Scene, String>
                 *gamma_n *= s;
             }
         }
-        ContactSettings::Wca { .. } => {
+        ContactSettings::Wca(_) => {
             return Err(format!(
                 "{file}: --sweep diameter needs model = \"hertz\" (the WCA sigma is tied to the diameter and eps has no size-free meaning)"
             ))
@@ -143,22 +144,29 @@ pub struct PublishedPorosity {
 }
 
 /// The published points of `reference/packing/porosity_vs_diameter_published.csv` (compiled in).
-pub fn published_porosity() -> Vec<PublishedPorosity> {
-    parse_published(include_str!(
+pub fn published_porosity() -> Result<Vec<PublishedPorosity>, String> {
+    parse_published(include_bytes!(
         "../../../../reference/packing/porosity_vs_diameter_published.csv"
     ))
+    .map_err(|e| e.to_string())
 }
 
-fn parse_published(text: &str) -> Vec<PublishedPorosity> {
-    text.lines()
-        .filter(|l| !l.starts_with('#') && !l.starts_with("diameter_um") && !l.trim().is_empty())
-        .filter_map(|l| {
-            let mut f = l.splitn(4, ',');
-            Some(PublishedPorosity {
-                diameter_um: f.next()?.trim().parse().ok()?,
-                porosity: f.next()?.trim().parse().ok()?,
-                read_uncertainty: f.next()?.trim().parse().ok()?,
-                source: f.next()?.trim().to_string(),
+fn parse_published(text: &[u8]) -> Result<Vec<PublishedPorosity>, TableError> {
+    let table = CsvTable::parse(
+        Path::new("reference/packing/porosity_vs_diameter_published.csv"),
+        text,
+    )?;
+    let [d, porosity, uncertainty, source] =
+        ["diameter_um", "porosity", "read_uncertainty", "source"].map(|name| table.column(name));
+    let (d, porosity, uncertainty, source) = (d?, porosity?, uncertainty?, source?);
+    table
+        .rows()
+        .map(|row| {
+            Ok(PublishedPorosity {
+                diameter_um: row.parse(d)?,
+                porosity: row.parse(porosity)?,
+                read_uncertainty: row.parse(uncertainty)?,
+                source: row.text(source)?.trim().to_string(),
             })
         })
         .collect()
@@ -224,21 +232,48 @@ pub fn diameter_sweep(
         .iter()
         .map(|&d| scale_to_diameter(scene, d).map(|s| (d, s)))
         .collect::<Result<Vec<_>, _>>()?;
-    let published = published_porosity();
+    let published = published_porosity()?;
     let published_at = |d: Real| {
         published
             .iter()
             .find(|p| (p.diameter_um / (d * 1e6) - 1.0).abs() < 1e-6)
             .map(|p| p.porosity)
     };
-    let write = |name: &str, text: &str| {
-        write_atomic(&out.join(name), text.as_bytes())
+    let write = |name: &str, table: &mut CsvBuffer| {
+        table
+            .bytes()
+            .and_then(|bytes| write_atomic(&out.join(name), bytes))
             .map_err(|e| format!("cannot write {}: {e}", out.join(name).display()))
     };
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let mut csv = String::from("diameter_m,diameter_um,n_particles,steps,dt_s,contact_period_s,vdw_cutoff_gap_m,bond_number,simulated_s,settled,porosity,published_porosity,region_z_lo_m,region_z_hi_m,region_height_d,bed_height_d,mean_pore_diameter_m,median_pore_diameter_m,wall_s\n");
-    let mut psd_csv =
-        String::from("diameter_um,pore_diameter_lo_um,pore_diameter_hi_um,fraction,cumulative\n");
+    let mut csv = CsvBuffer::new([
+        "diameter_m",
+        "diameter_um",
+        "n_particles",
+        "steps",
+        "dt_s",
+        "contact_period_s",
+        "vdw_cutoff_gap_m",
+        "bond_number",
+        "simulated_s",
+        "settled",
+        "porosity",
+        "published_porosity",
+        "region_z_lo_m",
+        "region_z_hi_m",
+        "region_height_d",
+        "bed_height_d",
+        "mean_pore_diameter_m",
+        "median_pore_diameter_m",
+        "wall_s",
+    ]);
+    let mut psd_csv = CsvBuffer::new([
+        "diameter_um",
+        "pore_diameter_lo_um",
+        "pore_diameter_hi_um",
+        "fraction",
+        "cumulative",
+    ]);
     let mut results: Vec<(Real, RunSummary)> = Vec::new();
     let mut psd: Vec<(Real, Vec<(Real, Real)>)> = Vec::new();
     for (d, s) in &scenes {
@@ -259,44 +294,48 @@ pub fn diameter_sweep(
             .stages
             .last()
             .is_some_and(|st| st.ended_by.starts_with("kinetic energy"));
-        csv += &format!(
-            "{d:e},{},{},{},{:.6e},{:.6e},{},{},{:.6e},{settled},{},{},{},{},{},{},{},{},{wall:.1}\n",
+        csv.row([
+            format!("{d:e}"),
             format_um(*d),
-            summary.n_particles,
-            summary.steps,
-            summary.dt_s,
-            summary.contact_period_s,
+            summary.n_particles.to_string(),
+            summary.steps.to_string(),
+            format!("{:.6e}", summary.dt_s),
+            format!("{:.6e}", summary.contact_period_s),
             f(vdw_cutoff(s)),
             f(bond_number(s)),
-            summary.simulated_s,
+            format!("{:.6e}", summary.simulated_s),
+            settled.to_string(),
             p.map_or(String::new(), |p| format!("{:.5}", p.porosity)),
             published_at(*d).map_or(String::new(), |v| format!("{v}")),
             f(p.map(|p| p.region_z_m[0])),
             f(p.map(|p| p.region_z_m[1])),
-            p.map_or(String::new(), |p| format!("{:.2}", p.region_height_diameters)),
+            p.map_or(String::new(), |p| {
+                format!("{:.2}", p.region_height_diameters)
+            }),
             p.map_or(String::new(), |p| format!("{:.2}", p.bed_height_diameters)),
             f(p.map(|p| p.mean_pore_diameter_m)),
             f(p.map(|p| p.median_pore_diameter_m)),
-        );
-        write("porosity_vs_diameter.csv", &csv)?;
+            format!("{wall:.1}"),
+        ]);
+        write("porosity_vs_diameter.csv", &mut csv)?;
         if p.is_some() {
             let path = run_dir.join("pore_size.csv");
-            let text = std::fs::read_to_string(&path)
-                .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let rows = CsvTable::read(&path)
+                .and_then(|t| t.numbers(&["diameter_lo", "diameter_hi", "fraction", "cumulative"]))
+                .map_err(|e| e.to_string())?;
             let mut points = Vec::new();
-            for line in text.lines().skip(1) {
-                let v: Vec<Real> = line.split(',').filter_map(|x| x.parse().ok()).collect();
-                if let [lo, hi, fraction, cumulative] = v[..] {
-                    psd_csv += &format!(
-                        "{},{:.6},{:.6},{fraction:.6e},{cumulative:.6e}\n",
-                        format_um(*d),
-                        lo * 1e6,
-                        hi * 1e6
-                    );
-                    points.push((0.5 * (lo + hi) * 1e6, fraction));
-                }
+            for row in rows {
+                let (lo, hi, fraction, cumulative) = (row[0], row[1], row[2], row[3]);
+                psd_csv.row([
+                    format_um(*d),
+                    format!("{:.6}", lo * 1e6),
+                    format!("{:.6}", hi * 1e6),
+                    format!("{fraction:.6e}"),
+                    format!("{cumulative:.6e}"),
+                ]);
+                points.push((0.5 * (lo + hi) * 1e6, fraction));
             }
-            write("pore_size_vs_diameter.csv", &psd_csv)?;
+            write("pore_size_vs_diameter.csv", &mut psd_csv)?;
             psd.push((*d, points));
         }
         results.push((*d, summary));
@@ -488,7 +527,7 @@ mod tests {
 
     #[test]
     fn published_points_are_read_with_their_source() {
-        let p = published_porosity();
+        let p = published_porosity().unwrap();
         assert!(!p.is_empty());
         assert!(p.iter().all(|p| p.source.contains("paper B")
             && p.source.contains("read from the figure")

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use crate::report::{write_figure, Figure, Series, SeriesStyle};
-use cgdem_core::io::write_atomic;
+use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::Real;
 use cgdem_core::run::{run, Progress, RunOptions, RunSummary};
 use cgdem_core::scene::{Scene, StageEnd};
@@ -266,7 +266,20 @@ impl ConveyingSweep {
         reuse: bool,
     ) -> Result<Vec<(Real, RunSummary)>, String> {
         let mut results = Vec::new();
-        let mut csv = format!("{},screw_particles,mass_flow_kg_s,mass_flow_std_error_kg_s,fill_ratio,bulk_density_kg_m3,eq7_mass_flow_kg_s,eq7_full_mass_flow_kg_s,ratio_to_eq7,drive_torque_nm,drive_power_w,wall_s\n", self.variable);
+        let mut csv = CsvBuffer::new([
+            self.variable,
+            "screw_particles",
+            "mass_flow_kg_s",
+            "mass_flow_std_error_kg_s",
+            "fill_ratio",
+            "bulk_density_kg_m3",
+            "eq7_mass_flow_kg_s",
+            "eq7_full_mass_flow_kg_s",
+            "ratio_to_eq7",
+            "drive_torque_nm",
+            "drive_power_w",
+            "wall_s",
+        ]);
         let path = out.join(format!("{}.csv", self.name));
         for (x, scene) in variants {
             let options = RunOptions {
@@ -279,9 +292,9 @@ impl ConveyingSweep {
             let summary = run_or_reuse(&scene, &options, reuse)?;
             let c = summary.conveying.as_ref();
             let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-            csv += &format!(
-                "{x},{},{},{},{},{},{},{},{},{},{},{:.1}\n",
-                summary.n_body_particles,
+            csv.row([
+                x.to_string(),
+                summary.n_body_particles.to_string(),
                 f(c.map(|c| c.mass_flow_kg_s)),
                 f(c.map(|c| c.mass_flow_std_error_kg_s)),
                 f(c.map(|c| c.fill_ratio)),
@@ -291,9 +304,10 @@ impl ConveyingSweep {
                 f(c.map(|c| c.ratio_to_eq7)),
                 f(c.map(|c| c.drive_torque_nm)),
                 f(c.map(|c| c.drive_power_w)),
-                summary.wall_s,
-            );
-            write_atomic(&path, csv.as_bytes())
+                format!("{:.1}", summary.wall_s),
+            ]);
+            csv.bytes()
+                .and_then(|bytes| write_atomic(&path, bytes))
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
             results.push((x, summary));
         }

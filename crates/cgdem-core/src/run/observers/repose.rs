@@ -81,10 +81,13 @@ impl<'s> ReposeMeter<'s> {
     /// Writes `repose.csv` (all samples so far) and `profile.csv` (the latest profile).
     fn write(&self, profile: &HeapProfile) -> Result<(), RunError> {
         let path = self.out.join("profile.csv");
-        write_atomic(&path, profile_csv(profile).as_bytes()).map_err(|e| output_error(&path, e))?;
+        profile_csv(profile)
+            .and_then(|csv| write_atomic(&path, &csv))
+            .map_err(|e| output_error(&path, e))?;
         if !self.samples.is_empty() {
             let path = self.out.join("repose.csv");
-            write_atomic(&path, repose_csv(&self.samples).as_bytes())
+            repose_csv(&self.samples)
+                .and_then(|csv| write_atomic(&path, &csv))
                 .map_err(|e| output_error(&path, e))?;
         }
         Ok(())

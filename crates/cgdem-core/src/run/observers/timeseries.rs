@@ -3,7 +3,6 @@
 //! settling stage, whose condition is judged at these rows.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 use crate::contact::PairLaw;
@@ -20,7 +19,7 @@ use super::{Due, Flow, Observer, StageClock};
 pub(crate) struct TimeSeries<'s> {
     scene: &'s Scene,
     path: PathBuf,
-    file: BufWriter<File>,
+    file: csv::Writer<File>,
     next_row: Real,
     /// The conveying body's settings and index, for the conveying columns.
     conveying: Option<(&'s ConveyingSettings, usize)>,
@@ -38,22 +37,36 @@ impl<'s> TimeSeries<'s> {
         let mut series = TimeSeries {
             scene,
             path,
-            file: BufWriter::new(file),
+            file: csv::Writer::from_writer(file),
             next_row: 0.0,
             conveying,
             settle: None,
         };
-        let body_columns: String = scene
-            .bodies
-            .iter()
-            .map(|b| format!(",axial_torque_{}_nm", b.name))
-            .collect();
-        let conveying_columns = if conveying.is_some() {
-            ",fill_ratio,bulk_density_kg_m3,passed_mass_kg"
-        } else {
-            ""
-        };
-        writeln!(series.file, "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles,front_m,wall_height_m,deleted_mass_kg{body_columns}{conveying_columns},mechanical_energy_j")
+        let mut header: Vec<String> = [
+            "time_s",
+            "stage",
+            "kinetic_energy_j",
+            "kinetic_energy_per_mass_j_kg",
+            "n_particles",
+            "front_m",
+            "wall_height_m",
+            "deleted_mass_kg",
+        ]
+        .map(String::from)
+        .into();
+        header.extend(
+            scene
+                .bodies
+                .iter()
+                .map(|b| format!("axial_torque_{}_nm", b.name)),
+        );
+        if conveying.is_some() {
+            header.extend(["fill_ratio", "bulk_density_kg_m3", "passed_mass_kg"].map(String::from));
+        }
+        header.push("mechanical_energy_j".into());
+        series
+            .file
+            .write_record(&header)
             .map_err(|e| output_error(&series.path, e))?;
         Ok(series)
     }
@@ -85,32 +98,31 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
         let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
         let wall_height = profile.as_ref().map(|p| p.wall_height());
         let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-        let mut extra = format!(",{:.9e}", world.deleted_mass);
+        let mut row = vec![
+            format!("{:.9e}", world.time),
+            clock.stage.name.clone(),
+            format!("{ke:.9e}"),
+            format!("{:.9e}", ke / mass.max(Real::MIN_POSITIVE)),
+            world.particles.len().to_string(),
+            opt(front),
+            opt(wall_height),
+            format!("{:.9e}", world.deleted_mass),
+        ];
         for body in world.bodies() {
-            extra += &format!(",{:.6e}", body.axial_torque());
+            row.push(format!("{:.6e}", body.axial_torque()));
         }
         if let Some((c, k)) = self.conveying {
             let sample = conveying_sample(c, &world.bodies()[k], world);
-            extra += &format!(
-                ",{:.6e},{:.6e},{:.9e}",
-                sample.fill_ratio, sample.bulk_density, sample.passed_mass
-            );
+            row.push(format!("{:.6e}", sample.fill_ratio));
+            row.push(format!("{:.6e}", sample.bulk_density));
+            row.push(format!("{:.9e}", sample.passed_mass));
         }
         // Kinetic plus gravitational energy, for the stability suite's energy balance.
-        extra += &format!(",{:.9e}", world.mechanical_energy());
-        writeln!(
-            self.file,
-            "{:.9e},{},{:.9e},{:.9e},{},{},{}{extra}",
-            world.time,
-            clock.stage.name,
-            ke,
-            ke / mass.max(Real::MIN_POSITIVE),
-            world.particles.len(),
-            opt(front),
-            opt(wall_height)
-        )
-        .and_then(|()| self.file.flush())
-        .map_err(|e| output_error(&self.path, e))?;
+        row.push(format!("{:.9e}", world.mechanical_energy()));
+        self.file
+            .write_record(&row)
+            .and_then(|()| Ok(self.file.flush()?))
+            .map_err(|e| output_error(&self.path, e))?;
         if let Some((threshold, min_duration)) = self.settle {
             if elapsed >= min_duration && ke / mass < threshold {
                 return Ok(Flow::EndStage(StageEnding::Settled {

@@ -85,12 +85,12 @@ fn wca_contact(
             return Err(c.invalid("contact.sigma", sigma, format!("2^(1/6) sigma within 1% of the diameter of species `{}` ({} m), i.e. sigma near {:.6e}", s.name, s.diameter, s.diameter / TWO_POW_ONE_SIXTH)));
         }
     }
-    Ok(ContactSettings::Wca {
+    Ok(ContactSettings::Wca(WcaSettings {
         epsilon,
         sigma,
         gamma_n,
         gamma_t,
-    })
+    }))
 }
 
 pub(super) fn poisson(c: &Checker, field: &str, nu: f64) -> Result<f64, SceneError> {

@@ -1,0 +1,432 @@
+//! One run of a suite case by one code (cgdem, LAMMPS or LIGGGHTS) into its directory, or
+//! with `--reuse` the run already there, and what it measured (`RunRecord`); shared by the
+//! validation report (`validate`), the accuracy sweeps and the screw sections, which need
+//! these types and this runner but not each other.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::code::Code;
+use crate::suite_entry::SuiteError;
+use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
+use cgdem_core::run::{run, Progress, RunOptions};
+use cgdem_core::scene::Scene;
+
+/// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    /// It ran and its summary was read (it may still have stopped early: `partial`).
+    Ok,
+    Failed,
+    /// Not run: the code cannot run this scene, or it is not installed.
+    Skipped,
+}
+
+impl Outcome {
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Ok => "ok",
+            Outcome::Failed => "failed",
+            Outcome::Skipped => "skipped",
+        }
+    }
+}
+
+impl std::fmt::Display for Outcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One run of one code, as recorded in the suite's `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunRecord {
+    pub case: String,
+    pub code: Code,
+    pub lambda: u32,
+    pub cg_rule: CoarseGrainRule,
+    pub seed: u64,
+    pub status: Outcome,
+    pub reason: Option<String>,
+    pub dir: PathBuf,
+    pub n_particles: Option<u64>,
+    pub steps: Option<u64>,
+    pub wall_s: Option<f64>,
+    pub particle_steps_per_s: Option<f64>,
+    pub repose_angle_deg: Option<f64>,
+    pub repose_fit_r2: Option<f64>,
+    pub runout_m: Option<f64>,
+    /// The run was not repeated: its directory already held it (`--reuse`).
+    pub reused: bool,
+    /// The run stopped before its last stage ended (time limit, killed, stopped by a
+    /// guard): its fixed-time samples and histories count, its final state does not.
+    pub partial: bool,
+    /// Screw speed of a conveying case run at a suite's `rpms`, rev/min.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rpm: Option<f64>,
+    /// The conveying measurement (`analysis::conveying`) of a screw case.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_flow_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_flow_std_error_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fill_ratio: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bulk_density_kg_m3: Option<f64>,
+    /// Eq. (7) with the measured fill ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eq7_mass_flow_kg_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio_to_eq7: Option<f64>,
+}
+
+impl RunRecord {
+    /// A run that has not failed, with nothing measured yet.
+    pub fn ok(
+        case: String,
+        code: Code,
+        lambda: u32,
+        cg_rule: CoarseGrainRule,
+        seed: u64,
+        dir: PathBuf,
+    ) -> RunRecord {
+        RunRecord {
+            case,
+            code,
+            lambda,
+            cg_rule,
+            seed,
+            status: Outcome::Ok,
+            reason: None,
+            dir,
+            n_particles: None,
+            steps: None,
+            wall_s: None,
+            particle_steps_per_s: None,
+            repose_angle_deg: None,
+            repose_fit_r2: None,
+            runout_m: None,
+            reused: false,
+            partial: false,
+            rpm: None,
+            mass_flow_kg_s: None,
+            mass_flow_std_error_kg_s: None,
+            fill_ratio: None,
+            bulk_density_kg_m3: None,
+            eq7_mass_flow_kg_s: None,
+            ratio_to_eq7: None,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ValidateError {
+    #[error(transparent)]
+    Suite(#[from] SuiteError),
+    #[error("{file}: {message}")]
+    Case { file: PathBuf, message: String },
+    #[error("cannot write {path}: {message}")]
+    Output { path: PathBuf, message: String },
+}
+
+pub(super) fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateError {
+    ValidateError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+#[derive(Clone)]
+pub struct ValidateOptions {
+    pub suite: PathBuf,
+    pub out: PathBuf,
+    pub quiet: bool,
+    /// Where cgdem's runs report their progress.
+    pub progress: Option<Progress>,
+    /// Time limit of one reference-code run, seconds.
+    pub reference_timeout_s: u64,
+    /// Reuse a run directory that already holds this exact run (an interrupted suite resumes;
+    /// a report is rebuilt without re-running): when its summary's scene digest matches, or
+    /// for a reference run without one, when its deck is the one the case writes now (its
+    /// dumps are then post-processed again by the current code).
+    pub reuse: bool,
+    /// cgdem's guards only warn instead of stopping a run (`--keep-going`).
+    pub keep_going: bool,
+    /// Runs of a case made at the same time (`--jobs`), sharing the threads.
+    pub jobs: usize,
+    /// Raised on SIGINT/SIGTERM: runs in progress stop (cgdem at the end of a step, reference
+    /// codes with their process tree) and record why; no further run starts.
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Planted faults (`--fault KEY=VALUE`): scene overrides applied to cgdem's runs only,
+    /// after the case's own, the scene keeping its name, so that its comparisons with the
+    /// reference codes show whether the verdicts can fail (scripts/planted-faults.sh).
+    pub cgdem_faults: Vec<String>,
+    /// A nightly history directory (`history.json`, `cgdem history`): the report's first
+    /// screen says what moved since the last night recorded there.
+    pub history: Option<PathBuf>,
+}
+
+/// `run` applied to every item, `jobs` at a time, results in the items' order. With more
+/// than one job, the cores of the calling rayon pool are shared out: each job runs in a pool
+/// of its own with `threads / jobs` threads (at least one), so cgdem runs do not oversubscribe
+/// the machine; a reference code runs as one process per job.
+pub(super) fn run_concurrently<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    run: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    if jobs <= 1 || items.len() <= 1 {
+        return items.iter().map(&run).collect();
+    }
+    let threads_per_job = (rayon::current_num_threads() / jobs).max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<std::sync::Mutex<Option<R>>> =
+        items.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.min(items.len()) {
+            scope.spawn(|| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads_per_job)
+                    .build();
+                loop {
+                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some(item) = items.get(k) else { break };
+                    let result = match &pool {
+                        Ok(pool) => pool.install(|| run(item)),
+                        Err(_) => run(item), // no pool of its own: the global one
+                    };
+                    *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+                }
+            });
+        }
+    });
+    results
+        .into_iter()
+        .map(|r| {
+            r.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .expect("every item is taken by exactly one job")
+        })
+        .collect()
+}
+
+/// Runs one code on one setting (or, with `--reuse`, takes the run already in `dir`) and
+/// reads what it measured; a run that could not be made is recorded as skipped or failed.
+pub(super) fn run_one(
+    scene: &Scene,
+    code: Code,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    options: &ValidateOptions,
+) -> RunRecord {
+    let mut record = RunRecord::ok(
+        scene.name.clone(),
+        code,
+        lambda,
+        rule,
+        seed,
+        dir.to_path_buf(),
+    );
+    let outcome = match code {
+        Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
+        Code::Lammps | Code::Liggghts => {
+            run_reference_code(code, scene, lambda, rule, seed, dir, options)
+        }
+    };
+    match outcome {
+        Ok(reused) => {
+            record.reused = reused;
+            fill_from_summary(&mut record);
+        }
+        Err(RunOutcome::Skipped(reason)) => {
+            record.status = Outcome::Skipped;
+            record.reason = Some(reason);
+        }
+        Err(RunOutcome::Failed(reason)) => {
+            record.status = Outcome::Failed;
+            record.reason = Some(reason);
+        }
+    }
+    record
+}
+
+enum RunOutcome {
+    Skipped(String),
+    Failed(String),
+}
+
+/// Runs cgdem, or with `--reuse` takes the run already in `dir`; true when reused.
+fn run_cgdem(
+    scene: &Scene,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    options: &ValidateOptions,
+) -> Result<bool, RunOutcome> {
+    let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))?;
+    if options.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+        return Ok(true);
+    }
+    let run_options = RunOptions {
+        out_dir: dir.to_path_buf(),
+        progress: options.progress.clone(),
+        force_dt: false,
+        keep_going: options.keep_going,
+        stop: options.stop.clone(),
+        ..Default::default()
+    };
+    run(&coarse, &run_options)
+        .map(|_| false)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))
+}
+
+/// The scene digest in `dir/summary.json`, if a finished run left one.
+fn finished_digest(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value.get("scene_digest")?.as_str().map(str::to_string)
+}
+
+/// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
+/// reused. LIGGGHTS cannot express the seed's WCA model: its runs of such a case are skipped.
+fn run_reference_code(
+    code: Code,
+    scene: &Scene,
+    lambda: u32,
+    rule: CoarseGrainRule,
+    seed: u64,
+    dir: &Path,
+    validate: &ValidateOptions,
+) -> Result<bool, RunOutcome> {
+    use super::lammps::{RunStatus, RunnerOptions};
+    use super::reference::{run_reference, ReferenceOptions};
+    let reference = match code {
+        Code::Liggghts => Code::Liggghts,
+        _ => Code::Lammps,
+    };
+    if reference == Code::Liggghts
+        && matches!(scene.contact, cgdem_core::scene::ContactSettings::Wca(_))
+    {
+        return Err(RunOutcome::Skipped(
+            "LIGGGHTS cannot express the seed's WCA model (model = \"wca\"); it runs Hertz cases"
+                .into(),
+        ));
+    }
+    let name = reference.label();
+    let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
+        .map_err(|e| RunOutcome::Failed(e.to_string()))?;
+    let mut options = ReferenceOptions {
+        code: reference,
+        runner: RunnerOptions {
+            np: None,
+            timeout: std::time::Duration::from_secs(validate.reference_timeout_s),
+            stop: validate.stop.clone(),
+        },
+        ..ReferenceOptions::default()
+    };
+    // A finished run of this very scene is reused; one whose deck is the one this case
+    // writes now (an older summary without a digest) is post-processed again; anything else
+    // (no run, another deck, dumps gone) runs.
+    if validate.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+        return Ok(true);
+    }
+    if validate.reuse && dir.join("summary.json").exists() {
+        options.postprocess_only = true;
+        if let Ok(run) = run_reference(&coarse, dir, &options) {
+            if run.summary.is_some() {
+                return Ok(true);
+            }
+        }
+        options.postprocess_only = false;
+    }
+    let run = run_reference(&coarse, dir, &options).map_err(RunOutcome::Failed)?;
+    match run.status {
+        RunStatus::Completed { .. } => Ok(false),
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => Err(RunOutcome::Skipped(format!(
+            "{reason}; install with `{install_hint}`"
+        ))),
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => Err(RunOutcome::Failed(format!(
+            "{name} exit code {exit_code:?}; log tail: {log_tail}"
+        ))),
+        RunStatus::TimedOut { after_s, log_tail } => Err(RunOutcome::Failed(format!(
+            "{name} timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
+        ))),
+    }
+}
+
+fn fill_from_summary(record: &mut RunRecord) {
+    let path = record.dir.join("summary.json");
+    let value: serde_json::Value = match std::fs::read_to_string(&path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+    {
+        Ok(v) => v,
+        Err(e) => {
+            record.status = Outcome::Failed;
+            record.reason = Some(format!("{}: {e}", path.display()));
+            return;
+        }
+    };
+    let f = |key: &str| value.get(key).and_then(|v| v.as_f64());
+    record.n_particles = value.get("n_particles").and_then(|v| v.as_u64());
+    record.steps = value.get("steps").and_then(|v| v.as_u64());
+    record.wall_s = f("wall_s");
+    record.particle_steps_per_s = f("particle_steps_per_s");
+    record.repose_angle_deg = f("repose_angle_deg");
+    record.repose_fit_r2 = f("repose_fit_r2");
+    record.runout_m = f("runout_m");
+    let conveying = |key: &str| value["conveying"][key].as_f64();
+    record.mass_flow_kg_s = conveying("mass_flow_kg_s");
+    record.mass_flow_std_error_kg_s = conveying("mass_flow_std_error_kg_s");
+    record.fill_ratio = conveying("fill_ratio");
+    record.bulk_density_kg_m3 = conveying("bulk_density_kg_m3");
+    record.eq7_mass_flow_kg_s = conveying("eq7_mass_flow_kg_s");
+    record.ratio_to_eq7 = conveying("ratio_to_eq7");
+    let unfinished = value["stages"].as_array().and_then(|stages| {
+        stages.iter().find(|st| {
+            let how = st["ended_by"].as_str().unwrap_or("");
+            how == "did not finish" || how.starts_with("stopped")
+        })
+    });
+    if let Some(stage) = unfinished {
+        record.partial = true;
+        record.reason = Some(format!(
+            "partial: stage `{}` {} after {:.2} s",
+            stage["name"].as_str().unwrap_or("?"),
+            stage["ended_by"].as_str().unwrap_or("?"),
+            stage["end_s"].as_f64().unwrap_or(0.0) - stage["start_s"].as_f64().unwrap_or(0.0),
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outcomes_keep_the_words_of_summary_json_and_the_history_files() {
+        for (outcome, word) in [
+            (Outcome::Ok, "ok"),
+            (Outcome::Failed, "failed"),
+            (Outcome::Skipped, "skipped"),
+        ] {
+            let json = format!("\"{word}\"");
+            assert_eq!(serde_json::to_string(&outcome).unwrap(), json);
+            assert_eq!(serde_json::from_str::<Outcome>(&json).unwrap(), outcome);
+            assert_eq!(outcome.to_string(), word);
+        }
+        assert!(serde_json::from_str::<Outcome>("\"completed\"").is_err());
+    }
+}
