@@ -144,29 +144,8 @@ pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: 
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
-    let q_of = |e: Real| {
-        tsuji_q(e).ok_or_else(|| {
-            unsupported(if e < 0.5 {
-                format!("restitution {e}: damping tsuji cannot reach LIGGGHTS's dashpot below e ~ 0.114")
-            } else {
-                format!("restitution {e}: damping tsuji cannot damp as little as LIGGGHTS's dashpot does (its least damping, q = 1, is more)")
-            })
-        })
-    };
     let m = material(h);
-    let (y_eff, g_eff) = (Material::y_eff(m, m), Material::g_eff(m, m));
-    let x_t = tangential_damping_ratio(y_eff, g_eff);
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
-    // Rolling stiffness at the scene's characteristic speed, for the first species pair.
-    let s0 = &scene.species[0];
-    let rolling = |y: Real, gg: Real, r: Real, mass: Real| match h.rolling {
-        RollingKind::Epsd2 => format!(
-            " rolling sds {} 0.0 {}",
-            g(rolling_stiffness(y, gg, r, mass, h.characteristic_velocity)),
-            g(h.rolling_friction)
-        ),
-        _ => String::new(),
-    };
 
     let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
     let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
@@ -182,89 +161,13 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     let mut d = written_by(Code::Lammps, scene);
     d += "): Hertz, reference/MAPPING.md.\n";
     d += &preamble(Code::Lammps, scene);
-    d += "pair_style      granular\n";
-    let _ = writeln!(
-        d,
-        "# q = P^-1(sqrt(5)|beta(e)|) for e = {}; x = sqrt(4 G*/Y*)",
-        h.restitution
-    );
-    let _ = writeln!(
-        d,
-        "pair_coeff      * * hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {}{}",
-        g(m.youngs_modulus),
-        g(q_of(h.restitution)?),
-        g(m.poisson_ratio),
-        g(x_t),
-        g(h.friction),
-        rolling(y_eff, g_eff, s0.radius() * 0.5, s0.mass() * 0.5)
-    );
+    d += &pair_lines(scene, h, m)?;
     d += &neighbor_lines(Code::Lammps, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
-    let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
-    if scene.gravity.length() > 0.0 {
-        let dir = scene.gravity / scene.gravity.length();
-        let _ = writeln!(
-            d,
-            "fix             grav all gravity {} vector {} {} {}",
-            g(scene.gravity.length()),
-            g(dir.x),
-            g(dir.y),
-            g(dir.z)
-        );
-    }
-    let _ = writeln!(d, "timestep        {}", g(dt));
-    // Particle-wall pair values, passed so that this LAMMPS computes them exactly: its
-    // fix wall/gran hertz/material takes k_n = (4/3) E/(2(1 - nu)) sqrt(R delta) (measured:
-    // contact 10% short with E itself, (1 + nu)^(-2/5)), so E is given as 2 (1 - nu) Y_eff;
-    // the Mindlin stiffness is given explicitly (8 G_eff) rather than NULL.
-    let wm = wall_material(scene, h);
-    let (y_w, g_w) = (Material::y_eff(m, wm), Material::g_eff(m, wm));
-    let w = &scene.wall_contact;
-    // The wall acts as a particle of infinite radius and mass: R_eff = r, m_eff = m.
-    let wall_rolling = if h.rolling == RollingKind::Epsd2 {
-        format!(
-            " rolling sds {} 0.0 {}",
-            g(rolling_stiffness(
-                y_w,
-                g_w,
-                s0.radius(),
-                s0.mass(),
-                h.characteristic_velocity
-            )),
-            g(w.rolling_friction)
-        )
-    } else {
-        String::new()
-    };
-    let wall_model = if scene.walls.is_empty() && scene.bodies.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{wall_rolling}",
-            g(2.0 * (1.0 - m.poisson_ratio) * y_w),
-            g(q_of(w.restitution)?),
-            g(m.poisson_ratio),
-            g(8.0 * g_w),
-            g(tangential_damping_ratio(y_w, g_w)),
-            g(w.friction),
-        )
-    };
-    for wall in &scene.walls {
-        let (axis, up) = wall_axis(scene, wall)?;
-        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
-        let (lo, hi) = if up {
-            (at, "NULL".to_string())
-        } else {
-            ("NULL".to_string(), at)
-        };
-        let _ = writeln!(
-            d,
-            "fix             w_{} all wall/gran granular {wall_model} {}plane {lo} {hi}",
-            wall.name,
-            ["x", "y", "z"][axis]
-        );
-    }
+    d += &integration_lines(scene, integrated, dt);
+    let wall_model = wall_model(scene, h, m)?;
+    d += &wall_fix_lines(scene, &wall_model)?;
     let bodies = super::bodies::body_lines(scene, integrated, &wall_model)?;
     d += &bodies.setup;
     // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
@@ -281,15 +184,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         }
     }
     d += &super::deck::removal_pads(scene, 1);
-    for (k, (lo, hi)) in scene.deletions.iter().enumerate() {
-        // Grains whose centres enter the box are removed, checked every output interval.
-        d += &block_region(&format!("delete_{k}"), *lo, *hi);
-        let _ = writeln!(
-            d,
-            "fix             delete_{k} {integrated} evaporate {dump_every} 1000000 delete_{k} {}",
-            DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()]
-        );
-    }
+    d += &deletion_lines(scene, integrated, dump_every);
     let top_ups = top_up_lines(scene, integrated, dt, &mut files);
     d += &top_ups.setup;
     d += &kinetic_energy_lines(dump_every, true);
@@ -333,13 +228,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     if !bodies.refix_walls.is_empty() && later_setups {
         notes.push("LAMMPS: the body region's wall fix is defined anew at each setup (when the screw starts, at each top-up), so grains sliding on the casing lose their tangential history then".into());
     }
-    if !scene.deletions.is_empty() {
-        notes.push(format!("LAMMPS deletes grains in a [[delete]] box every {dump_every} steps (fix evaporate), cgdem every step"));
-    }
-    if h.rolling == RollingKind::Epsd2 {
-        notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
-    }
-    notes.push("LAMMPS tangential mindlin is not LIGGGHTS tangential history: full radii in the contact-point velocity, spring + dashpot capped at the Coulomb limit (reference/MAPPING.md)".into());
+    notes.extend(model_notes(scene, h, dump_every));
     Ok(Deck {
         input: d,
         data,
@@ -353,6 +242,164 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
             repose_dumps,
         },
     })
+}
+
+/// LAMMPS's Tsuji coefficient `q` for restitution `e`, or why this LAMMPS cannot damp so.
+fn tsuji_q_of(scene: &Scene, e: Real) -> Result<Real, DeckError> {
+    tsuji_q(e).ok_or_else(|| {
+        DeckError::unsupported(scene, if e < 0.5 {
+            format!("restitution {e}: damping tsuji cannot reach LIGGGHTS's dashpot below e ~ 0.114")
+        } else {
+            format!("restitution {e}: damping tsuji cannot damp as little as LIGGGHTS's dashpot does (its least damping, q = 1, is more)")
+        })
+    })
+}
+
+/// `pair_style granular` with the particle-particle `pair_coeff` (Hertz, Tsuji damping,
+/// Mindlin, and `rolling sds` for epsd2 at the scene's characteristic speed, first species).
+fn pair_lines(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, DeckError> {
+    let (y_eff, g_eff) = (Material::y_eff(m, m), Material::g_eff(m, m));
+    let s0 = &scene.species[0];
+    let rolling = match h.rolling {
+        RollingKind::Epsd2 => format!(
+            " rolling sds {} 0.0 {}",
+            g(rolling_stiffness(
+                y_eff,
+                g_eff,
+                s0.radius() * 0.5,
+                s0.mass() * 0.5,
+                h.characteristic_velocity
+            )),
+            g(h.rolling_friction)
+        ),
+        _ => String::new(),
+    };
+    let mut d = String::from("pair_style      granular\n");
+    let _ = writeln!(
+        d,
+        "# q = P^-1(sqrt(5)|beta(e)|) for e = {}; x = sqrt(4 G*/Y*)",
+        h.restitution
+    );
+    let _ = writeln!(
+        d,
+        "pair_coeff      * * hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {}{}",
+        g(m.youngs_modulus),
+        g(tsuji_q_of(scene, h.restitution)?),
+        g(m.poisson_ratio),
+        g(tangential_damping_ratio(y_eff, g_eff)),
+        g(h.friction),
+        rolling
+    );
+    Ok(d)
+}
+
+/// Time integration of the `integrated` group, gravity and the time step.
+fn integration_lines(scene: &Scene, integrated: &str, dt: Real) -> String {
+    let mut d = String::new();
+    let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
+    if scene.gravity.length() > 0.0 {
+        let dir = scene.gravity / scene.gravity.length();
+        let _ = writeln!(
+            d,
+            "fix             grav all gravity {} vector {} {} {}",
+            g(scene.gravity.length()),
+            g(dir.x),
+            g(dir.y),
+            g(dir.z)
+        );
+    }
+    let _ = writeln!(d, "timestep        {}", g(dt));
+    d
+}
+
+/// The particle-wall model of `fix wall/gran granular` (planar walls and body regions),
+/// empty for a scene with neither.
+fn wall_model(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, DeckError> {
+    let s0 = &scene.species[0];
+    // Particle-wall pair values, passed so that this LAMMPS computes them exactly: its
+    // fix wall/gran hertz/material takes k_n = (4/3) E/(2(1 - nu)) sqrt(R delta) (measured:
+    // contact 10% short with E itself, (1 + nu)^(-2/5)), so E is given as 2 (1 - nu) Y_eff;
+    // the Mindlin stiffness is given explicitly (8 G_eff) rather than NULL.
+    let wm = wall_material(scene, h);
+    let (y_w, g_w) = (Material::y_eff(m, wm), Material::g_eff(m, wm));
+    let w = &scene.wall_contact;
+    // The wall acts as a particle of infinite radius and mass: R_eff = r, m_eff = m.
+    let wall_rolling = if h.rolling == RollingKind::Epsd2 {
+        format!(
+            " rolling sds {} 0.0 {}",
+            g(rolling_stiffness(
+                y_w,
+                g_w,
+                s0.radius(),
+                s0.mass(),
+                h.characteristic_velocity
+            )),
+            g(w.rolling_friction)
+        )
+    } else {
+        String::new()
+    };
+    if scene.walls.is_empty() && scene.bodies.is_empty() {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{wall_rolling}",
+        g(2.0 * (1.0 - m.poisson_ratio) * y_w),
+        g(tsuji_q_of(scene, w.restitution)?),
+        g(m.poisson_ratio),
+        g(8.0 * g_w),
+        g(tangential_damping_ratio(y_w, g_w)),
+        g(w.friction),
+    ))
+}
+
+/// One `fix wall/gran` per planar wall, with the particle-wall `model`.
+fn wall_fix_lines(scene: &Scene, wall_model: &str) -> Result<String, DeckError> {
+    let mut lines = String::new();
+    for wall in &scene.walls {
+        let (axis, up) = wall_axis(scene, wall)?;
+        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
+        let (lo, hi) = if up {
+            (at, "NULL".to_string())
+        } else {
+            ("NULL".to_string(), at)
+        };
+        let _ = writeln!(
+            lines,
+            "fix             w_{} all wall/gran granular {wall_model} {}plane {lo} {hi}",
+            wall.name,
+            ["x", "y", "z"][axis]
+        );
+    }
+    Ok(lines)
+}
+
+/// `[[delete]]` boxes: grains whose centres enter one are removed, checked every output
+/// interval.
+fn deletion_lines(scene: &Scene, integrated: &str, dump_every: u64) -> String {
+    let mut d = String::new();
+    for (k, (lo, hi)) in scene.deletions.iter().enumerate() {
+        d += &block_region(&format!("delete_{k}"), *lo, *hi);
+        let _ = writeln!(
+            d,
+            "fix             delete_{k} {integrated} evaporate {dump_every} 1000000 delete_{k} {}",
+            DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()]
+        );
+    }
+    d
+}
+
+/// Where this LAMMPS deck's model differs from cgdem's and LIGGGHTS's.
+fn model_notes(scene: &Scene, h: &HertzSettings, dump_every: u64) -> Vec<String> {
+    let mut notes = Vec::new();
+    if !scene.deletions.is_empty() {
+        notes.push(format!("LAMMPS deletes grains in a [[delete]] box every {dump_every} steps (fix evaporate), cgdem every step"));
+    }
+    if h.rolling == RollingKind::Epsd2 {
+        notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
+    }
+    notes.push("LAMMPS tangential mindlin is not LIGGGHTS tangential history: full radii in the contact-point velocity, spring + dashpot capped at the Coulomb limit (reference/MAPPING.md)".into());
+    notes
 }
 
 /// Seeds of LAMMPS's random deletions and top-ups (primes; any positive integer will do).

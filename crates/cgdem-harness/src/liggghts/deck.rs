@@ -22,7 +22,7 @@ use crate::lammps::deck::{
 use crate::lammps::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{RollingKind, Scene};
+use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
 
 pub const DECK_FILE: &str = "deck.in";
 pub const LOG_FILE: &str = "log.liggghts";
@@ -37,8 +37,10 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     let h = hertz_settings(scene, "LIGGGHTS", true)?;
     let n = scene.species.len();
     // Planar walls and meshes share one atom type, whose material is `[wall_contact]`.
-    let has_walls = !scene.walls.is_empty() || !scene.bodies.is_empty();
-    let n_types = n + usize::from(has_walls);
+    let types = AtomTypes {
+        particles: n,
+        wall: !scene.walls.is_empty() || !scene.bodies.is_empty(),
+    };
     let (m, wm) = (material(h), wall_material(scene, h));
     for (what, e) in [
         ("contact.youngs_modulus", m.youngs_modulus),
@@ -55,26 +57,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
 
     let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
     let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
-    let data = data_file(scene, particles, &diameters, &densities, n_types);
-
-    // Per-type and per-type-pair tables; the wall type pairs with particles only.
-    let w = &scene.wall_contact;
-    let per_type = |particle: Real, wall: Real| {
-        let mut v = vec![g(particle); n];
-        if has_walls {
-            v.push(g(wall));
-        }
-        v.join(" ")
-    };
-    let per_pair = |particle: Real, wall: Real| {
-        let mut v = Vec::new();
-        for a in 0..n_types {
-            for b in 0..n_types {
-                v.push(g(if a == n || b == n { wall } else { particle }));
-            }
-        }
-        format!("{n_types} {}", v.join(" "))
-    };
+    let data = data_file(scene, particles, &diameters, &densities, types.count());
 
     let mut d = written_by(Code::Liggghts, scene);
     d += ").\n";
@@ -82,40 +65,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     d += &neighbor_lines(Code::Liggghts, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
-    // LIGGGHTS refuses E > 1e9 Pa in SI units unless told the particles are hard (steel).
-    if m.youngs_modulus.max(wm.youngs_modulus) > 1e9 {
-        d += "hard_particles  yes\n";
-    }
-    let _ = writeln!(
-        d,
-        "fix             m1 all property/global youngsModulus peratomtype {}",
-        per_type(m.youngs_modulus, wm.youngs_modulus)
-    );
-    let _ = writeln!(
-        d,
-        "fix             m2 all property/global poissonsRatio peratomtype {}",
-        per_type(m.poisson_ratio, wm.poisson_ratio)
-    );
-    let _ = writeln!(
-        d,
-        "fix             m3 all property/global coefficientRestitution peratomtypepair {}",
-        per_pair(h.restitution, w.restitution)
-    );
-    let _ = writeln!(
-        d,
-        "fix             m4 all property/global coefficientFriction peratomtypepair {}",
-        per_pair(h.friction, w.friction)
-    );
-    let rolling = if h.rolling == RollingKind::Epsd2 {
-        let _ = writeln!(
-            d,
-            "fix             m5 all property/global coefficientRollingFriction peratomtypepair {}",
-            per_pair(h.rolling_friction, w.rolling_friction)
-        );
-        " rolling_friction epsd2"
-    } else {
-        ""
-    };
+    let (materials, rolling) = material_lines(scene, h, &types);
+    d += &materials;
     let _ = writeln!(
         d,
         "pair_style      gran model hertz tangential history{rolling}"
@@ -134,18 +85,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             g(dir.z)
         );
     }
-    for wall in &scene.walls {
-        let (axis, _) = wall_axis(scene, wall)?;
-        let at = [wall.point.x, wall.point.y, wall.point.z][axis];
-        let _ = writeln!(
-            d,
-            "fix             w_{} all wall/gran model hertz tangential history{rolling} primitive type {} {}plane {}",
-            wall.name,
-            n + 1,
-            ["x", "y", "z"][axis],
-            g(at)
-        );
-    }
+    d += &wall_lines(scene, n + 1, rolling)?;
     let meshes = mesh_lines(scene, n + 1, rolling)?;
     d += &meshes.setup;
     d += &kinetic_energy_lines(dump_every, true);
@@ -186,6 +126,100 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         },
         files: meshes.files,
     })
+}
+
+/// LIGGGHTS's atom types: one per species, then one for all walls and meshes when the scene
+/// has any (it pairs with particles only).
+struct AtomTypes {
+    particles: usize,
+    wall: bool,
+}
+
+impl AtomTypes {
+    fn count(&self) -> usize {
+        self.particles + usize::from(self.wall)
+    }
+
+    /// A `peratomtype` table: `particle` for every species, `wall` for the wall type.
+    fn per_type(&self, particle: Real, wall: Real) -> String {
+        let mut v = vec![g(particle); self.particles];
+        if self.wall {
+            v.push(g(wall));
+        }
+        v.join(" ")
+    }
+
+    /// A `peratomtypepair` table: `wall` for pairs with the wall type, else `particle`.
+    fn per_pair(&self, particle: Real, wall: Real) -> String {
+        let (n, n_types) = (self.particles, self.count());
+        let mut v = Vec::new();
+        for a in 0..n_types {
+            for b in 0..n_types {
+                v.push(g(if a == n || b == n { wall } else { particle }));
+            }
+        }
+        format!("{n_types} {}", v.join(" "))
+    }
+}
+
+/// The material tables (`fix property/global`), and the `pair_style` suffix for rolling
+/// friction (empty without it).
+fn material_lines(scene: &Scene, h: &HertzSettings, types: &AtomTypes) -> (String, &'static str) {
+    let w = &scene.wall_contact;
+    let (m, wm) = (material(h), wall_material(scene, h));
+    let mut d = String::new();
+    // LIGGGHTS refuses E > 1e9 Pa in SI units unless told the particles are hard (steel).
+    if m.youngs_modulus.max(wm.youngs_modulus) > 1e9 {
+        d += "hard_particles  yes\n";
+    }
+    let _ = writeln!(
+        d,
+        "fix             m1 all property/global youngsModulus peratomtype {}",
+        types.per_type(m.youngs_modulus, wm.youngs_modulus)
+    );
+    let _ = writeln!(
+        d,
+        "fix             m2 all property/global poissonsRatio peratomtype {}",
+        types.per_type(m.poisson_ratio, wm.poisson_ratio)
+    );
+    let _ = writeln!(
+        d,
+        "fix             m3 all property/global coefficientRestitution peratomtypepair {}",
+        types.per_pair(h.restitution, w.restitution)
+    );
+    let _ = writeln!(
+        d,
+        "fix             m4 all property/global coefficientFriction peratomtypepair {}",
+        types.per_pair(h.friction, w.friction)
+    );
+    let rolling = if h.rolling == RollingKind::Epsd2 {
+        let _ = writeln!(
+            d,
+            "fix             m5 all property/global coefficientRollingFriction peratomtypepair {}",
+            types.per_pair(h.rolling_friction, w.rolling_friction)
+        );
+        " rolling_friction epsd2"
+    } else {
+        ""
+    };
+    (d, rolling)
+}
+
+/// One `fix wall/gran ... primitive` per planar wall, of atom type `wall_type`.
+fn wall_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<String, DeckError> {
+    let mut d = String::new();
+    for wall in &scene.walls {
+        let (axis, _) = wall_axis(scene, wall)?;
+        let at = [wall.point.x, wall.point.y, wall.point.z][axis];
+        let _ = writeln!(
+            d,
+            "fix             w_{} all wall/gran model hertz tangential history{rolling} primitive type {wall_type} {}plane {}",
+            wall.name,
+            ["x", "y", "z"][axis],
+            g(at)
+        );
+    }
+    Ok(d)
 }
 
 /// The deck lines of the scene's bodies: one `fix mesh/surface` per body from an ASCII STL
