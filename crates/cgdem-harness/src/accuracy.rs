@@ -6,10 +6,13 @@
 //! `neighbor.skin_fraction`, `body[0].cell_size`). Each point changes one knob from the
 //! reference and is judged against the same code's reference run: repose-angle difference and
 //! heap-profile distance for a collapse, mass-flow difference (and the distance from Eq. 7) for
-//! a screw feeder. The reference setting run with other insertion seeds gives the floor below
-//! which a difference is the packing, not the knob. The report plots error against wall time
-//! on log axes with each code's Pareto front, and tables the cheapest setting within each
-//! target.
+//! a screw feeder. Every setting (the reference and each point) is run with each of the
+//! sweep's insertion seeds, and a point's error is taken against the reference run with the
+//! same seed (the same packing), so the packing largely cancels; a setting's error is the mean
+//! over seeds with its standard error (the error bars). The largest difference between two
+//! reference runs with different seeds is the floor below which a difference is the packing,
+//! not the knob. The report plots error against wall time on log axes with each code's Pareto
+//! front, and tables the cheapest setting within each target.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -82,9 +85,8 @@ pub struct AccuracySweep {
     /// Overrides every point shares (e.g. a shorter run), with `variant` naming them.
     pub overrides: Vec<Override>,
     pub variant: String,
-    pub seed: u64,
-    /// The reference setting with these insertion seeds: the floor (packing-to-packing).
-    pub floor_seeds: Vec<u64>,
+    /// Insertion seeds: every setting runs with each (issue 24: at least 3 where affordable).
+    pub seeds: Vec<u64>,
     /// Every knob's value at the reference; `lambda` always among them.
     pub reference: BTreeMap<Knob, f64>,
     pub series: Vec<KnobSeries>,
@@ -98,9 +100,7 @@ pub(super) struct RawSweep {
     variant: String,
     #[serde(default)]
     set: Vec<String>,
-    seed: Option<u64>,
-    #[serde(default)]
-    floor_seeds: Vec<u64>,
+    seeds: Option<Vec<u64>>,
     reference: BTreeMap<String, toml::Value>,
     series: Vec<RawSeries>,
     angle_target_deg: Option<f64>,
@@ -206,12 +206,22 @@ impl AccuracySweep {
                 Err(invalid(field, v.to_string(), "a positive number"))
             }
         };
+        let seeds = raw.seeds.unwrap_or_else(|| vec![1]);
+        let mut distinct = seeds.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        if seeds.is_empty() || distinct.len() != seeds.len() {
+            return Err(invalid(
+                "seeds",
+                format!("{seeds:?}"),
+                "one or more distinct insertion seeds, e.g. [1, 2, 3]",
+            ));
+        }
         Ok(AccuracySweep {
             file: raw.file,
             overrides,
             variant: raw.variant,
-            seed: raw.seed.unwrap_or(1),
-            floor_seeds: raw.floor_seeds,
+            seeds,
             reference,
             series,
             targets: Targets {
@@ -254,9 +264,9 @@ impl AccuracySweep {
 pub struct AccuracyPoint {
     pub case: String,
     pub code: Code,
-    /// "reference", "floor" (the reference setting, another insertion seed) or the knob.
+    /// "reference" or the knob.
     pub series: String,
-    /// The varied knob's value (the reference's for "reference" and "floor").
+    /// The varied knob's value (the reference's for "reference").
     pub value: f64,
     /// The setting in words, e.g. "time.dt_fraction = 0.1".
     pub setting: String,
@@ -271,7 +281,7 @@ pub struct AccuracyPoint {
     pub particle_steps: Option<f64>,
     pub wall_s: Option<f64>,
     pub repose_angle_deg: Option<f64>,
-    /// |angle - the same code's reference angle|, degrees.
+    /// |angle - the angle of the same code's reference run with the same seed|, degrees.
     pub angle_error_deg: Option<f64>,
     /// RMS gap between the heap profile and the reference's, over the reference heap's
     /// height ([`profile_distance`]).
@@ -294,11 +304,16 @@ pub struct CheapestSetting {
     pub target: f64,
     /// None: no point other than the reference met the target.
     pub setting: Option<String>,
+    /// Means over the setting's seeds.
     pub wall_s: Option<f64>,
     pub particle_steps: Option<f64>,
     pub error: Option<f64>,
+    /// Standard error of `error` over the seeds (None with one seed).
+    pub error_se: Option<f64>,
+    /// Seeds the setting was measured with.
+    pub seeds: usize,
     pub reference_wall_s: Option<f64>,
-    /// The largest error of the reference setting with other insertion seeds.
+    /// The largest difference between two reference runs with different insertion seeds.
     pub floor: Option<f64>,
 }
 
@@ -458,9 +473,12 @@ pub(super) fn run_sweeps(
         "For each case: a reference setting (the finest affordable) and one series per knob \
          that buys speed (coarse-graining level lambda, time-step fraction of the contact \
          period, neighbour skin, SDF cell size), each point changing one knob from the \
-         reference. Errors are against the same code's reference run; the reference setting \
-         with other insertion seeds (\"floor\") shows how far a different random packing alone \
-         moves the result. Wall time is the whole run (insertion and output included) on the \
+         reference. Every setting runs with each of the sweep's insertion seeds, and a run's \
+         error is against the same code's reference run with the same seed (the same \
+         packing); a setting's error is the mean over its seeds, the error bars one standard \
+         error of that mean. The largest difference between two reference runs with \
+         different seeds (\"floor\") shows how far a different random packing alone moves the \
+         result. Wall time is the whole run (insertion and output included) on the \
          machine and thread count in the provenance; the machine is shared, so wall times \
          carry some percent of noise. Figures: error against wall time on log axes, one series \
          per knob and code, the Pareto front of each code dashed, the target dotted.",
@@ -481,8 +499,8 @@ pub(super) fn run_sweeps(
     Ok(Some(summary))
 }
 
-/// Runs the reference of every code, then each series point, then the floor seeds; codes
-/// alternate within each point so machine drift hits all alike.
+/// Runs, seed by seed, the reference of every code, then each series point; codes alternate
+/// within each point so machine drift hits all alike.
 fn run_sweep(
     sweep: &AccuracySweep,
     origin: &Path,
@@ -497,44 +515,37 @@ fn run_sweep(
     // (series, varied knob, value, codes, seed)
     let mut jobs: Vec<(String, Knob, f64, Vec<Code>, u64)> = Vec::new();
     let all = sweep.codes();
-    jobs.push((
-        "reference".into(),
-        Knob::Lambda,
-        0.0,
-        all.clone(),
-        sweep.seed,
-    ));
-    for s in &sweep.series {
-        for &v in &s.values {
-            if v != sweep.reference[&s.knob] {
-                jobs.push((
-                    s.knob.name().into(),
-                    s.knob.clone(),
-                    v,
-                    s.codes.clone(),
-                    sweep.seed,
-                ));
+    for &seed in &sweep.seeds {
+        jobs.push(("reference".into(), Knob::Lambda, 0.0, all.clone(), seed));
+        for s in &sweep.series {
+            for &v in &s.values {
+                if v != sweep.reference[&s.knob] {
+                    jobs.push((
+                        s.knob.name().into(),
+                        s.knob.clone(),
+                        v,
+                        s.codes.clone(),
+                        seed,
+                    ));
+                }
             }
         }
-    }
-    for &seed in &sweep.floor_seeds {
-        jobs.push(("floor".into(), Knob::Lambda, 0.0, all.clone(), seed));
     }
     let mut points = Vec::new();
     for (series, knob, value, codes, seed) in jobs {
         let mut knobs = sweep.reference.clone();
         let (setting, value, name) = match series.as_str() {
-            "reference" | "floor" => (
+            "reference" => (
                 "reference".to_string(),
                 f64::NAN,
-                format!("{series}-seed{seed}"),
+                format!("reference-seed{seed}"),
             ),
             _ => {
                 knobs.insert(knob.clone(), value);
                 (
                     format!("{} = {value}", knob.name()),
                     value,
-                    format!("{}-{value}", knob.file_name()),
+                    format!("{}-{value}-seed{seed}", knob.file_name()),
                 )
             }
         };
@@ -560,14 +571,9 @@ fn run_sweep(
             }
             if !options.quiet {
                 eprintln!(
-                    "{case} accuracy {} {}{}: {}{}",
+                    "{case} accuracy {} {} (seed {seed}): {}{}",
                     code.name(),
                     p.setting,
-                    if series == "floor" {
-                        format!(" (seed {seed})")
-                    } else {
-                        String::new()
-                    },
                     p.status,
                     p.reason
                         .as_deref()
@@ -655,7 +661,7 @@ fn read_profile(dir: &Path) -> Vec<(f64, f64)> {
         .unwrap_or_default()
 }
 
-/// Fills each point's errors against its code's reference run.
+/// Fills each point's errors against its code's reference run with the same seed.
 fn measure(points: &mut [AccuracyPoint]) {
     let references: Vec<AccuracyPoint> = points
         .iter()
@@ -666,17 +672,111 @@ fn measure(points: &mut [AccuracyPoint]) {
         if let (Some(q), Some(eq7)) = (p.mass_flow_kg_s, p.eq7_mass_flow_kg_s) {
             p.eq7_error = Some((q / eq7 - 1.0).abs()).filter(|e| e.is_finite());
         }
-        let Some(r) = references.iter().find(|r| r.code == p.code) else {
+        let Some(r) = references
+            .iter()
+            .find(|r| r.code == p.code && r.seed == p.seed)
+        else {
             continue;
         };
-        if let (Some(a), Some(b)) = (p.repose_angle_deg, r.repose_angle_deg) {
-            p.angle_error_deg = Some((a - b).abs());
-            p.profile_distance = profile_distance(&read_profile(&r.dir), &read_profile(&p.dir));
+        p.angle_error_deg = difference(Measure::Angle, p, r);
+        p.profile_distance = difference(Measure::Profile, p, r);
+        p.mass_flow_error = difference(Measure::MassFlow, p, r);
+    }
+}
+
+/// How far run `p` is from run `r` under measure `m` (None where either measured nothing).
+fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
+    let finite = |v: f64| Some(v).filter(|v| v.is_finite());
+    match m {
+        Measure::Angle => finite((p.repose_angle_deg? - r.repose_angle_deg?).abs()),
+        Measure::Profile => {
+            p.repose_angle_deg?;
+            r.repose_angle_deg?;
+            profile_distance(&read_profile(&r.dir), &read_profile(&p.dir))
         }
-        if let (Some(q), Some(q_ref)) = (p.mass_flow_kg_s, r.mass_flow_kg_s) {
-            p.mass_flow_error = Some((q / q_ref - 1.0).abs()).filter(|e| e.is_finite());
+        Measure::MassFlow => finite((p.mass_flow_kg_s? / r.mass_flow_kg_s? - 1.0).abs()),
+        Measure::Eq7 => finite((p.eq7_error? - r.eq7_error?).abs()),
+    }
+}
+
+/// The floor of a code under measure `m`: the largest difference between two of its
+/// reference runs (same setting, different insertion seeds); None with fewer than two.
+fn floor(code: Code, m: Measure, points: &[AccuracyPoint]) -> Option<f64> {
+    let references: Vec<&AccuracyPoint> = points
+        .iter()
+        .filter(|p| p.code == code && p.series == "reference" && p.status == Outcome::Ok)
+        .collect();
+    let mut worst: Option<f64> = None;
+    for (k, a) in references.iter().enumerate() {
+        for b in &references[k + 1..] {
+            if let Some(d) = difference(m, b, a) {
+                worst = Some(worst.map_or(d, |w| w.max(d)));
+            }
         }
     }
+    worst
+}
+
+/// One setting of one code (the reference or a series point) over the seeds it ran with.
+struct Setting<'a> {
+    series: &'a str,
+    setting: &'a str,
+    value: f64,
+    runs: Vec<&'a AccuracyPoint>,
+}
+
+impl Setting<'_> {
+    /// Mean over the runs that measured `m`, with its cost `cost` (the same runs' mean), the
+    /// standard error of the mean (None with one run) and the number of runs.
+    fn mean(&self, m: Measure, cost: Cost) -> Option<SettingMean> {
+        let pairs: Vec<(f64, f64)> = self
+            .runs
+            .iter()
+            .filter_map(|p| Some((cost.of(p)?, m.of(p)?)))
+            .collect();
+        let n = pairs.len();
+        if n == 0 {
+            return None;
+        }
+        let cost = pairs.iter().map(|p| p.0).sum::<f64>() / n as f64;
+        let error = pairs.iter().map(|p| p.1).sum::<f64>() / n as f64;
+        let se = (n > 1).then(|| {
+            let var = pairs.iter().map(|p| (p.1 - error).powi(2)).sum::<f64>() / (n - 1) as f64;
+            (var / n as f64).sqrt()
+        });
+        Some(SettingMean { cost, error, se, n })
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SettingMean {
+    cost: f64,
+    error: f64,
+    se: Option<f64>,
+    n: usize,
+}
+
+/// The settings of `code`, in the order of the points, each with its successful runs.
+fn settings(code: Code, points: &[AccuracyPoint]) -> Vec<Setting<'_>> {
+    let mut out: Vec<Setting> = Vec::new();
+    for p in points
+        .iter()
+        .filter(|p| p.code == code && p.status == Outcome::Ok)
+    {
+        match out
+            .iter_mut()
+            .find(|s| s.series == p.series && s.setting == p.setting)
+        {
+            Some(s) => s.runs.push(p),
+            None => out.push(Setting {
+                series: &p.series,
+                setting: &p.setting,
+                value: p.value,
+                runs: vec![p],
+            }),
+        }
+    }
+    out
 }
 
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {
@@ -705,12 +805,17 @@ fn write_sweep_section(
         .collect::<Vec<_>>()
         .join(", ");
     sub.paragraph(format!(
-        "Scene file {} with the overrides of variant `{}` ({}); insertion seed {}. Reference \
-         setting: {reference}.",
+        "Scene file {} with the overrides of variant `{}` ({}); insertion seeds {}. \
+         Reference setting: {reference}.",
         sweep.file.display(),
         sweep.variant,
         if shared.is_empty() { "none" } else { &shared },
-        sweep.seed
+        sweep
+            .seeds
+            .iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     ));
     let measures: Vec<Measure> = [
         Measure::Angle,
@@ -866,12 +971,12 @@ fn write_sweep_section(
         "cheapest setting within it",
         "wall s",
         "particle-steps",
-        "its error",
+        "its error (mean +- SE, seeds)",
         "reference wall s",
         "speed-up",
         "floor (other seeds)",
     ])
-    .caption("Cheapest setting within each target, per code: the fewest particle-steps (wall time beside it; on a shared machine the wall time of equal work varies too much to choose by). The reference is the yardstick: when no other point meets the target, none is named. Floor: the largest error of the reference setting with other insertion seeds; a target below it is met by chance.");
+    .caption("Cheapest setting within each target, per code: the fewest particle-steps (wall time beside it; on a shared machine the wall time of equal work varies too much to choose by). The reference is the yardstick: when no other point meets the target, none is named. A setting's error, cost and wall time are means over its seeds, the error with one standard error of the mean. Floor: the largest difference between two reference runs with different insertion seeds; a target below it is met by chance.");
     for c in &cheapest {
         let m = measure_named(&c.measure);
         let speedup = match (c.reference_wall_s, c.wall_s) {
@@ -888,7 +993,15 @@ fn write_sweep_section(
             },
             Cell::num(fmt_opt(c.wall_s, 1)),
             Cell::num(c.particle_steps.map_or("-".into(), |n| format!("{n:.3e}"))),
-            Cell::num(c.error.map_or("-".into(), |v| m.format(v))),
+            Cell::num(c.error.map_or("-".into(), |v| {
+                format!(
+                    "{}{} ({})",
+                    m.format(v),
+                    c.error_se
+                        .map_or(String::new(), |se| format!(" +- {}", m.format(se))),
+                    c.seeds
+                )
+            })),
             Cell::num(fmt_opt(c.reference_wall_s, 1)),
             Cell::num(speedup),
             Cell::num(c.floor.map_or("-".into(), |v| m.format(v))),
@@ -911,13 +1024,12 @@ fn measure_named(name: &str) -> Measure {
     .unwrap_or(Measure::Angle)
 }
 
-/// The points that are settings to choose from: the series, and the reference where its
-/// error is not zero by construction.
-fn candidates(code: Code, m: Measure, points: &[AccuracyPoint]) -> Vec<&AccuracyPoint> {
-    points
-        .iter()
-        .filter(|p| p.code == code && p.status == Outcome::Ok && p.series != "floor")
-        .filter(|p| p.series != "reference" || !m.against_reference())
+/// The settings to choose from: the series, and the reference where its error is not zero
+/// by construction.
+fn candidates(code: Code, m: Measure, points: &[AccuracyPoint]) -> Vec<Setting<'_>> {
+    settings(code, points)
+        .into_iter()
+        .filter(|s| s.series != "reference" || !m.against_reference())
         .collect()
 }
 
@@ -930,37 +1042,37 @@ fn cheapest_setting(
 ) -> CheapestSetting {
     // Chosen by particle-steps, not wall time: within one code the two are proportional at a
     // given per-step cost, and on a shared machine the wall time of equal work varied
-    // two-fold between runs (reports/accuracy/NOTE.md).
-    let found = candidates(code, m, points);
-    let cost: Vec<(f64, f64)> = found
-        .iter()
-        .map(|p| {
-            (
-                p.particle_steps.unwrap_or(f64::NAN),
-                m.of(p).unwrap_or(f64::NAN),
-            )
+    // two-fold between runs (reports/accuracy/NOTE.md). A setting's error is its mean over
+    // the seeds.
+    let found: Vec<(Setting, SettingMean)> = candidates(code, m, points)
+        .into_iter()
+        .filter_map(|s| {
+            let mean = s.mean(m, Cost::ParticleSteps)?;
+            Some((s, mean))
         })
         .collect();
-    let best = cheapest_within(&cost, m.target(targets)).map(|k| found[k]);
-    let reference = points
-        .iter()
-        .find(|p| p.code == code && p.series == "reference" && p.status == Outcome::Ok);
-    let floor = points
-        .iter()
-        .filter(|p| p.code == code && p.series == "floor")
-        .filter_map(|p| m.of(p))
-        .fold(None, |a: Option<f64>, e| Some(a.map_or(e, |a| a.max(e))));
+    let cost: Vec<(f64, f64)> = found.iter().map(|(_, a)| (a.cost, a.error)).collect();
+    let best = cheapest_within(&cost, m.target(targets)).map(|k| &found[k]);
+    let reference = settings(code, points)
+        .into_iter()
+        .find(|s| s.series == "reference");
+    let mean_of = |s: &Setting, f: fn(&AccuracyPoint) -> Option<f64>| {
+        let v: Vec<f64> = s.runs.iter().filter_map(|p| f(p)).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
     CheapestSetting {
         case: case.to_string(),
         code,
         measure: m.name().into(),
         target: m.target(targets),
-        setting: best.map(|p| p.setting.clone()),
-        wall_s: best.and_then(|p| p.wall_s),
-        particle_steps: best.and_then(|p| p.particle_steps),
-        error: best.and_then(|p| m.of(p)),
-        reference_wall_s: reference.and_then(|p| p.wall_s),
-        floor,
+        setting: best.map(|(s, _)| s.setting.to_string()),
+        wall_s: best.and_then(|(s, _)| mean_of(s, |p| p.wall_s)),
+        particle_steps: best.map(|(_, a)| a.cost),
+        error: best.map(|(_, a)| a.error),
+        error_se: best.and_then(|(_, a)| a.se),
+        seeds: best.map_or(0, |(_, a)| a.n),
+        reference_wall_s: reference.as_ref().and_then(|s| mean_of(s, |p| p.wall_s)),
+        floor: floor(code, m, points),
     }
 }
 
@@ -1007,46 +1119,37 @@ fn error_figure(
     .log_y();
     let mut walls: Vec<f64> = Vec::new();
     for &code in codes {
-        let mut knobs: Vec<&str> = points
-            .iter()
-            .filter(|p| p.code == code)
-            .map(|p| p.series.as_str())
-            .collect();
+        let all = settings(code, points);
+        let mut knobs: Vec<&str> = all.iter().map(|s| s.series).collect();
         knobs.sort();
         knobs.dedup();
         for knob in knobs {
-            let mut series: Vec<&AccuracyPoint> = points
+            let mut series: Vec<(f64, SettingMean)> = all
                 .iter()
-                .filter(|p| p.code == code && p.series == knob && p.status == Outcome::Ok)
+                .filter(|s| s.series == knob)
+                .filter_map(|s| Some((s.value, s.mean(m, cost_axis)?)))
                 .collect();
-            series.sort_by(|a, b| a.value.total_cmp(&b.value));
-            let xy: Vec<(f64, f64)> = series
-                .iter()
-                .filter_map(|p| Some((cost_axis.of(p)?, m.of(p)?)))
-                .collect();
-            walls.extend(xy.iter().map(|p| p.0));
-            if xy.is_empty() || (knob == "reference" && m.against_reference()) {
+            series.sort_by(|a, b| a.0.total_cmp(&b.0));
+            walls.extend(series.iter().map(|p| p.1.cost));
+            if series.is_empty() || (knob == "reference" && m.against_reference()) {
                 continue;
             }
-            let label = match knob {
-                "floor" => format!("{}: reference, other seeds", code.name()),
-                _ => format!("{}: {knob}", code.name()),
-            };
+            let xy = series.iter().map(|p| (p.1.cost, p.1.error)).collect();
+            let se = series.iter().map(|p| p.1.se.unwrap_or(0.0)).collect();
             let style = match knob {
-                "floor" | "reference" => SeriesStyle::Markers,
+                "reference" => SeriesStyle::Markers,
                 _ => SeriesStyle::LineMarkers,
             };
-            fig.series.push(Series::new(label, xy).style(style));
+            fig.series.push(
+                Series::new(format!("{}: {knob}", code.name()), xy)
+                    .style(style)
+                    .y_err(se),
+            );
         }
-        let found = candidates(code, m, points);
-        let cost: Vec<(f64, f64)> = found
+        let cost: Vec<(f64, f64)> = candidates(code, m, points)
             .iter()
-            .map(|p| {
-                (
-                    cost_axis.of(p).unwrap_or(f64::NAN),
-                    m.of(p).unwrap_or(f64::NAN),
-                )
-            })
+            .filter_map(|s| s.mean(m, cost_axis))
+            .map(|a| (a.cost, a.error))
             .collect();
         let front: Vec<(f64, f64)> = pareto_front(&cost)
             .into_iter()
@@ -1111,6 +1214,90 @@ mod tests {
         assert_eq!(cheapest_within(&points, 0.1), Some(0));
         assert_eq!(cheapest_within(&points, 0.001), None);
         assert_eq!(cheapest_within(&[(f64::NAN, 0.0)], 1.0), None);
+    }
+
+    fn run(series: &str, value: f64, seed: u64, angle: f64, particle_steps: f64) -> AccuracyPoint {
+        AccuracyPoint {
+            case: "c".into(),
+            code: Code::Cgdem,
+            series: series.into(),
+            value,
+            setting: format!("{series} = {value}"),
+            lambda: 1,
+            seed,
+            status: Outcome::Ok,
+            reason: None,
+            dir: PathBuf::from("/nonexistent"),
+            reused: false,
+            n_particles: Some(100),
+            steps: Some(10),
+            particle_steps: Some(particle_steps),
+            wall_s: Some(particle_steps / 1e6),
+            repose_angle_deg: Some(angle),
+            angle_error_deg: None,
+            profile_distance: None,
+            mass_flow_kg_s: None,
+            mass_flow_error: None,
+            eq7_mass_flow_kg_s: None,
+            eq7_error: None,
+        }
+    }
+
+    #[test]
+    fn errors_pair_runs_by_seed_and_settings_average_over_seeds() {
+        let mut points = vec![
+            run("reference", 0.02, 1, 30.0, 1e7),
+            run("reference", 0.02, 2, 31.0, 1e7),
+            run("reference", 0.02, 3, 29.5, 1e7),
+            run("dt", 0.1, 1, 30.5, 2e6),
+            run("dt", 0.1, 2, 31.2, 2e6),
+            run("dt", 0.1, 3, 29.0, 2e6),
+            run("dt", 0.3, 1, 31.0, 1e6),
+            run("dt", 0.3, 2, 30.0, 1e6),
+            run("dt", 0.3, 3, 30.5, 1e6),
+        ];
+        measure(&mut points);
+        // Against the reference with the same seed: 0.5, 0.2, 0.5 (against seed 1's
+        // reference alone they would be 0.5, 1.2, 1.0).
+        let errors: Vec<f64> = points[3..6]
+            .iter()
+            .map(|p| p.angle_error_deg.unwrap())
+            .collect();
+        for (e, want) in errors.iter().zip([0.5, 0.2, 0.5]) {
+            assert!((e - want).abs() < 1e-12, "{errors:?}");
+        }
+        let all = settings(Code::Cgdem, &points);
+        assert_eq!(all.len(), 3);
+        let dt = all[1].mean(Measure::Angle, Cost::ParticleSteps).unwrap();
+        assert_eq!(dt.n, 3);
+        assert!((dt.error - 0.4).abs() < 1e-12, "{dt:?}");
+        // Sample standard deviation sqrt(0.03), over sqrt(3).
+        assert!((dt.se.unwrap() - 0.1).abs() < 1e-12, "{dt:?}");
+        // The reference runs' largest difference between seeds: 31.0 against 29.5.
+        assert_eq!(floor(Code::Cgdem, Measure::Angle, &points), Some(1.5));
+        // dt 0.3 errs by 1.0, 1.0, 1.0: within 1.0 it is the cheapest; within 0.5 only dt 0.1.
+        let targets = Targets {
+            angle_deg: 0.5,
+            profile: 0.05,
+            mass_flow: 0.05,
+        };
+        let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &targets, &points);
+        assert_eq!(c.setting.as_deref(), Some("dt = 0.1"));
+        assert_eq!((c.seeds, c.particle_steps), (3, Some(2e6)));
+        let loose = Targets {
+            angle_deg: 1.0,
+            ..targets
+        };
+        let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &loose, &points);
+        assert_eq!(c.setting.as_deref(), Some("dt = 0.3"));
+        assert_eq!(c.error_se, Some(0.0));
+        // A failed run drops out of its setting's mean.
+        points[4].status = Outcome::Failed;
+        let all = settings(Code::Cgdem, &points);
+        assert_eq!(
+            all[1].mean(Measure::Angle, Cost::ParticleSteps).unwrap().n,
+            2
+        );
     }
 
     #[test]
@@ -1184,5 +1371,24 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("accuracy[0].series[0].values"), "{e}");
+        let with_seeds = |seeds: &str| {
+            suite("knob = \"time.dt_fraction\"\nvalues = [0.1]").replace(
+                "variant = \"acc\"\n",
+                &format!("variant = \"acc\"\n{seeds}\n"),
+            )
+        };
+        let ok = Suite::parse(&with_seeds("seeds = [3, 1, 2]"), Path::new("s.toml")).unwrap();
+        assert_eq!(ok.accuracy[0].seeds, vec![3, 1, 2]);
+        for bad in ["seeds = [1, 1]", "seeds = []"] {
+            let e = Suite::parse(&with_seeds(bad), Path::new("s.toml"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("accuracy[0].seeds"), "{bad}: {e}");
+        }
+        // The former single seed is refused by name, not silently ignored.
+        let e = Suite::parse(&with_seeds("seed = 1"), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("seed"), "{e}");
     }
 }
