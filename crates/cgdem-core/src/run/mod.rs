@@ -32,7 +32,7 @@ use crate::contact::PairLaw;
 use crate::guard::{GuardKind, GuardPeaks, GuardTrip};
 use crate::insertion::InsertionFailed;
 use crate::io::CsvBuffer;
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 use crate::scene::{ReposeSettings, Scene, StageEnd};
 use crate::timestep::{self, Timescales, UnstableTimeStep};
@@ -369,6 +369,33 @@ fn describe_end(end: &StageEnd) -> String {
             max_duration,
         } => format!("kinetic energy per mass below {kinetic_energy_per_mass:e} J/kg, after at least {min_duration} s and at most {max_duration} s"),
     }
+}
+
+/// The first columns of `timeseries.csv`, as cgdem and the reference post-processing write
+/// them.
+pub const TIMESERIES_COLUMNS: [&str; 7] = [
+    "time_s",
+    "stage",
+    "kinetic_energy_j",
+    "kinetic_energy_per_mass_j_kg",
+    "n_particles",
+    "front_m",
+    "wall_height_m",
+];
+
+/// The heap surface of `scene`'s `[repose]` section for particles at `position` of `radius`
+/// (None without one).
+pub fn heap_profile(scene: &Scene, position: &[Vec3], radius: &[Real]) -> Option<HeapProfile> {
+    scene.repose.as_ref().map(|r| {
+        heap::profile(
+            position,
+            radius,
+            r.wall_x,
+            scene.domain.hi.x,
+            scene.domain.lo.z,
+            r.bin_width_diameters * scene.max_diameter(),
+        )
+    })
 }
 
 /// `profile.csv`: the heap surface height per bin.

@@ -264,6 +264,24 @@ pub(crate) struct StageDumps<'a> {
     pub modify: &'a str,
 }
 
+/// The energy lines ([`kinetic_energy_lines`]), the trajectory dump every `dump_every` steps
+/// with `columns` and `dump_modify traj <modify>`; the stage dumps take the same.
+pub(crate) fn trajectory_lines<'a>(
+    d: &mut String,
+    dump_every: u64,
+    rotation: bool,
+    columns: &'a str,
+    modify: &'a str,
+) -> StageDumps<'a> {
+    *d += &kinetic_energy_lines(dump_every, rotation);
+    let _ = writeln!(
+        d,
+        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {columns}"
+    );
+    let _ = writeln!(d, "dump_modify     traj {modify}");
+    StageDumps { columns, modify }
+}
+
 /// The kinetic energy per mass the settle loops test (`v_kepm`) and the thermo line: LAMMPS
 /// and LIGGGHTS alike. With `rotation`, the rotational energy counts too, as in cgdem.
 pub(crate) fn kinetic_energy_lines(dump_every: u64, rotation: bool) -> String {
@@ -596,16 +614,13 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
         d += &removal_pads(scene, 2);
     }
 
-    d += &kinetic_energy_lines(dump_every, false);
-    let _ = writeln!(
-        d,
-        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {WCA_COLUMNS}"
+    let stages = trajectory_lines(
+        &mut d,
+        dump_every,
+        false,
+        WCA_COLUMNS,
+        "format float %.16g sort id",
     );
-    d += "dump_modify     traj format float %.16g sort id\n";
-    let stages = StageDumps {
-        columns: WCA_COLUMNS,
-        modify: "format float %.16g sort id",
-    };
     let repose_dumps = stage_lines(
         &mut d,
         scene,

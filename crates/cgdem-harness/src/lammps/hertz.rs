@@ -18,9 +18,9 @@
 use std::fmt::Write as _;
 
 use super::deck::{
-    block_region, data_file, frozen_lines, g, kinetic_energy_lines, neighbor_lines, preamble,
-    stage_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, Periodic, StageDumps,
-    StageHooks, LOG_FILE, TRAJECTORY_FILE,
+    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, stage_lines,
+    trajectory_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, Periodic, StageHooks,
+    LOG_FILE,
 };
 use crate::code::Code;
 use cgdem_core::contact::damping::restitution_beta;
@@ -187,16 +187,13 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     d += &deletion_lines(scene, integrated, dump_every);
     let top_ups = top_up_lines(scene, integrated, dt, &mut files);
     d += &top_ups.setup;
-    d += &kinetic_energy_lines(dump_every, true);
-    let _ = writeln!(
-        d,
-        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {HERTZ_COLUMNS}"
+    let dumps = trajectory_lines(
+        &mut d,
+        dump_every,
+        true,
+        HERTZ_COLUMNS,
+        "format float %.17g sort id",
     );
-    d += "dump_modify     traj format float %.17g sort id\n";
-    let dumps = StageDumps {
-        columns: HERTZ_COLUMNS,
-        modify: "format float %.17g sort id",
-    };
     let begin = |stage: &str| {
         let mut lines = String::new();
         for (start, motion) in &bodies.motions {

@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 use super::deck::{DeckPlan, TRAJECTORY_FILE};
 use super::dump::{read_dump, DumpError, Frame};
 use cgdem_core::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
-use cgdem_core::analysis::heap::{self, HeapProfile};
+use cgdem_core::analysis::heap::HeapProfile;
 use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::{Real, Vec3};
 use cgdem_core::run::{
-    headline_sample, profile_csv, repose_csv, ReposeSample, RunSummary, SampleTrigger, StageRecord,
+    headline_sample, heap_profile, profile_csv, repose_csv, ReposeSample, RunSummary,
+    SampleTrigger, StageRecord, TIMESERIES_COLUMNS,
 };
 use cgdem_core::scene::{ConveyingSettings, Scene};
 use cgdem_core::timestep::Timescales;
@@ -305,16 +306,7 @@ pub fn postprocess(
 
 /// The heap surface of one frame, measured as cgdem measures it (None without `[repose]`).
 fn frame_heap_profile(scene: &Scene, p: &FrameParticles) -> Option<HeapProfile> {
-    scene.repose.as_ref().map(|r| {
-        heap::profile(
-            &p.position,
-            &p.radius,
-            r.wall_x,
-            scene.domain.hi.x,
-            scene.domain.lo.z,
-            r.bin_width_diameters * scene.max_diameter(),
-        )
-    })
+    heap_profile(scene, &p.position, &p.radius)
 }
 
 /// Writes `timeseries.csv`, one row per trajectory frame after step 0 (cgdem's columns);
@@ -328,16 +320,7 @@ fn write_timeseries(
     dt: Real,
 ) -> Result<Option<(u64, FrameParticles)>, PostprocessError> {
     let max_diameter = scene.max_diameter();
-    let mut csv = CsvBuffer::new([
-        "time_s",
-        "stage",
-        "kinetic_energy_j",
-        "kinetic_energy_per_mass_j_kg",
-        "n_particles",
-        "front_m",
-        "wall_height_m",
-        "mechanical_energy_j",
-    ]);
+    let mut csv = CsvBuffer::new(TIMESERIES_COLUMNS.iter().chain(&["mechanical_energy_j"]));
     let origin =
         cgdem_core::simulation::potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
     let mut last_state = None;

@@ -16,8 +16,8 @@ use std::path::Path;
 
 use crate::code::Code;
 use crate::lammps::deck::{
-    block_region, data_file, frozen_lines, g, kinetic_energy_lines, neighbor_lines, preamble,
-    stage_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, StageDumps, StageHooks,
+    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, stage_lines,
+    trajectory_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, StageHooks,
 };
 use crate::lammps::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
 use cgdem_core::math::Real;
@@ -88,18 +88,9 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     d += &wall_lines(scene, n + 1, rolling)?;
     let meshes = mesh_lines(scene, n + 1, rolling)?;
     d += &meshes.setup;
-    d += &kinetic_energy_lines(dump_every, true);
     // LIGGGHTS's dump_modify format is one C format for the whole line (default: 6 digits).
     let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
-    let _ = writeln!(
-        d,
-        "dump            traj all custom {dump_every} {TRAJECTORY_FILE} {HERTZ_COLUMNS}"
-    );
-    let _ = writeln!(d, "dump_modify     traj {modify}");
-    let dumps = StageDumps {
-        columns: HERTZ_COLUMNS,
-        modify: &modify,
-    };
+    let dumps = trajectory_lines(&mut d, dump_every, true, HERTZ_COLUMNS, &modify);
     let begin = |stage: &str| stage_start_lines(scene, &meshes.pieces, stage, dt);
     let repose_dumps = stage_lines(
         &mut d,
@@ -172,26 +163,33 @@ fn material_lines(scene: &Scene, h: &HertzSettings, types: &AtomTypes) -> (Strin
     if m.youngs_modulus.max(wm.youngs_modulus) > 1e9 {
         d += "hard_particles  yes\n";
     }
-    let _ = writeln!(
-        d,
-        "fix             m1 all property/global youngsModulus peratomtype {}",
-        types.per_type(m.youngs_modulus, wm.youngs_modulus)
-    );
-    let _ = writeln!(
-        d,
-        "fix             m2 all property/global poissonsRatio peratomtype {}",
-        types.per_type(m.poisson_ratio, wm.poisson_ratio)
-    );
-    let _ = writeln!(
-        d,
-        "fix             m3 all property/global coefficientRestitution peratomtypepair {}",
-        types.per_pair(h.restitution, w.restitution)
-    );
-    let _ = writeln!(
-        d,
-        "fix             m4 all property/global coefficientFriction peratomtypepair {}",
-        types.per_pair(h.friction, w.friction)
-    );
+    for (fix, property, table) in [
+        (
+            "m1",
+            "youngsModulus peratomtype",
+            types.per_type(m.youngs_modulus, wm.youngs_modulus),
+        ),
+        (
+            "m2",
+            "poissonsRatio peratomtype",
+            types.per_type(m.poisson_ratio, wm.poisson_ratio),
+        ),
+        (
+            "m3",
+            "coefficientRestitution peratomtypepair",
+            types.per_pair(h.restitution, w.restitution),
+        ),
+        (
+            "m4",
+            "coefficientFriction peratomtypepair",
+            types.per_pair(h.friction, w.friction),
+        ),
+    ] {
+        let _ = writeln!(
+            d,
+            "fix             {fix} all property/global {property} {table}"
+        );
+    }
     let rolling = if h.rolling == RollingKind::Epsd2 {
         let _ = writeln!(
             d,

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::analysis::heap::{self, HeapProfile};
+use crate::analysis::heap::HeapProfile;
 use crate::contact::PairLaw;
 use crate::io::write_atomic;
 use crate::math::Real;
@@ -21,16 +21,7 @@ use super::{Due, Flow, Observer, StageClock, Warnings};
 
 /// The heap surface of the scene's `[repose]` section, if it has one.
 pub(crate) fn heap_profile(scene: &Scene, particles: &Particles) -> Option<HeapProfile> {
-    scene.repose.as_ref().map(|r| {
-        heap::profile(
-            &particles.position,
-            &particles.radius,
-            r.wall_x,
-            scene.domain.hi.x,
-            scene.domain.lo.z,
-            r.bin_width_diameters * scene.max_diameter(),
-        )
-    })
+    super::super::heap_profile(scene, &particles.position, &particles.radius)
 }
 
 pub(crate) struct ReposeMeter<'s> {

@@ -11,7 +11,7 @@ use crate::scene::{ConveyingSettings, Scene, StageEnd};
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
-use super::super::{output_error, RunError, StageEnding};
+use super::super::{output_error, RunError, StageEnding, TIMESERIES_COLUMNS};
 use super::conveying::conveying_sample;
 use super::repose::heap_profile;
 use super::{Due, Flow, Observer, StageClock};
@@ -42,18 +42,8 @@ impl<'s> TimeSeries<'s> {
             conveying,
             settle: None,
         };
-        let mut header: Vec<String> = [
-            "time_s",
-            "stage",
-            "kinetic_energy_j",
-            "kinetic_energy_per_mass_j_kg",
-            "n_particles",
-            "front_m",
-            "wall_height_m",
-            "deleted_mass_kg",
-        ]
-        .map(String::from)
-        .into();
+        let mut header: Vec<String> = TIMESERIES_COLUMNS.map(String::from).into();
+        header.push("deleted_mass_kg".into());
         header.extend(
             scene
                 .bodies
