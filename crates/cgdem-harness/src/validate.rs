@@ -1236,19 +1236,25 @@ mod tests {
     ) -> RunRecord {
         let dir = root.join(format!("{}-{seed}", code.name()));
         std::fs::create_dir_all(&dir).unwrap();
-        let mut csv =
-            String::from("time_s,stage,front_m,wall_height_m,kinetic_energy_per_mass_j_kg\n");
+        let mut csv = cgdem_core::io::CsvBuffer::new([
+            "time_s",
+            "stage",
+            "front_m",
+            "wall_height_m",
+            "kinetic_energy_per_mass_j_kg",
+        ]);
         for i in 0..=50 {
             let t = i as f64 * 0.01;
             let ke = (t * (0.6 - t)).max(1e-6);
-            csv += &format!(
-                "{},collapse,{},{},{ke}\n",
-                1.0 + t,
-                front(t),
-                0.135 - 0.2 * (front(t) - 0.1)
-            );
+            csv.row([
+                (1.0 + t).to_string(),
+                "collapse".into(),
+                front(t).to_string(),
+                (0.135 - 0.2 * (front(t) - 0.1)).to_string(),
+                ke.to_string(),
+            ]);
         }
-        std::fs::write(dir.join("timeseries.csv"), csv).unwrap();
+        std::fs::write(dir.join("timeseries.csv"), csv.bytes().unwrap()).unwrap();
         let mut r = RunRecord::ok(
             "aor_hertz_smoke".into(),
             code,
