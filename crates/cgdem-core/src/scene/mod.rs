@@ -50,13 +50,30 @@ pub struct WcaSettings {
 }
 
 /// The particle-particle contact law and its parameters (one set for all species pairs).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub enum ContactSettings {
     /// The seed's model, paper A Eq. (1)-(2): WCA repulsion plus normal and tangential
     /// viscous damping.
     Wca(WcaSettings),
     /// Hertz contact with LIGGGHTS/LAMMPS-style sub-models (paper B).
     Hertz(HertzSettings),
+}
+
+/// Written as when `Wca` was a struct variant: the scene digest (`Scene::digest`, by which
+/// `--reuse` recognises a finished run) hashes this text.
+impl std::fmt::Debug for ContactSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ContactSettings::Wca(w) => f
+                .debug_struct("Wca")
+                .field("epsilon", &w.epsilon)
+                .field("sigma", &w.sigma)
+                .field("gamma_n", &w.gamma_n)
+                .field("gamma_t", &w.gamma_t)
+                .finish(),
+            ContactSettings::Hertz(h) => f.debug_tuple("Hertz").field(h).finish(),
+        }
+    }
 }
 
 /// `damping = "hertz" | "yang"`.
@@ -395,5 +412,24 @@ impl Scene {
 
     pub fn max_diameter(&self) -> Real {
         self.species.iter().map(|s| s.diameter).fold(0.0, Real::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wca_settings_print_as_the_struct_variant_the_scene_digests_were_taken_of() {
+        let contact = ContactSettings::Wca(WcaSettings {
+            epsilon: 1.5,
+            sigma: 2e-3,
+            gamma_n: 0.25,
+            gamma_t: 0.125,
+        });
+        assert_eq!(
+            format!("{contact:?}"),
+            "Wca { epsilon: 1.5, sigma: 0.002, gamma_n: 0.25, gamma_t: 0.125 }"
+        );
     }
 }
