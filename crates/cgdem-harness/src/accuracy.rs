@@ -19,11 +19,12 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::dynamics::FlowSeries;
 use crate::code::Code;
 use crate::csv_table::CsvTable;
 use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
 use crate::runs::{output_error, run_one, Outcome, ValidateError, ValidateOptions};
-use crate::suite_entry::{parse_codes, parse_variant, SuiteError};
+use crate::suite_entry::{parse_codes, parse_variant, rule_names, SuiteError};
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::scene::{Override, Scene};
@@ -67,6 +68,20 @@ pub struct KnobSeries {
     pub knob: Knob,
     pub values: Vec<f64>,
     pub codes: Vec<Code>,
+    /// The coarse-graining rule of this series' runs (the sweep's unless it names one).
+    pub rule: CoarseGrainRule,
+}
+
+impl KnobSeries {
+    /// The series' name in tables, figures and `summary.json`: the knob, with the rule when
+    /// it is not the sweep's.
+    fn name(&self, sweep_rule: CoarseGrainRule) -> String {
+        if self.rule == sweep_rule {
+            self.knob.name().to_string()
+        } else {
+            format!("{} ({})", self.knob.name(), self.rule.name())
+        }
+    }
 }
 
 /// Target errors for the cheapest-setting table.
@@ -77,6 +92,10 @@ pub struct Targets {
     pub profile: f64,
     /// Relative mass-flow error (against the reference run and against Eq. 7).
     pub mass_flow: f64,
+    /// Relative error of the collapse's characteristic time t_half.
+    pub t_half: f64,
+    /// Absolute porosity difference.
+    pub porosity: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -87,6 +106,8 @@ pub struct AccuracySweep {
     pub variant: String,
     /// Insertion seeds: every setting runs with each (issue 24: at least 3 where affordable).
     pub seeds: Vec<u64>,
+    /// The coarse-graining rule of the reference and of series that name none.
+    pub rule: CoarseGrainRule,
     /// Every knob's value at the reference; `lambda` always among them.
     pub reference: BTreeMap<Knob, f64>,
     pub series: Vec<KnobSeries>,
@@ -101,11 +122,14 @@ pub(super) struct RawSweep {
     #[serde(default)]
     set: Vec<String>,
     seeds: Option<Vec<u64>>,
+    cg_rule: Option<String>,
     reference: BTreeMap<String, toml::Value>,
     series: Vec<RawSeries>,
     angle_target_deg: Option<f64>,
     profile_target: Option<f64>,
     mass_flow_target: Option<f64>,
+    t_half_target: Option<f64>,
+    porosity_target: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -114,6 +138,7 @@ struct RawSeries {
     knob: String,
     values: Vec<toml::Value>,
     codes: Option<Vec<String>>,
+    cg_rule: Option<String>,
 }
 
 fn number(v: &toml::Value) -> Option<f64> {
@@ -140,6 +165,14 @@ impl AccuracySweep {
             &format!("accuracy[{k}]"),
             path,
         )?;
+        let parse_rule = |name: &str, field: &str| {
+            CoarseGrainRule::from_name(name)
+                .ok_or_else(|| invalid(field, format!("\"{name}\""), &rule_names()))
+        };
+        let sweep_rule = match &raw.cg_rule {
+            None => CoarseGrainRule::Seed,
+            Some(name) => parse_rule(name, "cg_rule")?,
+        };
         let lambda_ok = |v: f64| v >= 1.0 && v.fract() == 0.0 && (v as u32).is_power_of_two();
         let mut reference = BTreeMap::new();
         for (key, value) in &raw.reference {
@@ -192,10 +225,15 @@ impl AccuracySweep {
                     parse_codes(&names, &format!("accuracy[{k}].series[{j}].codes"), path)?
                 }
             };
+            let rule = match s.cg_rule {
+                None => sweep_rule,
+                Some(name) => parse_rule(&name, &format!("series[{j}].cg_rule"))?,
+            };
             series.push(KnobSeries {
                 knob,
                 values,
                 codes,
+                rule,
             });
         }
         let target = |field: &str, v: Option<f64>, default: f64| {
@@ -222,12 +260,15 @@ impl AccuracySweep {
             overrides,
             variant: raw.variant,
             seeds,
+            rule: sweep_rule,
             reference,
             series,
             targets: Targets {
                 angle_deg: target("angle_target_deg", raw.angle_target_deg, 1.0)?,
                 profile: target("profile_target", raw.profile_target, 0.05)?,
                 mass_flow: target("mass_flow_target", raw.mass_flow_target, 0.05)?,
+                t_half: target("t_half_target", raw.t_half_target, 0.1)?,
+                porosity: target("porosity_target", raw.porosity_target, 0.02)?,
             },
         })
     }
@@ -260,7 +301,7 @@ impl AccuracySweep {
 }
 
 /// One run of the sweep, as recorded in `summary.json`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AccuracyPoint {
     pub case: String,
     pub code: Code,
@@ -271,6 +312,8 @@ pub struct AccuracyPoint {
     /// The setting in words, e.g. "time.dt_fraction = 0.1".
     pub setting: String,
     pub lambda: u32,
+    #[serde(default)]
+    pub cg_rule: CoarseGrainRule,
     pub seed: u64,
     pub status: Outcome,
     pub reason: Option<String>,
@@ -293,10 +336,23 @@ pub struct AccuracyPoint {
     pub eq7_mass_flow_kg_s: Option<f64>,
     /// |Q / Q_Eq7 - 1|.
     pub eq7_error: Option<f64>,
+    /// The collapse's characteristic time (front at half its largest advance,
+    /// [`FlowSeries::t_half`]) in the measured stage.
+    #[serde(default)]
+    pub t_half_s: Option<f64>,
+    /// |t_half / t_half of the reference run with the same seed - 1|.
+    #[serde(default)]
+    pub t_half_error: Option<f64>,
+    /// Porosity of a packing (`summary.json` `packing.porosity`).
+    #[serde(default)]
+    pub porosity: Option<f64>,
+    /// |porosity - the reference run's|.
+    #[serde(default)]
+    pub porosity_error: Option<f64>,
 }
 
 /// The cheapest point within a target error, per case, code and error measure.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CheapestSetting {
     pub case: String,
     pub code: Code,
@@ -317,7 +373,7 @@ pub struct CheapestSetting {
     pub floor: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AccuracySummary {
     pub points: Vec<AccuracyPoint>,
     pub cheapest: Vec<CheapestSetting>,
@@ -325,29 +381,61 @@ pub struct AccuracySummary {
 
 /// The error measures, each with the unit its target and axis use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Measure {
+pub enum Measure {
     Angle,
     Profile,
     MassFlow,
     Eq7,
+    THalf,
+    Porosity,
 }
 
 impl Measure {
-    fn of(self, p: &AccuracyPoint) -> Option<f64> {
+    pub const ALL: [Measure; 6] = [
+        Measure::Angle,
+        Measure::Profile,
+        Measure::MassFlow,
+        Measure::Eq7,
+        Measure::THalf,
+        Measure::Porosity,
+    ];
+
+    /// The run's error under this measure.
+    pub fn of(self, p: &AccuracyPoint) -> Option<f64> {
         match self {
             Measure::Angle => p.angle_error_deg,
             Measure::Profile => p.profile_distance,
             Measure::MassFlow => p.mass_flow_error,
             Measure::Eq7 => p.eq7_error,
+            Measure::THalf => p.t_half_error,
+            Measure::Porosity => p.porosity_error,
         }
     }
 
-    fn name(self) -> &'static str {
+    /// The quantity's short name (`cgdem advise --quantity`).
+    pub fn quantity(self) -> &'static str {
+        match self {
+            Measure::Angle => "repose_angle",
+            Measure::Profile => "profile",
+            Measure::MassFlow => "mass_flow",
+            Measure::Eq7 => "mass_flow_eq7",
+            Measure::THalf => "t_half",
+            Measure::Porosity => "porosity",
+        }
+    }
+
+    pub fn from_quantity(name: &str) -> Option<Measure> {
+        Self::ALL.into_iter().find(|m| m.quantity() == name)
+    }
+
+    pub fn name(self) -> &'static str {
         match self {
             Measure::Angle => "repose angle vs reference",
             Measure::Profile => "heap profile vs reference",
             Measure::MassFlow => "mass flow vs reference",
             Measure::Eq7 => "mass flow vs Eq. (7)",
+            Measure::THalf => "t_half vs reference",
+            Measure::Porosity => "porosity vs reference",
         }
     }
 
@@ -357,6 +445,8 @@ impl Measure {
             Measure::Profile => "profile_distance",
             Measure::MassFlow => "mass_flow_error",
             Measure::Eq7 => "eq7_error",
+            Measure::THalf => "t_half_error",
+            Measure::Porosity => "porosity_error",
         }
     }
 
@@ -366,6 +456,8 @@ impl Measure {
             Measure::Profile => "RMS profile gap / reference heap height [-]",
             Measure::MassFlow => "|Q / Q_reference - 1| [-]",
             Measure::Eq7 => "|Q / Q_Eq.(7) - 1| [-]",
+            Measure::THalf => "|t_half / t_half,reference - 1| [-]",
+            Measure::Porosity => "|porosity - reference| [-]",
         }
     }
 
@@ -374,12 +466,16 @@ impl Measure {
             Measure::Angle => t.angle_deg,
             Measure::Profile => t.profile,
             Measure::MassFlow | Measure::Eq7 => t.mass_flow,
+            Measure::THalf => t.t_half,
+            Measure::Porosity => t.porosity,
         }
     }
 
-    fn format(self, v: f64) -> String {
+    /// A value in the measure's unit, for tables and answers.
+    pub fn format(self, v: f64) -> String {
         match self {
             Measure::Angle => format!("{v:.2} deg"),
+            Measure::Porosity => format!("{v:.4}"),
             _ => format!("{:.1}%", 100.0 * v),
         }
     }
@@ -512,19 +608,28 @@ fn run_sweep(
     };
     let (reference_scene, _) = sweep.scene(&sweep.reference, origin).map_err(case_error)?;
     let case = reference_scene.name.clone();
-    // (series, varied knob, value, codes, seed)
-    let mut jobs: Vec<(String, Knob, f64, Vec<Code>, u64)> = Vec::new();
+    // (series, varied knob, value, codes, rule, seed)
+    let mut jobs: Vec<(String, Knob, f64, Vec<Code>, CoarseGrainRule, u64)> = Vec::new();
     let all = sweep.codes();
     for &seed in &sweep.seeds {
-        jobs.push(("reference".into(), Knob::Lambda, 0.0, all.clone(), seed));
+        jobs.push((
+            "reference".into(),
+            Knob::Lambda,
+            0.0,
+            all.clone(),
+            sweep.rule,
+            seed,
+        ));
         for s in &sweep.series {
             for &v in &s.values {
-                if v != sweep.reference[&s.knob] {
+                // The reference's own value is the reference, unless the rule differs.
+                if v != sweep.reference[&s.knob] || s.rule != sweep.rule {
                     jobs.push((
-                        s.knob.name().into(),
+                        s.name(sweep.rule),
                         s.knob.clone(),
                         v,
                         s.codes.clone(),
+                        s.rule,
                         seed,
                     ));
                 }
@@ -532,7 +637,7 @@ fn run_sweep(
         }
     }
     let mut points = Vec::new();
-    for (series, knob, value, codes, seed) in jobs {
+    for (series, knob, value, codes, rule, seed) in jobs {
         let mut knobs = sweep.reference.clone();
         let (setting, value, name) = match series.as_str() {
             "reference" => (
@@ -542,10 +647,18 @@ fn run_sweep(
             ),
             _ => {
                 knobs.insert(knob.clone(), value);
+                let (setting, rule_dir) = if rule == sweep.rule {
+                    (format!("{} = {value}", knob.name()), String::new())
+                } else {
+                    (
+                        format!("{} = {value}, {} rule", knob.name(), rule.name()),
+                        format!("-{}", rule.name()),
+                    )
+                };
                 (
-                    format!("{} = {value}", knob.name()),
+                    setting,
                     value,
-                    format!("{}-{value}-seed{seed}", knob.file_name()),
+                    format!("{}-{value}{rule_dir}-seed{seed}", knob.file_name()),
                 )
             }
         };
@@ -557,7 +670,7 @@ fn run_sweep(
                 .join(&case)
                 .join("accuracy")
                 .join(format!("{}-{name}", code.name()));
-            let point = run_point(&scene, code, lambda, seed, &dir, options);
+            let point = run_point(&scene, code, lambda, rule, seed, &dir, options);
             let mut p = AccuracyPoint {
                 case: case.clone(),
                 code,
@@ -591,11 +704,11 @@ fn run_point(
     scene: &Scene,
     code: Code,
     lambda: u32,
+    rule: CoarseGrainRule,
     seed: u64,
     dir: &Path,
     options: &ValidateOptions,
 ) -> AccuracyPoint {
-    let rule = CoarseGrainRule::Seed;
     let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
     // A run that stopped early (a guard, a time limit) measured nothing comparable.
     if record.partial {
@@ -633,6 +746,7 @@ fn run_point(
         value: f64::NAN,
         setting: String::new(),
         lambda,
+        cg_rule: rule,
         seed,
         status: record.status,
         reason: record.reason,
@@ -649,6 +763,16 @@ fn run_point(
         mass_flow_error: None,
         eq7_mass_flow_kg_s: conveying("eq7_mass_flow_kg_s"),
         eq7_error: None,
+        t_half_s: scene
+            .repose
+            .as_ref()
+            .filter(|_| ok)
+            .and_then(|r| FlowSeries::read(dir, &r.stage)?.t_half()),
+        t_half_error: None,
+        porosity: summary["packing"]["porosity"]
+            .as_f64()
+            .filter(|v| ok && v.is_finite()),
+        porosity_error: None,
     }
 }
 
@@ -662,7 +786,7 @@ fn read_profile(dir: &Path) -> Vec<(f64, f64)> {
 }
 
 /// Fills each point's errors against its code's reference run with the same seed.
-fn measure(points: &mut [AccuracyPoint]) {
+pub(crate) fn measure(points: &mut [AccuracyPoint]) {
     let references: Vec<AccuracyPoint> = points
         .iter()
         .filter(|p| p.series == "reference" && p.status == Outcome::Ok)
@@ -681,6 +805,8 @@ fn measure(points: &mut [AccuracyPoint]) {
         p.angle_error_deg = difference(Measure::Angle, p, r);
         p.profile_distance = difference(Measure::Profile, p, r);
         p.mass_flow_error = difference(Measure::MassFlow, p, r);
+        p.t_half_error = difference(Measure::THalf, p, r);
+        p.porosity_error = difference(Measure::Porosity, p, r);
     }
 }
 
@@ -696,6 +822,8 @@ fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
         }
         Measure::MassFlow => finite((p.mass_flow_kg_s? / r.mass_flow_kg_s? - 1.0).abs()),
         Measure::Eq7 => finite((p.eq7_error? - r.eq7_error?).abs()),
+        Measure::THalf => finite((p.t_half_s? / r.t_half_s? - 1.0).abs()),
+        Measure::Porosity => finite((p.porosity? - r.porosity?).abs()),
     }
 }
 
@@ -718,17 +846,17 @@ fn floor(code: Code, m: Measure, points: &[AccuracyPoint]) -> Option<f64> {
 }
 
 /// One setting of one code (the reference or a series point) over the seeds it ran with.
-struct Setting<'a> {
-    series: &'a str,
-    setting: &'a str,
-    value: f64,
-    runs: Vec<&'a AccuracyPoint>,
+pub(crate) struct Setting<'a> {
+    pub series: &'a str,
+    pub setting: &'a str,
+    pub value: f64,
+    pub runs: Vec<&'a AccuracyPoint>,
 }
 
 impl Setting<'_> {
     /// Mean over the runs that measured `m`, with its cost `cost` (the same runs' mean), the
     /// standard error of the mean (None with one run) and the number of runs.
-    fn mean(&self, m: Measure, cost: Cost) -> Option<SettingMean> {
+    pub fn mean(&self, m: Measure, cost: Cost) -> Option<SettingMean> {
         let pairs: Vec<(f64, f64)> = self
             .runs
             .iter()
@@ -749,15 +877,15 @@ impl Setting<'_> {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct SettingMean {
-    cost: f64,
-    error: f64,
-    se: Option<f64>,
-    n: usize,
+pub(crate) struct SettingMean {
+    pub cost: f64,
+    pub error: f64,
+    pub se: Option<f64>,
+    pub n: usize,
 }
 
 /// The settings of `code`, in the order of the points, each with its successful runs.
-fn settings(code: Code, points: &[AccuracyPoint]) -> Vec<Setting<'_>> {
+pub(crate) fn settings(code: Code, points: &[AccuracyPoint]) -> Vec<Setting<'_>> {
     let mut out: Vec<Setting> = Vec::new();
     for p in points
         .iter()
@@ -817,15 +945,10 @@ fn write_sweep_section(
             .collect::<Vec<_>>()
             .join(", ")
     ));
-    let measures: Vec<Measure> = [
-        Measure::Angle,
-        Measure::Profile,
-        Measure::MassFlow,
-        Measure::Eq7,
-    ]
-    .into_iter()
-    .filter(|m| points.iter().any(|p| m.of(p).is_some()))
-    .collect();
+    let measures: Vec<Measure> = Measure::ALL
+        .into_iter()
+        .filter(|m| points.iter().any(|p| m.of(p).is_some()))
+        .collect();
 
     let mut table = Table::new(
         [
@@ -851,6 +974,7 @@ fn write_sweep_section(
         "knob_value",
         "setting",
         "lambda",
+        "cg_rule",
         "seed",
         "status",
         "n_particles",
@@ -864,6 +988,10 @@ fn write_sweep_section(
         "mass_flow_error",
         "eq7_mass_flow_kg_s",
         "eq7_error",
+        "t_half_s",
+        "t_half_error",
+        "porosity",
+        "porosity_error",
     ]);
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
@@ -909,6 +1037,7 @@ fn write_sweep_section(
             // Kept free of commas (a spreadsheet's eye reads the file too).
             p.setting.replace(',', ";"),
             p.lambda.to_string(),
+            p.cg_rule.name().to_string(),
             p.seed.to_string(),
             p.status.to_string(),
             p.n_particles.map_or(String::new(), |n| n.to_string()),
@@ -922,6 +1051,10 @@ fn write_sweep_section(
             o(p.mass_flow_error),
             o(p.eq7_mass_flow_kg_s),
             o(p.eq7_error),
+            o(p.t_half_s),
+            o(p.t_half_error),
+            o(p.porosity),
+            o(p.porosity_error),
         ]);
     }
     std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
@@ -1013,15 +1146,10 @@ fn write_sweep_section(
 }
 
 fn measure_named(name: &str) -> Measure {
-    [
-        Measure::Angle,
-        Measure::Profile,
-        Measure::MassFlow,
-        Measure::Eq7,
-    ]
-    .into_iter()
-    .find(|m| m.name() == name)
-    .unwrap_or(Measure::Angle)
+    Measure::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .unwrap_or(Measure::Angle)
 }
 
 /// The settings to choose from: the series, and the reference where its error is not zero
@@ -1042,8 +1170,8 @@ fn cheapest_setting(
 ) -> CheapestSetting {
     // Chosen by particle-steps, not wall time: within one code the two are proportional at a
     // given per-step cost, and on a shared machine the wall time of equal work varied
-    // two-fold between runs (reports/accuracy/NOTE.md). A setting's error is its mean over
-    // the seeds.
+    // two-fold between runs (reports/accuracy/one-seed-2026-11-22/NOTE.md). A setting's
+    // error is its mean over the seeds.
     let found: Vec<(Setting, SettingMean)> = candidates(code, m, points)
         .into_iter()
         .filter_map(|s| {
@@ -1078,13 +1206,13 @@ fn cheapest_setting(
 
 /// The cost a figure's x axis shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Cost {
+pub(crate) enum Cost {
     WallTime,
     ParticleSteps,
 }
 
 impl Cost {
-    fn of(self, p: &AccuracyPoint) -> Option<f64> {
+    pub fn of(self, p: &AccuracyPoint) -> Option<f64> {
         match self {
             Cost::WallTime => p.wall_s,
             Cost::ParticleSteps => p.particle_steps,
@@ -1224,6 +1352,7 @@ mod tests {
             value,
             setting: format!("{series} = {value}"),
             lambda: 1,
+            cg_rule: CoarseGrainRule::Seed,
             seed,
             status: Outcome::Ok,
             reason: None,
@@ -1240,6 +1369,10 @@ mod tests {
             mass_flow_error: None,
             eq7_mass_flow_kg_s: None,
             eq7_error: None,
+            t_half_s: None,
+            t_half_error: None,
+            porosity: None,
+            porosity_error: None,
         }
     }
 
@@ -1256,7 +1389,15 @@ mod tests {
             run("dt", 0.3, 2, 30.0, 1e6),
             run("dt", 0.3, 3, 30.5, 1e6),
         ];
+        // Seed 1's dynamics and packing: t_half 20% longer, porosity 0.01 higher.
+        points[0].t_half_s = Some(1.0);
+        points[3].t_half_s = Some(1.2);
+        points[0].porosity = Some(0.40);
+        points[3].porosity = Some(0.41);
         measure(&mut points);
+        assert!((points[3].t_half_error.unwrap() - 0.2).abs() < 1e-12);
+        assert!((points[3].porosity_error.unwrap() - 0.01).abs() < 1e-12);
+        assert_eq!(points[4].t_half_error, None);
         // Against the reference with the same seed: 0.5, 0.2, 0.5 (against seed 1's
         // reference alone they would be 0.5, 1.2, 1.0).
         let errors: Vec<f64> = points[3..6]
@@ -1280,6 +1421,8 @@ mod tests {
             angle_deg: 0.5,
             profile: 0.05,
             mass_flow: 0.05,
+            t_half: 0.1,
+            porosity: 0.02,
         };
         let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &targets, &points);
         assert_eq!(c.setting.as_deref(), Some("dt = 0.1"));
@@ -1385,6 +1528,19 @@ mod tests {
                 .to_string();
             assert!(e.contains("accuracy[0].seeds"), "{bad}: {e}");
         }
+        // A series under another coarse-graining rule is its own series, named by the rule.
+        let ruled = suite("knob = \"lambda\"\nvalues = [2]\ncg_rule = \"bulk-viscosity\"");
+        let ok = Suite::parse(&ruled, Path::new("s.toml")).unwrap();
+        let s0 = &ok.accuracy[0].series[0];
+        assert_eq!(s0.rule, CoarseGrainRule::BulkViscosity);
+        assert_eq!(s0.name(ok.accuracy[0].rule), "lambda (bulk-viscosity)");
+        let e = Suite::parse(&ruled.replace("bulk-viscosity", "pfm"), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("accuracy[0].series[0].cg_rule") && e.contains("pfm"),
+            "{e}"
+        );
         // The former single seed is refused by name, not silently ignored.
         let e = Suite::parse(&with_seeds("seed = 1"), Path::new("s.toml"))
             .unwrap_err()

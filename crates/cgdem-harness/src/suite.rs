@@ -12,7 +12,7 @@ use cgdem_core::scene::{Override, Scene, SceneError};
 
 pub use crate::code::Code;
 pub use crate::suite_entry::SuiteError;
-pub(crate) use crate::suite_entry::{load_variant, parse_codes, parse_variant};
+pub(crate) use crate::suite_entry::{load_variant, parse_codes, parse_variant, rule_names};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SuiteCase {
@@ -181,14 +181,14 @@ impl Suite {
             } else {
                 c.cg_rules
                     .iter()
-                    .map(|name| match name.as_str() {
-                        "seed" => Ok(CoarseGrainRule::Seed),
-                        "bulk-viscosity" => Ok(CoarseGrainRule::BulkViscosity),
-                        other => Err(invalid(
-                            format!("case[{k}].cg_rules"),
-                            format!("\"{other}\""),
-                            "\"seed\" or \"bulk-viscosity\"",
-                        )),
+                    .map(|name| {
+                        CoarseGrainRule::from_name(name).ok_or_else(|| {
+                            invalid(
+                                format!("case[{k}].cg_rules"),
+                                format!("\"{name}\""),
+                                &rule_names(),
+                            )
+                        })
                     })
                     .collect::<Result<Vec<_>, _>>()?
             };

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::code::Code;
+use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::{Override, Scene, SceneError};
 
 /// The scene of a suite entry: its file with the overrides applied, named after the
@@ -97,4 +98,13 @@ pub enum SuiteError {
         value: String,
         allowed: String,
     },
+}
+
+/// The coarse-graining rules' names, as an error's "allowed" text.
+pub(crate) fn rule_names() -> String {
+    CoarseGrainRule::ALL
+        .iter()
+        .map(|r| format!("\"{}\"", r.name()))
+        .collect::<Vec<_>>()
+        .join(" or ")
 }
