@@ -298,7 +298,7 @@ mod tests {
             lambda,
             cg_rule: rule,
             seed,
-            status: "ok".into(),
+            status: crate::runs::Outcome::Ok,
             reason: None,
             dir: PathBuf::from("/nonexistent"),
             reused: false,
