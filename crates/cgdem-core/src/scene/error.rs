@@ -18,4 +18,7 @@ pub enum SceneError {
         value: String,
         allowed: String,
     },
+    /// A bad line of a `read_data` file (file, line, field).
+    #[error(transparent)]
+    DataFile(#[from] crate::io::lammps_data::DataFileError),
 }
