@@ -515,57 +515,57 @@ Velocities
         let cases = [
             (
                 GOOD.replace("Atoms # sphere", "Atoms # atomic"),
-                ":12: field `Atoms`",
+                ":11: field `Atoms`",
                 "sphere",
             ),
             (
                 GOOD.replace("3 2 0.1 2500 0.5 0.5 0.5", "3 2 0.1 2500 0.5 0.5"),
-                ":14: field `Atoms` = 6 columns",
+                ":13: field `Atoms` = 6 columns",
                 "7 columns",
             ),
             (
                 GOOD.replace("3 2 0.1", "3 4 0.1"),
-                ":14: field `Atoms atom-type` = 4",
+                ":13: field `Atoms atom-type` = 4",
                 "1 to 2",
             ),
             (
                 GOOD.replace("0.8 0.8 0.8", "0.8 nan 0.8"),
-                ":16: field `Atoms y` = nan",
+                ":15: field `Atoms y` = nan",
                 "finite",
             ),
             (
                 GOOD.replace("2 1 0.1", "1 1 0.1"),
-                ":16: field `Atoms atom-ID` = 1",
-                "line 15",
+                ":15: field `Atoms atom-ID` = 1",
+                "line 14",
             ),
             (
                 GOOD.replace("2 1 0.1 2500", "2 1 -0.1 2500"),
-                ":16: field `Atoms diameter`",
+                ":15: field `Atoms diameter`",
                 "> 0",
             ),
             (
                 GOOD.replace("3 0 0 0 0 0 -7", "4 0 0 0 0 0 -7"),
-                ":22: field `Velocities atom-ID` = 4",
+                ":21: field `Velocities atom-ID` = 4",
                 "Atoms",
             ),
             (
                 GOOD.replace("3 0 0 0 0 0 -7", "1 0 0 0 0 0 -7"),
-                ":22: field `Velocities atom-ID` = 1",
-                "line 21",
+                ":21: field `Velocities atom-ID` = 1",
+                "line 20",
             ),
             (
                 GOOD.replace("1 1 0 0 0 5 0", "1 1 0 0 0 inf 0"),
-                ":21: field `Velocities wy` = inf",
+                ":20: field `Velocities wy` = inf",
                 "finite",
             ),
             (
                 GOOD.replace("3 atoms", "4 atoms"),
-                ":12: field `Atoms` = 3 lines",
+                ":11: field `Atoms` = 3 lines",
                 "4",
             ),
             (
                 GOOD.replace("Atoms # sphere", "Bonds"),
-                ":12: field `section`",
+                ":11: field `section`",
                 "Atoms",
             ),
             (

@@ -18,7 +18,10 @@ pub enum SceneError {
         value: String,
         allowed: String,
     },
-    /// A bad line of a `read_data` file (file, line, field).
-    #[error(transparent)]
-    DataFile(#[from] crate::io::lammps_data::DataFileError),
+    /// A bad line of the scene's `read_data` file (which names its file, line and field).
+    #[error("{}: read_data: {source}", .scene.display())]
+    DataFile {
+        scene: PathBuf,
+        source: crate::io::lammps_data::DataFileError,
+    },
 }
