@@ -204,7 +204,9 @@ pub fn parse_data(text: &str, file: &Path) -> Result<DataFile, DataFileError> {
     }
 
     let mut atoms: Option<Vec<DataAtom>> = None;
-    let mut velocity_rows: Option<(usize, Vec<(usize, u64, [Real; 6])>)> = None;
+    // (section line, rows of (line, atom-ID, vx vy vz wx wy wz))
+    type VelocityRows = (usize, Vec<(usize, u64, [Real; 6])>);
+    let mut velocity_rows: Option<VelocityRows> = None;
     let mut skipped_seen: Vec<&str> = Vec::new();
     while k < lines.len() {
         let (line, keyword, comment) = lines[k];
@@ -608,13 +610,14 @@ Velocities
         );
         let d = parse_data(&text, Path::new(FILE)).unwrap();
         let v = d.velocities.unwrap();
-        for k in 0..2 {
-            assert_eq!(d.atoms[k].id, k as u64 + 1);
-            assert_eq!(d.atoms[k].atom_type, k as u64 + 1);
-            assert_eq!(d.atoms[k].position, p.position[k]);
-            assert_eq!(v[k].velocity, p.velocity[k]);
-            assert_eq!(v[k].omega, p.angular.as_ref().unwrap().omega[k]);
+        for (k, (a, v)) in d.atoms.iter().zip(&v).enumerate() {
+            assert_eq!(a.id, k as u64 + 1);
+            assert_eq!(a.atom_type, k as u64 + 1);
+            assert_eq!(a.position, p.position[k]);
+            assert_eq!(v.velocity, p.velocity[k]);
+            assert_eq!(v.omega, p.angular.as_ref().unwrap().omega[k]);
         }
+        assert_eq!(d.atoms.len(), 2);
         assert_eq!(d.atoms[1].density, 2.5);
     }
 }

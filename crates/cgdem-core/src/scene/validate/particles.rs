@@ -120,7 +120,7 @@ pub fn given_particles_from_data(
 ) -> Result<Vec<GivenParticle>, SceneError> {
     let wrap = |source: DataFileError| SceneError::DataFile {
         scene: scene.to_path_buf(),
-        source,
+        source: Box::new(source),
     };
     let data = parse_data(text, file).map_err(wrap)?;
     let error = |line: usize, field: &str, value: String, allowed: String| {
