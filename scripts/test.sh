@@ -15,6 +15,9 @@ fi
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets -- -D warnings
 cargo test --release --workspace
+# The VTK series read by meshio (installed from PyPI if missing) and checked against cgdem's
+# own state on three short runs (seconds).
+bash scripts/check-vtk-meshio.sh
 
 # The smoke suite: every part of the harness on a small collapse (a few minutes).
 report=target/smoke-report

@@ -33,6 +33,8 @@ pub enum CoarseGrainError {
         diameter: f64,
         reason: String,
     },
+    #[error("{file}: lambda = {lambda} is not allowed with given particles (`read_data`, `[[particle]]`): a prepared state has no coarser counterpart; coarse-grain the scene that prepared it")]
+    GivenParticles { file: String, lambda: u32 },
 }
 
 /// Hertz parameters under `phi'(r) = lambda^3 phi(r / lambda)`, i.e. every contact force
@@ -102,6 +104,12 @@ pub fn coarse_grain_by(
 ) -> Result<Scene, CoarseGrainError> {
     if lambda == 0 || !lambda.is_power_of_two() {
         return Err(CoarseGrainError::NotPowerOfTwo(lambda));
+    }
+    if lambda > 1 && !scene.particles.is_empty() {
+        return Err(CoarseGrainError::GivenParticles {
+            file: scene.source.display().to_string(),
+            lambda,
+        });
     }
     let l = lambda as f64;
     let (energy, damping, time) = rule.exponents();

@@ -1,4 +1,5 @@
-//! Generated bad input for the core's parsers: the scene TOML and STL (ASCII and binary).
+//! Generated bad input for the core's parsers: the scene TOML, STL (ASCII and binary) and
+//! LAMMPS data files (`read_data`).
 //! No input may panic; every error names the file and the field or line (or triangle).
 //! `cargo test` runs a few cases (64 per parser); `scripts/fuzz.sh` sets PROPTEST_CASES.
 
@@ -6,7 +7,7 @@ use std::path::Path;
 use std::sync::atomic::AtomicU64;
 
 use cgdem_core::geometry::stl::{stl_from_bytes, stl_unchecked_from_bytes};
-use cgdem_core::scene::Scene;
+use cgdem_core::scene::{given_particles_from_data, Scene};
 use proptest::prelude::*;
 
 #[path = "../../../tests/support/fuzz_cases.rs"]
@@ -100,6 +101,109 @@ fn mutated_scene() -> impl Strategy<Value = String> {
     ]
 }
 
+/// A data file for the tiny collapse's species and box: two atoms, velocities and spins.
+const DATA: &str = "LAMMPS data file (fuzz base)
+
+2 atoms
+2 atom types
+
+0.0 0.15 xlo xhi
+0.0 0.04 ylo yhi
+0.0 0.12 zlo zhi
+
+Atoms # sphere
+
+1 1 1.0e-2 2500.0 0.02 0.02 0.02
+2 1 1.0e-2 2500.0 0.05 0.02 0.02 0 0 0
+
+Velocities
+
+1 0.0 0.0 -1.0 0.0 30.0 0.0
+2 0.5 0.0 0.0 0.0 0.0 0.0
+";
+const DATA_FILE: &str = "fuzz/start.data";
+
+/// A data-file error names the scene, the data file and a field (with the line where one is
+/// to blame).
+fn check_data(text: &str) {
+    static SPECIES: std::sync::OnceLock<Scene> = std::sync::OnceLock::new();
+    let scene = SPECIES.get_or_init(|| Scene::parse(SCENE, Path::new(SCENE_FILE)).unwrap());
+    for rotates in [true, false] {
+        if let Err(e) = given_particles_from_data(
+            text,
+            Path::new(DATA_FILE),
+            Path::new(SCENE_FILE),
+            &scene.species,
+            &scene.domain,
+            rotates,
+        ) {
+            let m = e.to_string();
+            assert!(
+                m.starts_with(SCENE_FILE) && m.contains(DATA_FILE),
+                "no files in: {m}"
+            );
+            assert!(m.contains("field `"), "no field in: {m}");
+        }
+    }
+}
+
+/// The base data file with a token replaced by a bad one, lines dropped or duplicated, or cut.
+fn mutated_data() -> impl Strategy<Value = String> {
+    let lines: Vec<String> = DATA.lines().map(str::to_string).collect();
+    let n = lines.len();
+    let token = prop_oneof![
+        Just("nan".to_string()),
+        Just("inf".to_string()),
+        Just("-1".to_string()),
+        Just("0".to_string()),
+        Just("3".to_string()),
+        Just("1e308".to_string()),
+        Just("18446744073709551616".to_string()),
+        Just("# sphere".to_string()),
+        Just("Atoms".to_string()),
+        Just("".to_string()),
+        any::<f64>().prop_map(|v| format!("{v:e}")),
+        any::<i64>().prop_map(|v| v.to_string()),
+        "[a-zA-Z#]{1,8}",
+    ];
+    prop_oneof![
+        (0..n, 0..10usize, token).prop_map({
+            let lines = lines.clone();
+            move |(k, t, v)| {
+                let mut l = lines.clone();
+                let mut tokens: Vec<String> = l[k].split_whitespace().map(str::to_string).collect();
+                if tokens.is_empty() {
+                    tokens.push(v);
+                } else {
+                    let t = t % (tokens.len() + 1);
+                    if t == tokens.len() {
+                        tokens.push(v);
+                    } else {
+                        tokens[t] = v;
+                    }
+                }
+                l[k] = tokens.join(" ");
+                l.join("\n")
+            }
+        }),
+        (0..n, 0..n).prop_map({
+            let lines = lines.clone();
+            move |(a, b)| {
+                let mut l = lines.clone();
+                l.remove(a.min(n - 1));
+                if b < l.len() {
+                    let dup = l[b].clone();
+                    l.insert(b, dup);
+                }
+                l.join("\n")
+            }
+        }),
+        (0..DATA.len()).prop_map(|cut| DATA[..cut].to_string()),
+    ]
+}
+
+static DATA_ANY: AtomicU64 = AtomicU64::new(0);
+static DATA_MUTATED: AtomicU64 = AtomicU64::new(0);
 static SCENE_ANY: AtomicU64 = AtomicU64::new(0);
 static SCENE_MUTATED: AtomicU64 = AtomicU64::new(0);
 static STL_BYTES: AtomicU64 = AtomicU64::new(0);
@@ -219,6 +323,18 @@ proptest! {
     }
 
     #[test]
+    fn data_file_reader_takes_any_text(text in any::<String>()) {
+        check_data(&text);
+        counted(&DATA_ANY, "read_data (any text)");
+    }
+
+    #[test]
+    fn data_file_reader_takes_mutated_files(text in mutated_data()) {
+        check_data(&text);
+        counted(&DATA_MUTATED, "read_data (mutated: tokens, lines, cuts)");
+    }
+
+    #[test]
     fn stl_reader_takes_any_bytes(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
         check_stl(&bytes);
         counted(&STL_BYTES, "stl (any bytes)");
@@ -235,6 +351,23 @@ proptest! {
         check_stl(&bytes);
         counted(&STL_ASCII, "stl (ascii: numbers, keywords, cuts)");
     }
+}
+
+/// The fuzzers' base data file is read (so the mutations start from a good file).
+#[test]
+fn the_fuzz_base_data_file_is_good() {
+    check_data(DATA);
+    let scene = Scene::parse(SCENE, Path::new(SCENE_FILE)).unwrap();
+    let p = given_particles_from_data(
+        DATA,
+        Path::new(DATA_FILE),
+        Path::new(SCENE_FILE),
+        &scene.species,
+        &scene.domain,
+        true,
+    )
+    .unwrap();
+    assert_eq!(p.len(), 2);
 }
 
 /// A header that claims 2^32 - 1 triangles in an 84-byte file: refused by size, at once.

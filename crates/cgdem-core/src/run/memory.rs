@@ -50,10 +50,11 @@ pub fn bytes(b: Real) -> String {
     }
 }
 
-/// Particles the insertions will make (an upper bound for lattices and meshes), plus what
-/// top-ups may add (at most the region's count again per insertion).
+/// The particles given (`read_data`, `[[particle]]`), those the insertions will make (an upper
+/// bound for lattices and meshes), plus what top-ups may add (at most the region's count again
+/// per insertion).
 fn particle_count(scene: &Scene) -> Real {
-    let mut n = 0.0;
+    let mut n = scene.particles.len() as Real;
     for ins in &scene.insertions {
         let d = scene.species[ins.species].diameter;
         let box_volume = (ins.hi - ins.lo).max(crate::math::Vec3::ZERO);

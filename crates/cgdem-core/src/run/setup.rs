@@ -63,10 +63,14 @@ pub fn initial_particles(
 }
 
 /// The particles a run of the scene starts with, clear of its SDF bodies and with the
-/// particles of bodies built of particles first (frozen): what the reference codes start from.
+/// particles of bodies built of particles first (frozen): what the reference codes start from,
+/// with their spins when the law rotates.
 pub fn initial_particles_clear_of_bodies(scene: &Scene) -> Result<Particles, RunError> {
+    // With a rotating law the spins given (insert omega, read_data, [[particle]]) go into
+    // the deck's Velocities section.
+    let rotation = matches!(scene.contact, crate::scene::ContactSettings::Hertz(_));
     if scene.bodies.is_empty() {
-        return initial_particles(scene, false, &[]);
+        return initial_particles(scene, rotation, &[]);
     }
     struct Bodies<'s>(&'s Scene);
     impl LawVisitor for Bodies<'_> {
@@ -76,7 +80,7 @@ pub fn initial_particles_clear_of_bodies(scene: &Scene) -> Result<Particles, Run
         }
     }
     let (bodies, sites) = with_laws(scene, Bodies(scene))??;
-    initial_particles_with_bodies(scene, false, &bodies, &sites).map(|(p, _)| p)
+    initial_particles_with_bodies(scene, rotation, &bodies, &sites).map(|(p, _)| p)
 }
 
 /// As [`initial_particles`], with the particles of bodies built of particles first (`sites`:
@@ -106,6 +110,23 @@ pub fn initial_particles_with_bodies(
             first_id: first as u32,
             reference: positions.clone(),
         });
+    }
+    for given in &scene.particles {
+        let species = &scene.species[given.species];
+        let k = particles.len();
+        particles.push(
+            given.species as u16,
+            given.position,
+            species.radius(),
+            species.mass(),
+        );
+        particles.velocity[k] = given.velocity;
+        if let Some(angular) = particles.angular.as_mut() {
+            angular.omega[k] = given.omega;
+        }
+        if species.frozen {
+            particles.freeze(k);
+        }
     }
     for (index, ins) in scene.insertions.iter().enumerate() {
         let species = &scene.species[ins.species];

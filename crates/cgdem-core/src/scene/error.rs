@@ -18,4 +18,10 @@ pub enum SceneError {
         value: String,
         allowed: String,
     },
+    /// A bad line of the scene's `read_data` file (which names its file, line and field).
+    #[error("{}: read_data: {source}", .scene.display())]
+    DataFile {
+        scene: PathBuf,
+        source: Box<crate::io::lammps_data::DataFileError>,
+    },
 }

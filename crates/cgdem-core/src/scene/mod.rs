@@ -10,6 +10,7 @@ pub use crate::analysis::conveying::ConveyingSettings;
 pub use cg_rule::CoarseGrainRule;
 pub use error::SceneError;
 pub use overrides::Override;
+pub use validate::given_particles_from_data;
 
 use std::path::{Path, PathBuf};
 
@@ -175,6 +176,18 @@ pub struct Lattice {
     pub radius: Option<Real>,
 }
 
+/// A particle the run starts with, from `read_data` or a `[[particle]]` table; its size and
+/// density are its species'.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GivenParticle {
+    pub species: usize,
+    pub position: Vec3,
+    /// m/s.
+    pub velocity: Vec3,
+    /// rad/s; zero unless the contact law rotates particles.
+    pub omega: Vec3,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Insertion {
     pub species: usize,
@@ -303,6 +316,9 @@ pub struct OutputSettings {
     pub vtk_interval: Real,
     /// Also write the pair contacts as lines (`vtk/contacts.pvd`) with each VTK frame.
     pub vtk_contact_network: bool,
+    /// Also write each VTK frame's particles as a LAMMPS data file
+    /// (`vtk/particles_NNNNNN.data`), from which a scene can start (`read_data`).
+    pub write_data: bool,
     /// Simulated seconds between time-series rows.
     pub timeseries_interval: Real,
 }
@@ -345,6 +361,9 @@ pub struct Scene {
     pub skin_fraction: Real,
     pub resort_every: u32,
     pub insertions: Vec<Insertion>,
+    /// Particles given one by one: those of `read_data` (by atom-ID), then the `[[particle]]`
+    /// tables; placed before the insertions, after the particles of bodies.
+    pub particles: Vec<GivenParticle>,
     pub stages: Vec<Stage>,
     pub output: OutputSettings,
     pub repose: Option<ReposeSettings>,

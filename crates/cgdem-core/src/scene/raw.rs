@@ -9,6 +9,8 @@ pub struct RawScene {
     pub name: String,
     #[serde(default)]
     pub description: String,
+    /// A LAMMPS data file (`atom_style sphere`) whose particles the run starts with.
+    pub read_data: Option<String>,
     pub domain: RawDomain,
     pub species: Vec<RawSpecies>,
     pub contact: RawContact,
@@ -22,6 +24,8 @@ pub struct RawScene {
     pub neighbor: Option<RawNeighbor>,
     #[serde(default, rename = "insert")]
     pub insertions: Vec<RawInsertion>,
+    #[serde(default, rename = "particle")]
+    pub particles: Vec<RawParticle>,
     #[serde(rename = "stage")]
     pub stages: Vec<RawStage>,
     #[serde(default)]
@@ -190,6 +194,18 @@ pub struct RawInsertion {
     pub refill: Option<RawRefill>,
 }
 
+/// `[[particle]]`: one particle the run starts with.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawParticle {
+    pub species: String,
+    pub position: [f64; 3],
+    /// Checked against the species' diameter (a species has one size).
+    pub diameter: Option<f64>,
+    pub velocity: Option<[f64; 3]>,
+    pub omega: Option<[f64; 3]>,
+}
+
 /// `[[body]] particles = { species = "...", lattice = "fcc" }`: a body built of particles.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -223,6 +239,7 @@ pub struct RawStage {
 pub struct RawOutput {
     pub vtk_interval: Option<f64>,
     pub vtk_contact_network: Option<bool>,
+    pub write_data: Option<bool>,
     pub timeseries_interval: Option<f64>,
 }
 

@@ -205,54 +205,21 @@ pub fn data_file(
     densities: &[Real],
     n_types: usize,
 ) -> String {
-    let (lo, hi) = (scene.domain.lo, scene.domain.hi);
-    let mut data = format!(
-        "LAMMPS data file written by cgdem {} for scene {} (lambda = {})\n\n{} atoms\n{} atom types\n\n",
+    let title = format!(
+        "LAMMPS data file written by cgdem {} for scene {} (lambda = {})",
         env!("CARGO_PKG_VERSION"),
         scene.name,
-        scene.lambda,
-        particles.len(),
-        n_types
+        scene.lambda
     );
-    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
-        let _ = writeln!(data, "{} {} {name}lo {name}hi", g(lo[axis]), g(hi[axis]));
-    }
-    data += "\nAtoms # sphere\n\n";
-    for k in 0..particles.len() {
-        let species = particles.species[k] as usize;
-        let p = particles.position[k];
-        let _ = writeln!(
-            data,
-            "{} {} {} {} {} {} {}",
-            particles.id[k] + 1,
-            species + 1,
-            g(diameters[species]),
-            g(densities[species]),
-            g(p.x),
-            g(p.y),
-            g(p.z)
-        );
-    }
-    data += "\nVelocities\n\n";
-    for k in 0..particles.len() {
-        let v = particles.velocity[k];
-        let w = particles
-            .angular
-            .as_ref()
-            .map_or(cgdem_core::math::Vec3::ZERO, |a| a.omega[k]);
-        let _ = writeln!(
-            data,
-            "{} {} {} {} {} {} {}",
-            particles.id[k] + 1,
-            g(v.x),
-            g(v.y),
-            g(v.z),
-            g(w.x),
-            g(w.y),
-            g(w.z)
-        );
-    }
-    data
+    cgdem_core::io::lammps_data::data_text(
+        &title,
+        scene.domain.lo,
+        scene.domain.hi,
+        particles,
+        diameters,
+        densities,
+        n_types,
+    )
 }
 
 /// Dump columns of the WCA deck (no rotation).

@@ -576,6 +576,78 @@ mod tests {
         assert!(deck.plan.notes.iter().any(|n| n.contains("rolling sds")));
     }
 
+    /// Spins given in a scene (insert omega, `[[particle]]`) reach both reference codes through
+    /// the data file's `Velocities` section (`wx wy wz`, which `read_data` takes for
+    /// atom_style sphere / granular), and the data file reads back as the same particles.
+    #[test]
+    fn decks_carry_the_initial_spins_and_their_data_file_reads_back() {
+        use cgdem_core::scene::{given_particles_from_data, Override};
+        crate::at_repo_root();
+        let path = std::path::Path::new("tests/data/tiny_hertz_collapse.toml");
+        let overrides: Vec<Override> = ["insert[0].omega=[0.0, 30.0, -2.5]"]
+            .iter()
+            .map(|o| Override::parse(o, path).unwrap())
+            .collect();
+        let mut scene = Scene::load_with_overrides(path, &overrides).unwrap();
+        scene.particles.push(cgdem_core::scene::GivenParticle {
+            species: 0,
+            position: cgdem_core::math::Vec3::new(0.1, 0.02, 0.05),
+            velocity: cgdem_core::math::Vec3::new(-1.0, 0.0, 0.0),
+            omega: cgdem_core::math::Vec3::new(0.0, 0.0, 7.0),
+        });
+        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let omega = &particles.angular.as_ref().expect("Hertz: spins").omega;
+        assert_eq!(omega[0], cgdem_core::math::Vec3::new(0.0, 0.0, 7.0));
+        assert!(omega[1..]
+            .iter()
+            .all(|&w| w == cgdem_core::math::Vec3::new(0.0, 30.0, -2.5)));
+        for deck in [
+            write_hertz_deck(&scene, &particles, 1e-5).unwrap(),
+            crate::liggghts::write_deck(&scene, &particles, 1e-5).unwrap(),
+        ] {
+            let velocities = &deck.data[deck.data.find("Velocities").unwrap()..];
+            assert!(
+                velocities.contains(&format!(
+                    "\n1 {} {} {} {} {} {}\n",
+                    g(-1.0),
+                    g(0.0),
+                    g(0.0),
+                    g(0.0),
+                    g(0.0),
+                    g(7.0)
+                )),
+                "{velocities:.300}"
+            );
+            assert!(
+                velocities.contains(&format!(
+                    "\n2 {} {} {} {} {} {}\n",
+                    g(0.0),
+                    g(0.0),
+                    g(0.0),
+                    g(0.0),
+                    g(30.0),
+                    g(-2.5)
+                )),
+                "{velocities:.300}"
+            );
+            let back = given_particles_from_data(
+                &deck.data,
+                std::path::Path::new("particles.data"),
+                path,
+                &scene.species,
+                &scene.domain,
+                true,
+            )
+            .unwrap();
+            assert_eq!(back.len(), particles.len());
+            for (k, b) in back.iter().enumerate() {
+                assert_eq!(b.position, particles.position[k]);
+                assert_eq!(b.velocity, particles.velocity[k]);
+                assert_eq!(b.omega, omega[k]);
+            }
+        }
+    }
+
     #[test]
     fn screw_deck_turns_the_particle_screw_from_the_conveying_stage_inside_the_casing_region() {
         crate::at_repo_root();

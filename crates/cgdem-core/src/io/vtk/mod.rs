@@ -17,6 +17,9 @@
 //! `body` (index in scene order, per triangle) and `velocity` (of the body's surface, per
 //! vertex). Contact arrays (`dump local` of `compute pair/gran/local`): `id` (the two
 //! particles' ids), `normal_force` (N, positive pushes apart) and `overlap` (m), per line.
+//!
+//! With `[output] write_data = true` each frame's particles are also written as a LAMMPS data
+//! file (`particles_NNNNNN.data`, see `io::lammps_data`), from which a scene can start.
 
 mod appended;
 mod series;
@@ -48,6 +51,17 @@ pub struct VtkOutput {
     /// Each body's mesh in its body frame (= world at t = 0), scene order.
     bodies: Option<(PvdSeries, Vec<TriMesh>)>,
     contacts: Option<PvdSeries>,
+    /// With `output.write_data`: each frame's particles also as a LAMMPS data file.
+    data: Option<DataFrames>,
+}
+
+/// What a frame's data file needs besides the particles: the scene's name, box and species.
+struct DataFrames {
+    scene: String,
+    lo: crate::math::Vec3,
+    hi: crate::math::Vec3,
+    diameters: Vec<crate::math::Real>,
+    densities: Vec<crate::math::Real>,
 }
 
 impl VtkOutput {
@@ -60,6 +74,7 @@ impl VtkOutput {
             particles: PvdSeries::new(dir.join("particles.pvd")),
             bodies: (!meshes.is_empty()).then(|| (PvdSeries::new(dir.join("bodies.pvd")), meshes)),
             contacts: contact_network.then(|| PvdSeries::new(dir.join("contacts.pvd"))),
+            data: None,
         })
     }
 
@@ -76,8 +91,18 @@ impl VtkOutput {
                     .map_err(|e| format!("{}: body[{k}].mesh: {e}", scene.source.display()))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        VtkOutput::new(dir, meshes, scene.output.vtk_contact_network)
-            .map_err(|e| format!("{}: {e}", dir.display()))
+        let mut out = VtkOutput::new(dir, meshes, scene.output.vtk_contact_network)
+            .map_err(|e| format!("{}: {e}", dir.display()))?;
+        if scene.output.write_data {
+            out.data = Some(DataFrames {
+                scene: scene.name.clone(),
+                lo: scene.domain.lo,
+                hi: scene.domain.hi,
+                diameters: scene.species.iter().map(|s| s.diameter).collect(),
+                densities: scene.species.iter().map(|s| s.density).collect(),
+            });
+        }
+        Ok(out)
     }
 
     /// Frames written so far.
@@ -112,6 +137,28 @@ impl VtkOutput {
             bytes.contacts = total_len(&data);
             write_frame_file(&self.dir.join(&file), &data)?;
             push(series, time, file)?;
+        }
+        if let Some(d) = &self.data {
+            // The frame's time in the title, to full precision: the data file and the .vtu
+            // of one frame can be matched by a reader.
+            let title = format!(
+                "LAMMPS data file written by cgdem {}: frame {frame} of scene {} at t = {time:.17e} s",
+                env!("CARGO_PKG_VERSION"),
+                d.scene
+            );
+            let text = crate::io::lammps_data::data_text(
+                &title,
+                d.lo,
+                d.hi,
+                &world.particles,
+                &d.diameters,
+                &d.densities,
+                d.diameters.len(),
+            );
+            write_frame_file(
+                &self.dir.join(format!("particles_{frame:06}.data")),
+                &[text.into_bytes()],
+            )?;
         }
         self.frames += 1;
         Ok(bytes)

@@ -6,7 +6,10 @@ mod contact;
 mod domain;
 mod insertion;
 mod packing;
+mod particles;
 mod stages;
+
+pub use particles::given_particles_from_data;
 
 use std::path::Path;
 
@@ -91,6 +94,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     let (skin_fraction, resort_every) =
         domain::neighbor(&c, raw.neighbor.as_ref(), &domain, &species)?;
     let insertions = insertion::insertions(&c, &raw, &domain, &species)?;
+    let particles = particles::given_particles(&c, &raw, &domain, &species)?;
     let stages = stages::stages(&c, &raw.stages, &walls)?;
     let output = stages::output(&c, raw.output.as_ref())?;
     let repose = raw
@@ -131,6 +135,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         skin_fraction,
         resort_every,
         insertions,
+        particles,
         stages,
         output,
         repose,

@@ -67,6 +67,7 @@ pub(super) fn output(
     Ok(OutputSettings {
         vtk_interval,
         vtk_contact_network: output.and_then(|o| o.vtk_contact_network).unwrap_or(false),
+        write_data: output.and_then(|o| o.write_data).unwrap_or(false),
         timeseries_interval,
     })
 }
