@@ -55,6 +55,8 @@ pub struct RunOptions {
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Split the box into these subdomains with ghost layers (`--grid`); None: one world.
     pub grid: Option<crate::decomposition::GridSpec>,
+    /// The MPI ranks a `--grid` run is spread over (`mpirun`); one process by default.
+    pub comm: crate::decomposition::Comm,
 }
 
 #[derive(Debug, thiserror::Error)]
