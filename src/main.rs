@@ -186,6 +186,12 @@ enum Command {
         /// Time limit of one reference-code run, seconds.
         #[arg(long, default_value_t = 1800)]
         reference_timeout: u64,
+        /// Also time cgdem decomposed into these subdomains (`2x1x1`, as `run --grid`), as a
+        /// case `<case>-grid<G>` in the same alternation (ratio to the undecomposed run per
+        /// repetition). MPI ranks are not launched: `cgdem run` cannot start from the
+        /// bench's prepared state; time them with `mpirun ... cgdem run --grid`.
+        #[arg(long)]
+        grid: Option<cgdem_core::decomposition::GridSpec>,
     },
     /// Add a nightly report (a `cgdem validate` output) to the history in DIR: appends its
     /// metrics to DIR/history.json, rewrites DIR/index.html with the history table, trend
@@ -602,6 +608,7 @@ fn main() -> ExitCode {
             prepare,
             no_outcome,
             reference_timeout,
+            grid,
         } => {
             let mut parsed = Vec::new();
             for name in &codes {
@@ -621,6 +628,7 @@ fn main() -> ExitCode {
                 return ExitCode::FAILURE;
             }
             let options = cgdem_harness::bench::BenchOptions {
+                grid,
                 cases,
                 out: out.clone(),
                 codes: parsed,

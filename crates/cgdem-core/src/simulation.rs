@@ -822,6 +822,30 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
     }
 
+    /// The grid, ranks, particles per subdomain, imbalance and bytes sent between ranks per
+    /// step, when decomposed. Collective under MPI.
+    pub fn decomposition_summary(&self) -> Option<crate::run::DecompositionSummary> {
+        let d = self.decomposition.as_ref()?;
+        let counts: Vec<usize> = d
+            .comm
+            .gather_by_subdomain(d.subdomains.len(), |s, out| {
+                out.push(d.subdomains[s].n_owned as Real)
+            })
+            .iter()
+            .map(|w| w[0] as usize)
+            .collect();
+        let mean = counts.iter().sum::<usize>() as Real / counts.len().max(1) as Real;
+        let most = counts.iter().copied().max().unwrap_or(0) as Real;
+        let bytes = d.comm.sum(d.bytes_sent) as Real;
+        Some(crate::run::DecompositionSummary {
+            grid: d.grid.counts,
+            ranks: d.comm.size(),
+            subdomain_particles: counts,
+            imbalance: if mean > 0.0 { most / mean } else { 1.0 },
+            bytes_sent_between_ranks_per_step: bytes / self.steps.max(1) as Real,
+        })
+    }
+
     /// The processes the world is stepped on (one unless decomposed under MPI).
     pub fn comm(&self) -> Comm {
         self.decomposition

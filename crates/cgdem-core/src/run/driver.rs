@@ -122,6 +122,7 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
         final_state: options.keep_final_state.then(|| world.particles.clone()),
         memory: Some(world.memory_use()),
+        decomposition: world.decomposition_summary(),
     };
     for o in &mut observers {
         o.observer()
