@@ -1141,8 +1141,8 @@ fn cheapest_setting(
 ) -> CheapestSetting {
     // Chosen by particle-steps, not wall time: within one code the two are proportional at a
     // given per-step cost, and on a shared machine the wall time of equal work varied
-    // two-fold between runs (reports/accuracy/NOTE.md). A setting's error is its mean over
-    // the seeds.
+    // two-fold between runs (reports/accuracy/one-seed-2026-11-22/NOTE.md). A setting's
+    // error is its mean over the seeds.
     let found: Vec<(Setting, SettingMean)> = candidates(code, m, points)
         .into_iter()
         .filter_map(|s| {
