@@ -39,3 +39,7 @@ if [ "$(id -u)" = 0 ] || command -v chromium >/dev/null 2>&1; then
 else
     echo "note: chromium not available and cannot be installed without root; report not checked in a browser"
 fi
+
+# The MPI transport of --grid: built with --features mpi (OpenMPI installed as root), 2 and 4
+# ranks against the threaded run, CSVs compared with cmp. Last, as it replaces the binary.
+bash scripts/mpi-check.sh

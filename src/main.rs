@@ -86,7 +86,9 @@ enum Command {
         /// Split the box into subdomains with ghost layers, each stepped on its own thread
         /// (domain decomposition): `2x1x1` subdomains along x, y, z, or a count (`2`) for the
         /// grid with the least ghost surface. Off by default; velocity Verlet and planar walls
-        /// only so far. Results match the undecomposed run to rounding, not bitwise.
+        /// only so far. Results match the undecomposed run to rounding, not bitwise. Under
+        /// `mpirun -np N` (a build with `--features mpi`) each rank steps a block of the
+        /// subdomains; the outputs are bitwise those of the same grid on threads.
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
         /// With `--sweep rpm=` or `screw_ratio=`: a run directory whose summary.json holds
@@ -184,6 +186,12 @@ enum Command {
         /// Time limit of one reference-code run, seconds.
         #[arg(long, default_value_t = 1800)]
         reference_timeout: u64,
+        /// Also time cgdem decomposed into these subdomains (`2x1x1`, as `run --grid`), as a
+        /// case `<case>-grid<G>` in the same alternation (ratio to the undecomposed run per
+        /// repetition). MPI ranks are not launched: `cgdem run` cannot start from the
+        /// bench's prepared state; time them with `mpirun ... cgdem run --grid`.
+        #[arg(long)]
+        grid: Option<cgdem_core::decomposition::GridSpec>,
     },
     /// Add a nightly report (a `cgdem validate` output) to the history in DIR: appends its
     /// metrics to DIR/history.json, rewrites DIR/index.html with the history table, trend
@@ -626,6 +634,7 @@ fn main() -> ExitCode {
             prepare,
             no_outcome,
             reference_timeout,
+            grid,
         } => {
             let mut parsed = Vec::new();
             for name in &codes {
@@ -645,6 +654,7 @@ fn main() -> ExitCode {
                 return ExitCode::FAILURE;
             }
             let options = cgdem_harness::bench::BenchOptions {
+                grid,
                 cases,
                 out: out.clone(),
                 codes: parsed,
@@ -727,6 +737,32 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
+            // Under mpirun (a build with the `mpi` feature) each rank steps its subdomains;
+            // rank 0 writes the outputs, the others write theirs into a scratch directory.
+            let comm = match cgdem_core::decomposition::Comm::from_environment() {
+                Ok(comm) => comm,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            if comm.is_distributed() && (grid.is_none() || sweep.is_some()) {
+                if comm.is_root() {
+                    eprintln!(
+                        "error: under mpirun ({} ranks) cgdem run needs --grid (at least one subdomain per rank) and no --sweep",
+                        comm.size()
+                    );
+                }
+                return ExitCode::from(2);
+            }
+            let root = comm.is_root();
+            let scratch = (!root).then(|| {
+                std::env::temp_dir().join(format!(
+                    "cgdem-rank{}-{}",
+                    comm.rank(),
+                    std::process::id()
+                ))
+            });
             let pool = match worker_pool(threads) {
                 Ok(pool) => pool,
                 Err(code) => return code,
@@ -789,15 +825,21 @@ fn main() -> ExitCode {
                         }
                         out_used = Some(out_dir.clone());
                         let options = RunOptions {
-                            out_dir: out_dir.clone(),
-                            progress: progress_bar::progress(quiet),
+                            out_dir: scratch.clone().unwrap_or_else(|| out_dir.clone()),
+                            progress: progress_bar::progress(quiet || !root),
                             force_dt,
                             keep_going,
                             stop: interrupt.as_ref().map(|i| i.flag()),
                             grid,
+                            comm: comm.clone(),
                             ..Default::default()
                         };
-                        let summary = run(&scene, &options).map_err(|e| e.to_string())?;
+                        let summary = run(&scene, &options).map_err(|e| e.to_string());
+                        if let Some(dir) = &scratch {
+                            let _ = std::fs::remove_dir_all(dir);
+                            return summary.map(|s| (s, out_dir));
+                        }
+                        let summary = summary?;
                         // A figure that cannot be drawn does not fail the run it shows.
                         match cgdem_harness::report::run_figures::write_run_figures(&scene, &summary, &out_dir) {
                             Ok(files) => figures.extend(files.into_iter().map(|f| f.png)),
@@ -806,6 +848,14 @@ fn main() -> ExitCode {
                         Ok((summary, out_dir))
                     })
             });
+            if !root {
+                // Rank 0 reports; every rank ends with the same status.
+                return if result.is_ok() {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::FAILURE
+                };
+            }
             if let Some(out_dir) = &out_used {
                 if let Some(code) = interrupted(&interrupt, out_dir) {
                     if let Err(message) = &result {

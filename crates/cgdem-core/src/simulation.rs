@@ -14,7 +14,7 @@ use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::decomposition::step::{Decomposition, Physics};
-use crate::decomposition::{choose_counts, Grid, GridSpec, HistoryRows};
+use crate::decomposition::{choose_counts, Comm, Grid, GridSpec, HistoryRows};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
 use crate::guard::{
@@ -246,6 +246,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         let next = self.particles.id.iter().max().map_or(0, |&m| m + 1);
         let decomposed = self.decomposition.take();
+        // Under MPI every rank gathers every particle, adds the same ones and deals out its
+        // own again.
         let rows = decomposed.as_ref().map(|d| d.gathered_rows());
         if let Some(d) = &decomposed {
             // The wall histories live in the subdomains between rebuilds.
@@ -261,7 +263,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 for _ in 0..positions.len() {
                     rows.push(&[]);
                 }
-                self.decompose(d.grid, rows);
+                self.decompose(d.grid, rows, d.comm);
             }
             _ => self.rebuild(),
         }
@@ -674,7 +676,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// Splits the world into the subdomains of `spec` (`--grid`): from now on each steps
     /// its own particles and ghosts. Velocity Verlet with planar walls only so far.
-    pub fn set_grid(&mut self, spec: GridSpec) -> Result<(), String> {
+    /// Under MPI (`comm` of several ranks) each rank steps the subdomains it owns.
+    pub fn set_grid(&mut self, spec: GridSpec, comm: Comm) -> Result<(), String> {
         let unsupported = if self.integrator != Integrator::VelocityVerlet {
             Some("the pcvv integrator")
         } else if !self.bodies.is_empty() || !self.kinematic.is_empty() {
@@ -710,6 +713,17 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         };
         let grid = Grid::balanced(counts, &self.domain, &p.position);
         grid.check_width(self.ghost_width())?;
+        if comm.size() > grid.len() {
+            return Err(format!(
+                "{} MPI ranks need at least as many subdomains, and the grid {}x{}x{} has {}; give a grid of at least {} subdomains",
+                comm.size(),
+                counts[0],
+                counts[1],
+                counts[2],
+                grid.len(),
+                comm.size()
+            ));
+        }
         // Histories by partner id, in the pair's canonical orientation (lower id first).
         let mut entries = Vec::new();
         for (pair, &h) in self.list.pairs.iter().zip(&self.history) {
@@ -723,7 +737,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             entries.push((j, id_i, h));
         }
         let rows = HistoryRows::from_entries(p.len(), entries);
-        self.decompose(grid, rows);
+        self.decompose(grid, rows, comm);
         self.list = VerletList::new(self.neighbor.skin);
         self.history = Vec::new();
         self.reaction_force = Vec::new();
@@ -738,7 +752,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     /// Deals the particles out over `grid` with their histories and evaluates the forces.
-    fn decompose(&mut self, grid: Grid, rows: HistoryRows<L::History>) {
+    fn decompose(&mut self, grid: Grid, rows: HistoryRows<L::History>, comm: Comm) {
         let slots = self.wall_slots();
         self.wall_history
             .resize(self.particles.len() * slots, W::History::default());
@@ -752,10 +766,66 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.ghost_width(),
             self.law.reach() + self.neighbor.skin,
             self.neighbor.skin,
+            comm,
         );
-        (self.particles, self.wall_history) = decomposition.gathered();
+        if !decomposition.comm.is_distributed() {
+            (self.particles, self.wall_history) = decomposition.gathered();
+        }
         self.decomposition = Some(Box::new(decomposition));
         self.decomposed_forces(false);
+        // Under MPI the forces do not reach `particles`: gather them (every rank).
+        self.sync_particles();
+    }
+
+    /// Under MPI, brings every rank's owned particles into `particles` (subdomain order, as
+    /// one process lays them out): call before reading `particles` while decomposed.
+    /// Collective: every rank must call it at the same step. Nothing to do otherwise.
+    pub fn sync_particles(&mut self) {
+        if let Some(d) = &self.decomposition {
+            if d.comm.is_distributed() {
+                (self.particles, self.wall_history) = d.gathered();
+            }
+        }
+    }
+
+    /// Particles in the world (over all ranks under MPI, where `particles` is refreshed only
+    /// by `sync_particles`).
+    pub fn particle_count(&self) -> usize {
+        match &self.decomposition {
+            Some(d) => d.total,
+            None => self.particles.len(),
+        }
+    }
+
+    /// The grid, ranks, particles per subdomain, imbalance and bytes sent between ranks per
+    /// step, when decomposed. Collective under MPI.
+    pub fn decomposition_summary(&self) -> Option<crate::run::DecompositionSummary> {
+        let d = self.decomposition.as_ref()?;
+        let counts: Vec<usize> = d
+            .comm
+            .gather_by_subdomain(d.subdomains.len(), |s, out| {
+                out.push(d.subdomains[s].n_owned as Real)
+            })
+            .iter()
+            .map(|w| w[0] as usize)
+            .collect();
+        let mean = counts.iter().sum::<usize>() as Real / counts.len().max(1) as Real;
+        let most = counts.iter().copied().max().unwrap_or(0) as Real;
+        let bytes = d.comm.sum(d.bytes_sent) as Real;
+        Some(crate::run::DecompositionSummary {
+            grid: d.grid.counts,
+            ranks: d.comm.size(),
+            subdomain_particles: counts,
+            imbalance: if mean > 0.0 { most / mean } else { 1.0 },
+            bytes_sent_between_ranks_per_step: bytes / self.steps.max(1) as Real,
+        })
+    }
+
+    /// The processes the world is stepped on (one unless decomposed under MPI).
+    pub fn comm(&self) -> Comm {
+        self.decomposition
+            .as_ref()
+            .map_or_else(Comm::local, |d| d.comm.clone())
     }
 
     /// The subdomains' grid and particle counts, when decomposed.
@@ -807,28 +877,44 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let domain = self.domain.clone();
         let keep = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
         let origin = self.potential_origin();
+        let gravity = self.gravity;
+        let tripped = self.guard.trip.is_some();
         let d = self.decomposition.as_mut().expect("decomposed");
-        for sub in &d.subdomains {
+        // Per subdomain, in order, the particles that left the box or are removed: (id,
+        // position, velocity, energy, left the box, removed), gathered from every rank.
+        let events = d.comm.gather_by_subdomain(d.subdomains.len(), |s, out| {
+            let sub = &d.subdomains[s];
             let p = &sub.particles;
             for k in 0..sub.n_owned {
                 let x = p.position[k];
-                if stop_on_lost
-                    && x.is_finite()
-                    && !domain.contains_bounded(x)
-                    && self.guard.trip.is_none()
-                {
-                    self.guard.left_box.push((p.id[k], x, p.velocity[k]));
+                let left = stop_on_lost && x.is_finite() && !domain.contains_bounded(x) && !tripped;
+                let removed = !keep(x);
+                if !left && !removed {
+                    continue;
                 }
-                if keep(x) {
+                let e = 0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
+                    - p.mass[k] * gravity.dot(x - origin);
+                out.push(p.id[k] as Real);
+                out.extend_from_slice(&x.to_array());
+                out.extend_from_slice(&p.velocity[k].to_array());
+                out.extend_from_slice(&[e, left as u8 as Real, removed as u8 as Real]);
+            }
+        });
+        for words in &events {
+            for w in words.chunks_exact(10) {
+                let id = w[0] as u32;
+                if w[8] != 0.0 {
+                    let (x, v) = (Vec3::new(w[1], w[2], w[3]), Vec3::new(w[4], w[5], w[6]));
+                    self.guard.left_box.push((id, x, v));
+                }
+                if w[9] == 0.0 {
                     continue;
                 }
                 self.lost += 1;
-                let e = 0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
-                    - p.mass[k] * self.gravity.dot(x - origin);
-                if e.is_finite() {
-                    self.guard.removed_energy += e;
+                if w[7].is_finite() {
+                    self.guard.removed_energy += w[7];
                 } else {
-                    self.guard.removed_non_finite.push(p.id[k]);
+                    self.guard.removed_non_finite.push(id);
                 }
             }
         }
@@ -836,7 +922,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             && d.builds.is_multiple_of(self.neighbor.resort_every as u64);
         let slots = (self.walls.walls.len() + self.bodies.len()).max(1);
         d.rebuild(&domain, slots, &keep, resort);
-        (self.particles, self.wall_history) = d.gathered();
+        if !d.comm.is_distributed() {
+            (self.particles, self.wall_history) = d.gathered();
+        }
     }
 
     pub fn kinetic_energy(&self) -> Real {
@@ -863,7 +951,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// gravitational energy, plus the elastic energy stored in overlapping pairs, which may
     /// turn into motion (particles placed overlapping push apart).
     pub fn reset_energy_reference(&mut self) {
-        self.guard.energy_reference = Some(self.mechanical_energy() + self.pair_elastic_energy());
+        let (energy, _) = self.guard_energy();
+        self.guard.energy_reference = Some(energy + self.pair_elastic_energy());
         self.guard.removed_energy = 0.0;
     }
 
@@ -908,6 +997,15 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.kinetic_energy() + potential
     }
 
+    /// Mechanical energy and mobile mass for the energy guard: decomposed, summed per
+    /// subdomain (so the same on any number of threads or ranks, and without gathering).
+    fn guard_energy(&self) -> (Real, Real) {
+        match &self.decomposition {
+            Some(d) => d.energy_and_mobile_mass(self.gravity, self.potential_origin()),
+            None => (self.mechanical_energy(), self.particles.mobile_mass()),
+        }
+    }
+
     /// Kinetic plus gravitational energy of particle `k` (as in `mechanical_energy`).
     fn particle_energy(&self, k: usize) -> Real {
         let p = &self.particles;
@@ -938,7 +1036,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let overlap = self.max_overlap_fraction();
         let peaks = &mut self.guard.peaks;
         peaks.overlap_fraction = peaks.overlap_fraction.max(overlap);
-        self.guard.trip = if !self.guard.finite || !self.guard.removed_non_finite.is_empty() {
+        let non_finite = !self.guard.finite || !self.guard.removed_non_finite.is_empty();
+        let lost = !self.guard.left_box.is_empty() && s.stop_on_lost;
+        if non_finite || overlap > s.max_overlap_fraction || lost {
+            // The diagnosis names particles: every rank gathers them (the reduced overlaps,
+            // finiteness and removal events are the same on all, so all trip together).
+            self.sync_particles();
+        }
+        self.guard.trip = if non_finite {
             Some(self.diagnose_non_finite())
         } else if self.max_overlap_fraction() > s.max_overlap_fraction {
             if self.decomposition.is_some() {
@@ -963,17 +1068,22 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     fn check_energy(&mut self) -> Option<GuardTrip> {
         let s = self.guard.settings;
-        let energy = self.mechanical_energy();
+        let (energy, mobile_mass) = self.guard_energy();
         let removed = std::mem::take(&mut self.guard.removed_energy);
         if let Some(reference) = &mut self.guard.energy_reference {
             *reference -= removed;
         }
         match self.guard.energy_reference {
             Some(reference) => {
-                let scale = reference.max(self.particles.mobile_mass() * s.energy_floor_per_mass);
+                let scale = reference.max(mobile_mass * s.energy_floor_per_mass);
                 let rise = (energy - reference) / scale;
                 self.guard.peaks.energy_rise = self.guard.peaks.energy_rise.max(rise);
-                (rise > s.energy_growth).then(|| self.diagnose_energy(energy, reference))
+                if rise <= s.energy_growth {
+                    return None;
+                }
+                // The diagnosis names particles: every rank gathers them (all trip together).
+                self.sync_particles();
+                Some(self.diagnose_energy(energy, reference))
             }
             None => {
                 self.guard.energy_reference = Some(energy);

@@ -28,6 +28,7 @@ use crate::liggghts;
 use crate::report::plot::write_bar_chart;
 use crate::suite::Code;
 use cgdem_core::analysis::conical_heap::{conical_heap, ConicalHeap};
+use cgdem_core::decomposition::GridSpec;
 use cgdem_core::math::{Real, Vec3};
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{run, RunOptions};
@@ -52,6 +53,11 @@ pub struct BenchOptions {
     /// heap it leaves.
     pub outcome: bool,
     pub timeout: Duration,
+    /// Also time cgdem decomposed into these subdomains (`--grid`), as a case of its own
+    /// (`<case>-grid<G>`) run in the same alternation, so that each repetition gives the
+    /// ratio decomposed / undecomposed from adjacent runs. The reference codes run the
+    /// undecomposed case only.
+    pub grid: Option<GridSpec>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -138,6 +144,7 @@ pub struct BenchReport {
 }
 
 /// A case ready to time: the scene cut to `steps`, its step and the prepared state.
+#[derive(Clone)]
 struct PreparedCase {
     name: String,
     timed: Scene,
@@ -145,42 +152,56 @@ struct PreparedCase {
     state: Particles,
     dt: Real,
     reference_codes: bool,
+    /// cgdem runs decomposed into this grid (the reference codes skip the case).
+    grid: Option<GridSpec>,
 }
 
 pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
     let out = &options.out;
     let mut cases = Vec::new();
     for path in &options.cases {
-        cases.push(prepare(path, options)?);
+        let case = prepare(path, options)?;
+        if let Some(grid) = options.grid {
+            let mut decomposed = case.clone();
+            decomposed.name = format!("{}-grid{grid}", case.name);
+            decomposed.grid = Some(grid);
+            cases.push(case);
+            cases.push(decomposed);
+        } else {
+            cases.push(case);
+        }
     }
     let mut runs: Vec<BenchRun> = Vec::new();
     let mut memory = Vec::new();
     for &threads in &options.threads {
         for repetition in 0..options.pairs {
-            for case in &cases {
-                let mut order: Vec<Code> = options.codes.clone();
-                if repetition % 2 == 1 {
-                    order.reverse();
-                }
-                for code in order {
-                    let dir = out
-                        .join(&case.name)
-                        .join(format!("{}-t{threads}-r{repetition}", code.name()));
-                    let (run, mem) = timed_run(case, code, threads, repetition, &dir, options);
-                    eprintln!(
-                        "bench {} {} threads={threads} rep={repetition}: {}",
-                        case.name,
-                        code.name(),
-                        run.particle_steps_per_s
-                            .map_or(run.status.clone(), |v| format!("{v:.3e} particle-steps/s"))
-                    );
-                    if let Some(m) = mem {
-                        if memory.iter().all(|x: &BenchMemory| x.case != m.case) {
-                            memory.push(m);
-                        }
+            // Every (case, code) in turn, the whole sequence reversed on odd repetitions
+            // (A B C, C B A), so adjacent runs make each ratio.
+            let mut order: Vec<(&PreparedCase, Code)> = cases
+                .iter()
+                .flat_map(|case| options.codes.iter().map(move |&code| (case, code)))
+                .collect();
+            if repetition % 2 == 1 {
+                order.reverse();
+            }
+            for (case, code) in order {
+                let dir = out
+                    .join(&case.name)
+                    .join(format!("{}-t{threads}-r{repetition}", code.name()));
+                let (run, mem) = timed_run(case, code, threads, repetition, &dir, options);
+                eprintln!(
+                    "bench {} {} threads={threads} rep={repetition}: {}",
+                    case.name,
+                    code.name(),
+                    run.particle_steps_per_s
+                        .map_or(run.status.clone(), |v| format!("{v:.3e} particle-steps/s"))
+                );
+                if let Some(m) = mem {
+                    if memory.iter().all(|x: &BenchMemory| x.case != m.case) {
+                        memory.push(m);
                     }
-                    runs.push(run);
                 }
+                runs.push(run);
             }
         }
     }
@@ -284,6 +305,7 @@ fn prepare(path: &Path, options: &BenchOptions) -> Result<PreparedCase, BenchErr
         state,
         dt,
         reference_codes: rotation,
+        grid: None,
     })
 }
 
@@ -326,6 +348,7 @@ fn run_code(
                 out_dir: dir.to_path_buf(),
                 initial_state: Some(case.state.clone()),
                 keep_final_state: true,
+                grid: case.grid,
                 ..Default::default()
             };
             match pool.install(|| run(scene, &run_options)) {
@@ -340,6 +363,14 @@ fn run_code(
                 }
                 Err(e) => return (RunResult::failed(e.to_string()), None),
             }
+        }
+        Code::Liggghts | Code::Lammps if case.grid.is_some() => {
+            result.status = "skipped".into();
+            result.reason = Some(format!(
+                "`{}` is cgdem's decomposed run; the reference codes run the undecomposed case",
+                case.name
+            ));
+            return (result, None);
         }
         Code::Liggghts | Code::Lammps if !case.reference_codes => {
             result.status = "skipped".into();

@@ -7,17 +7,32 @@ use crate::math::{Real, Vec3};
 pub trait PairHistory: Copy + Default + Send + Sync + PartialEq {
     /// The same history seen from the other particle.
     fn mirrored(self) -> Self;
+    /// `f64` words of one history, for the MPI transport of the decomposed step.
+    const WORDS: usize;
+    fn write_words(&self, out: &mut Vec<Real>);
+    /// From exactly `WORDS` words.
+    fn read_words(words: &[Real]) -> Self;
 }
 
 /// The seed's model keeps no history: a zero-sized type, so its store costs nothing.
 impl PairHistory for () {
     fn mirrored(self) -> Self {}
+    const WORDS: usize = 0;
+    fn write_words(&self, _: &mut Vec<Real>) {}
+    fn read_words(_: &[Real]) -> Self {}
 }
 
 /// A displacement of `i` relative to `j` (e.g. a tangential spring): `j` sees it negated.
 impl PairHistory for Vec3 {
     fn mirrored(self) -> Self {
         -self
+    }
+    const WORDS: usize = 3;
+    fn write_words(&self, out: &mut Vec<Real>) {
+        out.extend_from_slice(&self.to_array());
+    }
+    fn read_words(w: &[Real]) -> Self {
+        Vec3::new(w[0], w[1], w[2])
     }
 }
 
@@ -26,11 +41,26 @@ impl<A: PairHistory, B: PairHistory> PairHistory for (A, B) {
     fn mirrored(self) -> Self {
         (self.0.mirrored(), self.1.mirrored())
     }
+    const WORDS: usize = A::WORDS + B::WORDS;
+    fn write_words(&self, out: &mut Vec<Real>) {
+        self.0.write_words(out);
+        self.1.write_words(out);
+    }
+    fn read_words(w: &[Real]) -> Self {
+        (A::read_words(&w[..A::WORDS]), B::read_words(&w[A::WORDS..]))
+    }
 }
 
 /// A magnitude (e.g. accumulated slip length): the same from either side.
 impl PairHistory for Real {
     fn mirrored(self) -> Self {
         self
+    }
+    const WORDS: usize = 1;
+    fn write_words(&self, out: &mut Vec<Real>) {
+        out.push(*self);
+    }
+    fn read_words(w: &[Real]) -> Self {
+        w[0]
     }
 }

@@ -6,6 +6,7 @@
 
 use rayon::prelude::*;
 
+use super::transport::{Comm, Wire};
 use super::{Grid, Subdomain};
 use crate::contact::PairHistory;
 use crate::math::{Real, Vec3};
@@ -55,14 +56,11 @@ pub fn pack<H: PairHistory, WH: PairHistory>(
 
 /// Second half: appends to `sub` the ghosts every subdomain packed for it, in subdomain
 /// then list order, and records where they came from for `forward`.
-pub fn unpack<H: PairHistory, WH: PairHistory>(
-    sub: &mut Subdomain<H, WH>,
-    packed: &[Vec<(usize, Particles)>],
-) {
+pub fn unpack<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, packed: &[Vec<Ghosts>]) {
     sub.particles.truncate(sub.n_owned);
     sub.receives.clear();
     for (from, lists) in packed.iter().enumerate() {
-        for (list, (to, ghosts)) in lists.iter().enumerate() {
+        for (list, Ghosts(to, ghosts)) in lists.iter().enumerate() {
             if *to != sub.index {
                 continue;
             }
@@ -74,17 +72,57 @@ pub fn unpack<H: PairHistory, WH: PairHistory>(
     }
 }
 
-/// Both halves over all subdomains.
+/// Ghosts for one subdomain: its index and the particles, as they travel.
+#[derive(Clone, Debug)]
+pub struct Ghosts(pub usize, pub Particles);
+
+impl Default for Ghosts {
+    /// A slot meant for another rank's subdomain.
+    fn default() -> Self {
+        Ghosts(usize::MAX, Particles::default())
+    }
+}
+
+impl Wire for Ghosts {
+    fn write(&self, out: &mut Vec<Real>) {
+        out.push(self.0 as Real);
+        self.1.write(out);
+    }
+
+    fn read(input: &mut &[Real]) -> Self {
+        let to = input[0] as usize;
+        *input = &input[1..];
+        Ghosts(to, Particles::read(input))
+    }
+}
+
+/// Both halves over the subdomains `comm` owns here, the ghosts of other ranks' subdomains
+/// sent there. Returns the bytes sent to other ranks.
 pub fn borders<H: PairHistory, WH: PairHistory>(
     subs: &mut [Subdomain<H, WH>],
     grid: &Grid,
     width: Real,
-) {
-    let packed: Vec<Vec<(usize, Particles)>> = subs
+    comm: &Comm,
+) -> u64 {
+    let count = subs.len();
+    let mut packed: Vec<Vec<Ghosts>> = subs
         .par_iter_mut()
-        .map(|sub| pack(sub, grid, width))
+        .map(|sub| {
+            if comm.owns(sub.index, count) {
+                pack(sub, grid, width)
+                    .into_iter()
+                    .map(|(to, p)| Ghosts(to, p))
+                    .collect()
+            } else {
+                Vec::new()
+            }
+        })
         .collect();
-    subs.par_iter_mut().for_each(|sub| unpack(sub, &packed));
+    let sent = comm.route(&mut packed, |_, _, g| g.0, &mut None);
+    subs.par_iter_mut()
+        .filter(|sub| comm.owns(sub.index, count))
+        .for_each(|sub| unpack(sub, &packed));
+    sent
 }
 
 #[cfg(test)]
@@ -118,7 +156,7 @@ pub(crate) mod tests {
             subs[0].rows.push(&[]);
         }
         subs[0].n_owned = p.len();
-        exchange(&mut subs, &grid, domain, 1, &|_| true);
+        exchange(&mut subs, &grid, domain, 1, &|_| true, &Comm::local());
         (p, grid, subs)
     }
 
@@ -171,7 +209,7 @@ pub(crate) mod tests {
             let width = 0.1;
             let (p, grid, mut subs) = decomposed(&domain, counts, 600, 3);
             grid.check_width(width).unwrap();
-            borders(&mut subs, &grid, width);
+            borders(&mut subs, &grid, width, &Comm::local());
             for sub in &subs {
                 let mut ghosts: Vec<(u32, [u64; 3])> = (sub.n_owned..sub.particles.len())
                     .map(|k| {

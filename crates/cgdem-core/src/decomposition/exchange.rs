@@ -5,10 +5,11 @@
 
 use rayon::prelude::*;
 
+use super::transport::{read_histories, write_histories, Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
 use crate::domain::Domain;
-use crate::math::Vec3;
+use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 
 /// Particles on their way to one subdomain, with everything that travels with them.
@@ -18,6 +19,43 @@ pub struct Migrants<H, WH> {
     /// `wall_slots` entries per particle.
     pub wall_history: Vec<WH>,
     pub rows: HistoryRows<H>,
+}
+
+impl<H: PairHistory, WH: PairHistory> Default for Migrants<H, WH> {
+    fn default() -> Self {
+        Migrants::new(false)
+    }
+}
+
+impl<H: PairHistory, WH: PairHistory> Wire for Migrants<H, WH> {
+    fn write(&self, out: &mut Vec<Real>) {
+        self.particles.write(out);
+        write_histories(&self.wall_history, out);
+        out.extend(self.rows.start.iter().map(|&s| s as Real));
+        let (partners, histories): (Vec<u32>, Vec<H>) = self.rows.rows.iter().copied().unzip();
+        out.extend(partners.iter().map(|&p| p as Real));
+        write_histories(&histories, out);
+    }
+
+    fn read(input: &mut &[Real]) -> Self {
+        let particles = Particles::read(input);
+        let wall_history = read_histories(input);
+        let n = particles.len() + 1;
+        let start: Vec<u32> = input[..n].iter().map(|&s| s as u32).collect();
+        *input = &input[n..];
+        let m = *start.last().expect("at least one start") as usize;
+        let partners: Vec<u32> = input[..m].iter().map(|&p| p as u32).collect();
+        *input = &input[m..];
+        let histories: Vec<H> = read_histories(input);
+        Migrants {
+            particles,
+            wall_history,
+            rows: HistoryRows {
+                start,
+                rows: partners.into_iter().zip(histories).collect(),
+            },
+        }
+    }
 }
 
 impl<H: PairHistory, WH: PairHistory> Migrants<H, WH> {
@@ -80,7 +118,10 @@ pub fn unpack<H: PairHistory, WH: PairHistory>(
     packed: &[Vec<Migrants<H, WH>>],
 ) {
     for from in packed {
-        let m = &from[sub.index];
+        // Under MPI a subdomain of another rank that sent nothing here has no buffer.
+        let Some(m) = from.get(sub.index) else {
+            continue;
+        };
         for k in 0..m.particles.len() {
             sub.particles.push_copy(&m.particles, k);
             sub.rows.push(m.rows.of(k));
@@ -90,25 +131,37 @@ pub fn unpack<H: PairHistory, WH: PairHistory>(
     sub.n_owned = sub.particles.len();
 }
 
-/// Both halves over all subdomains, each subdomain on its own task.
+/// Both halves over the subdomains `comm` owns here, each subdomain on its own task, with
+/// the buffers for other ranks' subdomains sent there. Returns the bytes sent to other ranks.
 pub fn exchange<H: PairHistory, WH: PairHistory>(
     subs: &mut [Subdomain<H, WH>],
     grid: &Grid,
     domain: &Domain,
     wall_slots: usize,
     keep: &(impl Fn(Vec3) -> bool + Sync),
-) {
-    let packed: Vec<Vec<Migrants<H, WH>>> = subs
+    comm: &Comm,
+) -> u64 {
+    let count = subs.len();
+    let mut packed: Vec<Vec<Migrants<H, WH>>> = subs
         .par_iter_mut()
-        .map(|sub| pack(sub, grid, domain, wall_slots, keep))
+        .map(|sub| {
+            if comm.owns(sub.index, count) {
+                pack(sub, grid, domain, wall_slots, keep)
+            } else {
+                Vec::new()
+            }
+        })
         .collect();
-    subs.par_iter_mut().for_each(|sub| unpack(sub, &packed));
+    let sent = comm.route(&mut packed, |_, to, _| to, &mut None);
+    subs.par_iter_mut()
+        .filter(|sub| comm.owns(sub.index, count))
+        .for_each(|sub| unpack(sub, &packed));
+    sent
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Real;
     use rand::{Rng, SeedableRng};
 
     /// Particles spread over a box, each with a recognisable wall history (its id) and a
@@ -164,7 +217,7 @@ mod tests {
                 }
             }
             let keep = |x: Vec3| domain.contains_bounded(x);
-            exchange(&mut subs, &grid, &domain, 2, &keep);
+            exchange(&mut subs, &grid, &domain, 2, &keep, &Comm::local());
             let mut seen = vec![0; p.len()];
             for sub in &subs {
                 assert_eq!(sub.particles.len(), sub.n_owned);

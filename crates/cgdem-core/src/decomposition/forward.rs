@@ -3,9 +3,10 @@
 
 use rayon::prelude::*;
 
+use super::transport::{read_vec3s, write_vec3s, Comm, Wire};
 use super::Subdomain;
 use crate::contact::PairHistory;
-use crate::math::Vec3;
+use crate::math::{Real, Vec3};
 
 /// What a ghost needs each step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -16,14 +17,39 @@ pub struct GhostState {
     pub omega: Vec3,
 }
 
+/// One send list's ghost states, as they travel.
+#[derive(Clone, Debug, Default)]
+pub struct States(pub Vec<GhostState>);
+
+impl Wire for States {
+    fn write(&self, out: &mut Vec<Real>) {
+        out.push(self.0.len() as Real);
+        for g in &self.0 {
+            write_vec3s(&[g.position, g.velocity, g.omega], out);
+        }
+    }
+
+    fn read(input: &mut &[Real]) -> Self {
+        let n = input[0] as usize;
+        *input = &input[1..];
+        let v = read_vec3s(input, 3 * n);
+        States(
+            v.chunks_exact(3)
+                .map(|c| GhostState {
+                    position: c[0],
+                    velocity: c[1],
+                    omega: c[2],
+                })
+                .collect(),
+        )
+    }
+}
+
 /// First half: `sub`'s owned state per send list into `out` (one buffer per list, reused).
-pub fn pack<H: PairHistory, WH: PairHistory>(
-    sub: &Subdomain<H, WH>,
-    out: &mut Vec<Vec<GhostState>>,
-) {
+pub fn pack<H: PairHistory, WH: PairHistory>(sub: &Subdomain<H, WH>, out: &mut Vec<States>) {
     let p = &sub.particles;
-    out.resize_with(sub.sends.len(), Vec::new);
-    for (list, buffer) in sub.sends.iter().zip(out.iter_mut()) {
+    out.resize_with(sub.sends.len(), States::default);
+    for (list, States(buffer)) in sub.sends.iter().zip(out.iter_mut()) {
         buffer.clear();
         buffer.extend(list.indices.iter().map(|&k| {
             let k = k as usize;
@@ -37,14 +63,11 @@ pub fn pack<H: PairHistory, WH: PairHistory>(
 }
 
 /// Second half: `sub`'s ghosts from the buffers of the lists they came from, in order.
-pub fn unpack<H: PairHistory, WH: PairHistory>(
-    sub: &mut Subdomain<H, WH>,
-    packed: &[Vec<Vec<GhostState>>],
-) {
+pub fn unpack<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, packed: &[Vec<States>]) {
     let mut k = sub.n_owned;
     let p = &mut sub.particles;
     for &(from, list) in &sub.receives {
-        for g in &packed[from][list] {
+        for g in &packed[from][list].0 {
             p.position[k] = g.position;
             p.velocity[k] = g.velocity;
             if let Some(a) = p.angular.as_mut() {
@@ -56,16 +79,27 @@ pub fn unpack<H: PairHistory, WH: PairHistory>(
     debug_assert_eq!(k, p.len(), "ghost count changed without a rebuild");
 }
 
-/// Both halves over all subdomains; `buffers` holds one set per subdomain, reused.
+/// Both halves over the subdomains `comm` owns here; `buffers` holds one set per
+/// subdomain, reused (under MPI, other ranks' sets hold what they sent here). Returns the
+/// bytes sent to other ranks. `counts`: what each rank sends here, known after the first
+/// forward following a rebuild (`None` then).
 pub fn forward<H: PairHistory, WH: PairHistory>(
     subs: &mut [Subdomain<H, WH>],
-    buffers: &mut Vec<Vec<Vec<GhostState>>>,
-) {
-    buffers.resize_with(subs.len(), Vec::new);
+    buffers: &mut Vec<Vec<States>>,
+    comm: &Comm,
+    counts: &mut Option<Vec<usize>>,
+) -> u64 {
+    let count = subs.len();
+    buffers.resize_with(count, Vec::new);
     subs.par_iter()
         .zip(buffers.par_iter_mut())
+        .filter(|(sub, _)| comm.owns(sub.index, count))
         .for_each(|(sub, out)| pack(sub, out));
-    subs.par_iter_mut().for_each(|sub| unpack(sub, buffers));
+    let sent = comm.route(buffers, |from, list, _| subs[from].sends[list].to, counts);
+    subs.par_iter_mut()
+        .filter(|sub| comm.owns(sub.index, count))
+        .for_each(|sub| unpack(sub, buffers));
+    sent
 }
 
 #[cfg(test)]
@@ -83,7 +117,7 @@ mod tests {
             periodic: [true, false, false],
         };
         let (_, grid, mut subs) = decomposed(&domain, [2, 2, 1], 400, 5);
-        borders(&mut subs, &grid, 0.1);
+        borders(&mut subs, &grid, 0.1, &Comm::local());
         let before: Vec<Vec<Vec3>> = subs.iter().map(|s| s.particles.position.clone()).collect();
         // Move every owned particle by an amount that depends on its id.
         let moved = |id: u32| Vec3::new(1e-3 * id as Real, 0.0, -2e-3);
@@ -95,7 +129,7 @@ mod tests {
             }
         }
         let mut buffers = Vec::new();
-        forward(&mut subs, &mut buffers);
+        forward(&mut subs, &mut buffers, &Comm::local(), &mut None);
         let mut ghosts = 0;
         for (sub, old) in subs.iter().zip(&before) {
             for (k, &was) in old.iter().enumerate().skip(sub.n_owned) {

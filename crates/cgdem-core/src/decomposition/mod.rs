@@ -14,8 +14,8 @@
 //! Pairs that cross a boundary are evaluated by both owners (newton off, as LIGGGHTS's
 //! granular pair styles), so no forces travel back; each pair is evaluated with the particle
 //! of lower id first, so both sides compute the same numbers and keep the same history.
-//! Each phase packs what travels into buffers and unpacks them on the other side: the
-//! threads here share memory, an MPI transport would send the same buffers.
+//! Each phase packs what travels into buffers and unpacks them on the other side: threads in
+//! one process read them in place, MPI ranks send the same buffers ([`transport`]).
 
 pub mod borders;
 pub mod exchange;
@@ -23,8 +23,10 @@ pub mod forward;
 pub mod grid;
 pub mod list;
 pub mod step;
+pub mod transport;
 
 pub use grid::{choose_counts, Grid, GridSpec};
+pub use transport::Comm;
 
 use crate::contact::PairHistory;
 use crate::math::Vec3;

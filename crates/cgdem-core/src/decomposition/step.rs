@@ -6,8 +6,10 @@ use rayon::prelude::*;
 
 use super::borders::borders;
 use super::exchange::exchange;
-use super::forward::{forward, GhostState};
+use super::forward::{forward, States};
 use super::list::LocalList;
+use super::transport::{read_histories, write_histories};
+use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
@@ -40,12 +42,21 @@ pub struct Decomposition<H, WH> {
     pub extra: Real,
     pub skin: Real,
     pub builds: u64,
-    buffers: Vec<Vec<Vec<GhostState>>>,
+    /// The processes the subdomains are spread over; this one steps those it owns.
+    pub comm: Comm,
+    /// Owned particles over all subdomains (all ranks), as of the last rebuild.
+    pub total: usize,
+    /// Bytes this rank sent to other ranks (exchange, borders, forward) since the start.
+    pub bytes_sent: u64,
+    buffers: Vec<Vec<States>>,
+    /// Words each rank sends here in a forward, fixed between rebuilds.
+    forward_counts: Option<Vec<usize>>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     /// Deals `particles` (with their wall histories and contact-history rows, one per
-    /// particle) out to the subdomains of `grid` and builds ghosts and lists.
+    /// particle; the same on every rank) out to the subdomains of `grid` that `comm` owns
+    /// here, in order, and builds ghosts and lists.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         grid: Grid,
@@ -57,19 +68,27 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         width: Real,
         extra: Real,
         skin: Real,
+        comm: Comm,
     ) -> Self {
         let rotation = particles.angular.is_some();
-        let mut subdomains: Vec<Subdomain<H, WH>> = (0..grid.len())
+        let count = grid.len();
+        let mut subdomains: Vec<Subdomain<H, WH>> = (0..count)
             .map(|s| Subdomain::new(s, &grid, rotation))
             .collect();
-        let first = &mut subdomains[0];
         for k in 0..particles.len() {
-            first.particles.push_copy(particles, k);
-            first.rows.push(rows.of(k));
+            let x = domain.wrap(particles.position[k]);
+            let owner = grid.owner(x);
+            if !comm.owns(owner, count) {
+                continue;
+            }
+            let sub = &mut subdomains[owner];
+            sub.particles.push_copy(particles, k);
+            *sub.particles.position.last_mut().expect("just pushed") = x;
+            sub.rows.push(rows.of(k));
+            sub.wall_history
+                .extend_from_slice(&wall_history[k * wall_slots..(k + 1) * wall_slots]);
+            sub.n_owned += 1;
         }
-        first.wall_history = wall_history.to_vec();
-        first.n_owned = particles.len();
-        exchange(&mut subdomains, &grid, domain, wall_slots, &|_| true);
         let mut d = Decomposition {
             grid,
             subdomains,
@@ -77,7 +96,11 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             extra,
             skin,
             builds: 0,
+            comm,
+            total: particles.len(),
+            bytes_sent: 0,
             buffers: Vec::new(),
+            forward_counts: None,
         };
         d.borders_and_lists(false);
         d
@@ -87,17 +110,32 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     fn borders_and_lists(&mut self, resort: bool) {
         let width = self.width;
         if resort {
-            self.subdomains
-                .par_iter_mut()
-                .for_each(|sub| resort_by_cell(sub, width));
+            self.owned_mut().for_each(|sub| resort_by_cell(sub, width));
         }
-        borders(&mut self.subdomains, &self.grid, width);
+        self.bytes_sent += borders(&mut self.subdomains, &self.grid, width, &self.comm);
+        self.forward_counts = None;
         let extra = self.extra;
-        self.subdomains.par_iter_mut().for_each(|sub| {
+        self.owned_mut().for_each(|sub| {
             sub.list = LocalList::build(sub, extra, width);
             sub.rows = HistoryRows::default();
         });
         self.builds += 1;
+    }
+
+    /// The subdomains this rank steps, each on its own task.
+    fn owned_mut(&mut self) -> impl ParallelIterator<Item = &mut Subdomain<H, WH>> {
+        let (comm, count) = (&self.comm, self.subdomains.len());
+        self.subdomains
+            .par_iter_mut()
+            .filter(move |sub| comm.owns(sub.index, count))
+    }
+
+    /// The subdomains this rank steps.
+    pub fn owned(&self) -> impl Iterator<Item = &Subdomain<H, WH>> {
+        let (comm, count) = (&self.comm, self.subdomains.len());
+        self.subdomains
+            .iter()
+            .filter(move |sub| comm.owns(sub.index, count))
     }
 
     /// A list rebuild: histories into rows, exchange (dropping particles `keep` refuses),
@@ -109,24 +147,54 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         keep: &(impl Fn(Vec3) -> bool + Sync),
         resort: bool,
     ) {
-        self.subdomains.par_iter_mut().for_each(|sub| {
+        self.owned_mut().for_each(|sub| {
             sub.rows = sub.list.rows(&sub.particles.id, sub.n_owned);
         });
-        exchange(&mut self.subdomains, &self.grid, domain, wall_slots, keep);
+        self.bytes_sent += exchange(
+            &mut self.subdomains,
+            &self.grid,
+            domain,
+            wall_slots,
+            keep,
+            &self.comm,
+        );
         self.borders_and_lists(resort);
+        let here: usize = self.owned().map(|s| s.n_owned).sum();
+        self.total = self.comm.sum(here as u64) as usize;
     }
 
     /// The owned particles of all subdomains side by side (the world's arrays after a
-    /// rebuild), with their wall histories.
+    /// rebuild), with their wall histories; under MPI gathered from every rank (to every
+    /// rank, so each takes the same decisions from them).
     pub fn gathered(&self) -> (Particles, Vec<WH>) {
         let rotation = self.subdomains[0].particles.angular.is_some();
         let mut all = Particles::new(rotation);
         let mut wall = Vec::new();
-        for sub in &self.subdomains {
-            for k in 0..sub.n_owned {
-                all.push_copy(&sub.particles, k);
+        if !self.comm.is_distributed() {
+            for sub in &self.subdomains {
+                for k in 0..sub.n_owned {
+                    all.push_copy(&sub.particles, k);
+                }
+                wall.extend_from_slice(&sub.wall_history);
             }
-            wall.extend_from_slice(&sub.wall_history);
+            return (all, wall);
+        }
+        let per_sub = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                let sub = &self.subdomains[s];
+                let mut owned = sub.particles.clone();
+                owned.truncate(sub.n_owned);
+                owned.write(out);
+                write_histories(&sub.wall_history, out);
+            });
+        for words in per_sub {
+            let mut input = &words[..];
+            let p = Particles::read(&mut input);
+            for k in 0..p.len() {
+                all.push_copy(&p, k);
+            }
+            wall.extend_from_slice(&read_histories::<WH>(&mut input));
         }
         (all, wall)
     }
@@ -134,10 +202,32 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     /// The contact-history rows of every owned particle, in the gathered order.
     pub fn gathered_rows(&self) -> HistoryRows<H> {
         let mut rows = HistoryRows::default();
-        for sub in &self.subdomains {
-            let own = sub.list.rows(&sub.particles.id, sub.n_owned);
-            for k in 0..sub.n_owned {
-                rows.push(own.of(k));
+        let per_sub = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                let sub = &self.subdomains[s];
+                let own = sub.list.rows(&sub.particles.id, sub.n_owned);
+                out.push(sub.n_owned as Real);
+                out.extend(own.start.iter().map(|&v| v as Real));
+                out.extend(own.rows.iter().map(|r| r.0 as Real));
+                let histories: Vec<H> = own.rows.iter().map(|r| r.1).collect();
+                write_histories(&histories, out);
+            });
+        for words in per_sub {
+            if words.is_empty() {
+                continue;
+            }
+            let n = words[0] as usize;
+            let start: Vec<usize> = words[1..n + 2].iter().map(|&v| v as usize).collect();
+            let m = start[n];
+            let partners = &words[n + 2..n + 2 + m];
+            let mut input = &words[n + 2 + m..];
+            let histories: Vec<H> = read_histories(&mut input);
+            for k in 0..n {
+                let own: Vec<(u32, H)> = (start[k]..start[k + 1])
+                    .map(|r| (partners[r] as u32, histories[r]))
+                    .collect();
+                rows.push(&own);
             }
         }
         rows
@@ -146,75 +236,126 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     /// Half kick and drift of the owned particles; whether one moved past half the skin.
     pub fn drift_kick(&mut self, dt: Real) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
-        self.subdomains
-            .par_iter_mut()
+        let moved = self
+            .owned_mut()
             .map(|sub| drift_kick(sub, dt, limit_sq))
-            .reduce(|| false, |a, b| a || b)
+            .reduce(|| false, |a, b| a || b);
+        // The exchange is collective: every rank rebuilds when one must.
+        self.comm.any(moved)
     }
 
     /// Ghosts take their owners' state.
     pub fn forward(&mut self) {
-        forward(&mut self.subdomains, &mut self.buffers);
+        self.bytes_sent += forward(
+            &mut self.subdomains,
+            &mut self.buffers,
+            &self.comm,
+            &mut self.forward_counts,
+        );
     }
 
     /// Forces on the owned particles, then (if `kick`) the closing half kick, and the new
-    /// state copied into `world`'s arrays (the subdomains' owned particles side by side).
-    /// Returns the deepest pair and wall overlaps and whether every value is finite.
+    /// state copied into `world`'s arrays (the subdomains' owned particles side by side; not
+    /// under MPI, where `gathered` brings them when they are read). Returns the deepest pair
+    /// and wall overlaps and whether every value is finite, over all ranks.
     pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         kick: bool,
         world: &mut Particles,
     ) -> (Real, Real, bool) {
+        let step = |sub: &mut Subdomain<H, WH>| {
+            let (pairs, walls) = forces(sub, physics);
+            let finite = !kick || closing_kick(sub, physics.dt);
+            (pairs, walls, finite)
+        };
+        let reduce = |a: (Real, Real, bool), b: (Real, Real, bool)| {
+            (larger(a.0, b.0), larger(a.1, b.1), a.2 && b.2)
+        };
+        if self.comm.is_distributed() {
+            let (pairs, walls, finite) = self
+                .owned_mut()
+                .map(step)
+                .reduce(|| (0.0, 0.0, true), reduce);
+            // One reduction for the three (max is exact in any order).
+            let mut v = [pairs, walls, if finite { 0.0 } else { 1.0 }];
+            self.comm.max_each(&mut v);
+            return (v[0], v[1], v[2] == 0.0);
+        }
         let mut views = world_views(world, self.subdomains.iter().map(|s| s.n_owned));
         self.subdomains
             .par_iter_mut()
             .zip(views.par_iter_mut())
             .map(|(sub, view)| {
-                let (pairs, walls) = forces(sub, physics);
-                let finite = !kick || closing_kick(sub, physics.dt);
+                let result = step(sub);
                 view.copy_from(&sub.particles);
-                (pairs, walls, finite)
+                result
             })
-            .reduce(
-                || (0.0, 0.0, true),
-                |a, b| (larger(a.0, b.0), larger(a.1, b.1), a.2 && b.2),
-            )
+            .reduce(|| (0.0, 0.0, true), reduce)
+    }
+
+    /// Kinetic plus gravitational energy (from `origin`) and mobile mass of the owned
+    /// particles, summed per subdomain and then over the subdomains in order: the same
+    /// numbers on any number of threads or ranks.
+    pub fn energy_and_mobile_mass(&self, gravity: Vec3, origin: Vec3) -> (Real, Real) {
+        let per_sub = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                let sub = &self.subdomains[s];
+                let p = &sub.particles;
+                let (mut energy, mut mass) = (0.0, 0.0);
+                for k in 0..sub.n_owned {
+                    energy += 0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
+                        - p.mass[k] * gravity.dot(p.position[k] - origin);
+                    if p.inv_mass[k] > 0.0 {
+                        mass += p.mass[k];
+                    }
+                }
+                out.extend_from_slice(&[energy, mass]);
+            });
+        per_sub
+            .iter()
+            .fold((0.0, 0.0), |(e, m), w| (e + w[0], m + w[1]))
     }
 
     /// Elastic energy of the listed pairs, each counted once: owned pairs, and pairs with a
     /// ghost from the side of the lower id.
     pub fn pair_elastic_energy<L: PairLaw>(&self, law: &L, n_species: usize) -> Real {
-        self.subdomains
-            .iter()
-            .map(|sub| {
-                let p = &sub.particles;
-                sub.list
-                    .pairs
-                    .iter()
-                    .filter(|&&[i, j]| {
-                        (j as usize) < sub.n_owned || p.id[i as usize] < p.id[j as usize]
-                    })
-                    .map(|&[i, j]| {
-                        let (i, j) = (i as usize, j as usize);
-                        let distance = (p.position[i] - p.position[j]).length();
-                        let species_pair =
-                            p.species[i] as usize * n_species + p.species[j] as usize;
-                        law.elastic_energy(species_pair, p.radius[i], p.radius[j], distance)
-                    })
-                    .sum::<Real>()
-            })
-            .sum()
+        let per_sub = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                let sub = &self.subdomains[s];
+                out.push({
+                    let p = &sub.particles;
+                    sub.list
+                        .pairs
+                        .iter()
+                        .filter(|&&[i, j]| {
+                            (j as usize) < sub.n_owned || p.id[i as usize] < p.id[j as usize]
+                        })
+                        .map(|&[i, j]| {
+                            let (i, j) = (i as usize, j as usize);
+                            let distance = (p.position[i] - p.position[j]).length();
+                            let species_pair =
+                                p.species[i] as usize * n_species + p.species[j] as usize;
+                            law.elastic_energy(species_pair, p.radius[i], p.radius[j], distance)
+                        })
+                        .sum::<Real>()
+                })
+            });
+        per_sub.iter().map(|w| w[0]).sum()
     }
 
     /// Pairs listed over all subdomains (a pair across a boundary twice).
     pub fn listed_pairs(&self) -> usize {
-        self.subdomains.iter().map(|s| s.list.pairs.len()).sum()
+        let here: usize = self.owned().map(|s| s.list.pairs.len()).sum();
+        self.comm.sum(here as u64) as usize
     }
 
     /// Ghosts over all subdomains.
     pub fn ghosts(&self) -> usize {
-        self.subdomains.iter().map(|s| s.ghosts()).sum()
+        let here: usize = self.owned().map(|s| s.ghosts()).sum();
+        self.comm.sum(here as u64) as usize
     }
 }
 

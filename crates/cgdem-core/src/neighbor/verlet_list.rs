@@ -480,6 +480,13 @@ mod tests {
         fn mirrored(self) -> Self {
             Spring(-self.0)
         }
+        const WORDS: usize = 3;
+        fn write_words(&self, out: &mut Vec<Real>) {
+            self.0.write_words(out);
+        }
+        fn read_words(w: &[Real]) -> Self {
+            Spring(Vec3::read_words(w))
+        }
     }
 
     #[test]

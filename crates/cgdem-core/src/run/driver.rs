@@ -38,7 +38,7 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     let out = &options.out_dir;
     std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
     let (dt, scales, warning) = time_step_for(scene, &law, &wall_law, options.force_dt)?;
-    let mut warnings = Warnings::default();
+    let mut warnings = Warnings(Vec::new(), !options.comm.is_root());
     if let Some(w) = warning {
         warnings.push(w);
     }
@@ -70,6 +70,8 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     let started = Instant::now();
     let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings)?;
     driver.progress.finish();
+    // Under MPI every rank gathers the final state (rank 0 writes it).
+    world.sync_particles();
     let wall_s = started.elapsed().as_secs_f64();
     for (kind, count) in driver.guard_counts.iter().filter(|(_, count)| *count > 1) {
         warnings.push(format!(
@@ -120,6 +122,7 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
         final_state: options.keep_final_state.then(|| world.particles.clone()),
         memory: Some(world.memory_use()),
+        decomposition: world.decomposition_summary(),
     };
     for o in &mut observers {
         o.observer()
@@ -204,7 +207,7 @@ fn build_world<L: PairLaw, W: WallLaw>(
             .collect(),
     );
     if let Some(spec) = options.grid {
-        world.set_grid(spec).map_err(|e| {
+        world.set_grid(spec, options.comm.clone()).map_err(|e| {
             RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
         })?;
     }
@@ -300,6 +303,7 @@ impl Driver<'_> {
         warnings: &mut Warnings,
     ) -> Result<Option<GuardTrip>, RunError> {
         for stage in &self.scene.stages {
+            world.sync_particles();
             world.reset_energy_reference();
             for name in &stage.remove_walls {
                 world.walls.remove(name);
@@ -345,6 +349,7 @@ impl Driver<'_> {
                     stage.name
                 ));
             }
+            world.sync_particles();
             for o in observers.iter_mut() {
                 o.observer().stage_ends(world, &clock, warnings)?;
             }
@@ -381,7 +386,7 @@ impl Driver<'_> {
         let mut ending = Ok(StageEnding::Duration(duration));
         'steps: for k in 1..=stage_steps {
             world.step();
-            self.particle_steps += world.particles.len() as u64;
+            self.particle_steps += world.particle_count() as u64;
             if let Some(trip) = world.take_guard_trip() {
                 if !self.keep_going {
                     ending = Err(trip);
@@ -393,6 +398,10 @@ impl Driver<'_> {
             if k % 256 == 0 {
                 self.progress.advance(256);
             }
+            // Under MPI the observers read the particles gathered at the steps they are due.
+            if observers.iter().any(|o| o.is_due(world, clock)) {
+                world.sync_particles();
+            }
             for o in observers.iter_mut() {
                 if let Flow::EndStage(reason) = o.after_step(world, clock)? {
                     ending = Ok(reason);
@@ -400,11 +409,19 @@ impl Driver<'_> {
                 }
             }
             // At the end of a whole step, its outputs written: a consistent state to keep.
-            if self
+            let stop = self
                 .stop
                 .as_ref()
-                .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
-            {
+                .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed));
+            // Under MPI all ranks stop at the same step when a signal reached any of them
+            // (asked every 64 steps: a collective costs a wait on a loaded machine).
+            let comm = world.comm();
+            let stop = if comm.is_distributed() {
+                k % 64 == 0 && comm.any(stop)
+            } else {
+                stop
+            };
+            if stop {
                 self.interrupted = true;
                 ending = Ok(StageEnding::Interrupted);
                 break;
@@ -449,6 +466,7 @@ impl Driver<'_> {
             let interval = ins.refill.as_ref().map_or(Real::INFINITY, |r| r.interval);
             if world.time - clock.start + 0.5 * self.dt >= (*done + 1) as Real * interval {
                 *done += 1;
+                world.sync_particles();
                 let seed = ins.seed.wrapping_add(1_000_003 * *done);
                 let added = region.top_up(&world.particles, world.bodies(), *target, seed);
                 let species = &self.scene.species[ins.species];

@@ -56,6 +56,8 @@ pub struct RunOptions {
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Split the box into these subdomains with ghost layers (`--grid`); None: one world.
     pub grid: Option<crate::decomposition::GridSpec>,
+    /// The MPI ranks a `--grid` run is spread over (`mpirun`); one process by default.
+    pub comm: crate::decomposition::Comm,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -268,6 +270,25 @@ pub struct RunSummary {
     pub final_state: Option<Particles>,
     /// The solver's arrays at the end (none for reference codes).
     pub memory: Option<crate::simulation::MemoryUse>,
+    /// The subdomains of a `--grid` run (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decomposition: Option<DecompositionSummary>,
+}
+
+/// What `summary.json` says of a decomposed run (`--grid`, issue 23).
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct DecompositionSummary {
+    /// Subdomains along x, y, z.
+    pub grid: [usize; 3],
+    /// MPI ranks (1: threads in one process).
+    pub ranks: usize,
+    /// Owned particles per subdomain at the end.
+    pub subdomain_particles: Vec<usize>,
+    /// Most particles in one subdomain over the mean, at the end (1 is perfect balance).
+    pub imbalance: Real,
+    /// Bytes the ranks sent each other per step, averaged over the run (exchange, borders,
+    /// forward; 0 in one process, where the threads read the buffers in place).
+    pub bytes_sent_between_ranks_per_step: Real,
 }
 
 /// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.

@@ -301,6 +301,7 @@ pub fn postprocess(
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
         final_state: None,
         memory: None,
+        decomposition: None,
     })
 }
 

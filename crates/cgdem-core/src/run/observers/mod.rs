@@ -64,13 +64,16 @@ pub(crate) enum Flow {
     EndStage(super::StageEnding),
 }
 
-/// Warnings a run collects for `summary.json` (also printed as they arise).
+/// Warnings a run collects for `summary.json` (also printed as they arise, unless the
+/// second field says not to: MPI ranks other than 0 collect the same ones).
 #[derive(Default)]
-pub(crate) struct Warnings(pub Vec<String>);
+pub(crate) struct Warnings(pub Vec<String>, pub bool);
 
 impl Warnings {
     pub(crate) fn push(&mut self, w: String) {
-        eprintln!("warning: {w}");
+        if !self.1 {
+            eprintln!("warning: {w}");
+        }
         self.0.push(w);
     }
 }
@@ -120,6 +123,11 @@ impl<'s, L: PairLaw, W: WallLaw> Scheduled<'s, L, W> {
     pub(crate) fn stage_begins(&mut self, world: &World<L, W>, clock: &StageClock) {
         self.observer.stage_begins(world, clock);
         self.due = self.observer.due();
+    }
+
+    /// Whether the observer is due after the step that ended at `world.time`.
+    pub(crate) fn is_due(&self, world: &World<L, W>, clock: &StageClock) -> bool {
+        self.due.is_due(world.time, clock.start, clock.dt)
     }
 
     /// Runs the observer if it is due after the step that ended at `world.time`.
