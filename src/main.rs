@@ -4,7 +4,7 @@
 mod interrupt;
 mod progress_bar;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -245,6 +245,28 @@ enum Command {
         /// The cgdem commit the night ran.
         #[arg(long)]
         commit: String,
+    },
+    /// Which coarse-graining level and rule keeps a quantity within a target, from a stored
+    /// matrix (a `cgdem validate` report whose sweeps vary lambda under each rule against a
+    /// fine reference): the coarsest setting whose mean error over seeds plus twice its
+    /// standard error is within the target, with its saving; "none" and the closest otherwise.
+    Advise {
+        /// The case: its scene file (e.g. validation/cases/aor_hertz.toml) or its name in the
+        /// report (e.g. aor_hertz-fidelity).
+        case: String,
+        /// repose_angle (deg), profile, mass_flow, mass_flow_eq7, t_half (relative) or
+        /// porosity (absolute).
+        #[arg(long)]
+        quantity: String,
+        /// The largest error allowed, in the quantity's unit (e.g. 2 for 2 deg, 0.05 for 5%).
+        #[arg(long)]
+        target: f64,
+        /// The report directory (or its summary.json) holding the matrix.
+        #[arg(long, default_value = "reports/cg_fidelity")]
+        matrix: PathBuf,
+        /// Print the answer as JSON.
+        #[arg(long)]
+        json: bool,
     },
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).
@@ -685,6 +707,13 @@ fn main() -> ExitCode {
                 }
             }
         }
+        Command::Advise {
+            case,
+            quantity,
+            target,
+            matrix,
+            json,
+        } => advise(&case, &quantity, target, &matrix, json),
         Command::History {
             dir,
             add,
@@ -944,4 +973,58 @@ fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, ExitCode> {
             eprintln!("error: cannot start the worker threads: {e}");
             ExitCode::FAILURE
         })
+}
+
+/// `cgdem advise`: the answer from the stored matrix, in words or as JSON.
+fn advise(case: &str, quantity: &str, target: f64, matrix: &Path, json: bool) -> ExitCode {
+    use cgdem_harness::accuracy::Measure;
+    use cgdem_harness::advise;
+    let Some(m) = Measure::from_quantity(quantity) else {
+        let known: Vec<&str> = Measure::ALL.iter().map(|m| m.quantity()).collect();
+        eprintln!(
+            "error: --quantity {quantity:?} is not allowed: one of {}",
+            known.join(", ")
+        );
+        return ExitCode::FAILURE;
+    };
+    if !(target.is_finite() && target > 0.0) {
+        eprintln!(
+            "error: --target {target} is not allowed: a positive number in the quantity's unit"
+        );
+        return ExitCode::FAILURE;
+    }
+    // A scene file names its case by the scene's name; anything else is a case name.
+    let name = if case.ends_with(".toml") {
+        match cgdem_core::scene::Scene::load(Path::new(case)) {
+            Ok(scene) => scene.name,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    } else {
+        case.to_string()
+    };
+    let answer = advise::read_matrix(matrix)
+        .and_then(|(file, points)| advise::advise(&file, &points, &name, m, target));
+    match answer {
+        Ok(a) if json => match serde_json::to_string_pretty(&a) {
+            Ok(text) => {
+                println!("{text}");
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: cannot write the answer as JSON: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Ok(a) => {
+            println!("{}", a.text(m));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

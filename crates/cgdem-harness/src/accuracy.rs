@@ -6,17 +6,21 @@
 //! `neighbor.skin_fraction`, `body[0].cell_size`). Each point changes one knob from the
 //! reference and is judged against the same code's reference run: repose-angle difference and
 //! heap-profile distance for a collapse, mass-flow difference (and the distance from Eq. 7) for
-//! a screw feeder. The reference setting run with other insertion seeds gives the floor below
-//! which a difference is the packing, not the knob. The report plots error against wall time
-//! on log axes with each code's Pareto front, and tables the cheapest setting within each
-//! target.
+//! a screw feeder. Every setting (the reference and each point) is run with each of the
+//! sweep's insertion seeds, and a point's error is taken against the reference run with the
+//! same seed (the same packing), so the packing largely cancels; a setting's error is the mean
+//! over seeds with its standard error (the error bars). The largest difference between two
+//! reference runs with different seeds is the floor below which a difference is the packing,
+//! not the knob. The report plots error against wall time on log axes with each code's Pareto
+//! front, and tables the cheapest setting within each target.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::suite::{parse_codes, parse_variant, Code, Suite, SuiteError};
+use super::dynamics::FlowSeries;
+use super::suite::{parse_codes, parse_variant, rule_names, Code, Suite, SuiteError};
 use super::validate::{output_error, run_one, ValidateError, ValidateOptions};
 use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
 use cgdem_core::coarse_graining::CoarseGrainRule;
@@ -62,6 +66,20 @@ pub struct KnobSeries {
     pub knob: Knob,
     pub values: Vec<f64>,
     pub codes: Vec<Code>,
+    /// The coarse-graining rule of this series' runs (the sweep's unless it names one).
+    pub rule: CoarseGrainRule,
+}
+
+impl KnobSeries {
+    /// The series' name in tables, figures and `summary.json`: the knob, with the rule when
+    /// it is not the sweep's.
+    fn name(&self, sweep_rule: CoarseGrainRule) -> String {
+        if self.rule == sweep_rule {
+            self.knob.name().to_string()
+        } else {
+            format!("{} ({})", self.knob.name(), self.rule.name())
+        }
+    }
 }
 
 /// Target errors for the cheapest-setting table.
@@ -72,6 +90,10 @@ pub struct Targets {
     pub profile: f64,
     /// Relative mass-flow error (against the reference run and against Eq. 7).
     pub mass_flow: f64,
+    /// Relative error of the collapse's characteristic time t_half.
+    pub t_half: f64,
+    /// Absolute porosity difference.
+    pub porosity: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -80,9 +102,10 @@ pub struct AccuracySweep {
     /// Overrides every point shares (e.g. a shorter run), with `variant` naming them.
     pub overrides: Vec<Override>,
     pub variant: String,
-    pub seed: u64,
-    /// The reference setting with these insertion seeds: the floor (packing-to-packing).
-    pub floor_seeds: Vec<u64>,
+    /// Insertion seeds: every setting runs with each (issue 24: at least 3 where affordable).
+    pub seeds: Vec<u64>,
+    /// The coarse-graining rule of the reference and of series that name none.
+    pub rule: CoarseGrainRule,
     /// Every knob's value at the reference; `lambda` always among them.
     pub reference: BTreeMap<Knob, f64>,
     pub series: Vec<KnobSeries>,
@@ -96,14 +119,15 @@ pub(super) struct RawSweep {
     variant: String,
     #[serde(default)]
     set: Vec<String>,
-    seed: Option<u64>,
-    #[serde(default)]
-    floor_seeds: Vec<u64>,
+    seeds: Option<Vec<u64>>,
+    cg_rule: Option<String>,
     reference: BTreeMap<String, toml::Value>,
     series: Vec<RawSeries>,
     angle_target_deg: Option<f64>,
     profile_target: Option<f64>,
     mass_flow_target: Option<f64>,
+    t_half_target: Option<f64>,
+    porosity_target: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -112,6 +136,7 @@ struct RawSeries {
     knob: String,
     values: Vec<toml::Value>,
     codes: Option<Vec<String>>,
+    cg_rule: Option<String>,
 }
 
 fn number(v: &toml::Value) -> Option<f64> {
@@ -138,6 +163,14 @@ impl AccuracySweep {
             &format!("accuracy[{k}]"),
             path,
         )?;
+        let parse_rule = |name: &str, field: &str| {
+            CoarseGrainRule::from_name(name)
+                .ok_or_else(|| invalid(field, format!("\"{name}\""), &rule_names()))
+        };
+        let sweep_rule = match &raw.cg_rule {
+            None => CoarseGrainRule::Seed,
+            Some(name) => parse_rule(name, "cg_rule")?,
+        };
         let lambda_ok = |v: f64| v >= 1.0 && v.fract() == 0.0 && (v as u32).is_power_of_two();
         let mut reference = BTreeMap::new();
         for (key, value) in &raw.reference {
@@ -190,10 +223,15 @@ impl AccuracySweep {
                     parse_codes(&names, &format!("accuracy[{k}].series[{j}].codes"), path)?
                 }
             };
+            let rule = match s.cg_rule {
+                None => sweep_rule,
+                Some(name) => parse_rule(&name, &format!("series[{j}].cg_rule"))?,
+            };
             series.push(KnobSeries {
                 knob,
                 values,
                 codes,
+                rule,
             });
         }
         let target = |field: &str, v: Option<f64>, default: f64| {
@@ -204,18 +242,31 @@ impl AccuracySweep {
                 Err(invalid(field, v.to_string(), "a positive number"))
             }
         };
+        let seeds = raw.seeds.unwrap_or_else(|| vec![1]);
+        let mut distinct = seeds.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        if seeds.is_empty() || distinct.len() != seeds.len() {
+            return Err(invalid(
+                "seeds",
+                format!("{seeds:?}"),
+                "one or more distinct insertion seeds, e.g. [1, 2, 3]",
+            ));
+        }
         Ok(AccuracySweep {
             file: raw.file,
             overrides,
             variant: raw.variant,
-            seed: raw.seed.unwrap_or(1),
-            floor_seeds: raw.floor_seeds,
+            seeds,
+            rule: sweep_rule,
             reference,
             series,
             targets: Targets {
                 angle_deg: target("angle_target_deg", raw.angle_target_deg, 1.0)?,
                 profile: target("profile_target", raw.profile_target, 0.05)?,
                 mass_flow: target("mass_flow_target", raw.mass_flow_target, 0.05)?,
+                t_half: target("t_half_target", raw.t_half_target, 0.1)?,
+                porosity: target("porosity_target", raw.porosity_target, 0.02)?,
             },
         })
     }
@@ -248,17 +299,19 @@ impl AccuracySweep {
 }
 
 /// One run of the sweep, as recorded in `summary.json`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AccuracyPoint {
     pub case: String,
     pub code: Code,
-    /// "reference", "floor" (the reference setting, another insertion seed) or the knob.
+    /// "reference" or the knob.
     pub series: String,
-    /// The varied knob's value (the reference's for "reference" and "floor").
+    /// The varied knob's value (the reference's for "reference").
     pub value: f64,
     /// The setting in words, e.g. "time.dt_fraction = 0.1".
     pub setting: String,
     pub lambda: u32,
+    #[serde(default)]
+    pub cg_rule: CoarseGrainRule,
     pub seed: u64,
     pub status: String,
     pub reason: Option<String>,
@@ -269,7 +322,7 @@ pub struct AccuracyPoint {
     pub particle_steps: Option<f64>,
     pub wall_s: Option<f64>,
     pub repose_angle_deg: Option<f64>,
-    /// |angle - the same code's reference angle|, degrees.
+    /// |angle - the angle of the same code's reference run with the same seed|, degrees.
     pub angle_error_deg: Option<f64>,
     /// RMS gap between the heap profile and the reference's, over the reference heap's
     /// height ([`profile_distance`]).
@@ -281,10 +334,23 @@ pub struct AccuracyPoint {
     pub eq7_mass_flow_kg_s: Option<f64>,
     /// |Q / Q_Eq7 - 1|.
     pub eq7_error: Option<f64>,
+    /// The collapse's characteristic time (front at half its largest advance,
+    /// [`FlowSeries::t_half`]) in the measured stage.
+    #[serde(default)]
+    pub t_half_s: Option<f64>,
+    /// |t_half / t_half of the reference run with the same seed - 1|.
+    #[serde(default)]
+    pub t_half_error: Option<f64>,
+    /// Porosity of a packing (`summary.json` `packing.porosity`).
+    #[serde(default)]
+    pub porosity: Option<f64>,
+    /// |porosity - the reference run's|.
+    #[serde(default)]
+    pub porosity_error: Option<f64>,
 }
 
 /// The cheapest point within a target error, per case, code and error measure.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CheapestSetting {
     pub case: String,
     pub code: Code,
@@ -292,15 +358,20 @@ pub struct CheapestSetting {
     pub target: f64,
     /// None: no point other than the reference met the target.
     pub setting: Option<String>,
+    /// Means over the setting's seeds.
     pub wall_s: Option<f64>,
     pub particle_steps: Option<f64>,
     pub error: Option<f64>,
+    /// Standard error of `error` over the seeds (None with one seed).
+    pub error_se: Option<f64>,
+    /// Seeds the setting was measured with.
+    pub seeds: usize,
     pub reference_wall_s: Option<f64>,
-    /// The largest error of the reference setting with other insertion seeds.
+    /// The largest difference between two reference runs with different insertion seeds.
     pub floor: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AccuracySummary {
     pub points: Vec<AccuracyPoint>,
     pub cheapest: Vec<CheapestSetting>,
@@ -308,29 +379,61 @@ pub struct AccuracySummary {
 
 /// The error measures, each with the unit its target and axis use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Measure {
+pub enum Measure {
     Angle,
     Profile,
     MassFlow,
     Eq7,
+    THalf,
+    Porosity,
 }
 
 impl Measure {
-    fn of(self, p: &AccuracyPoint) -> Option<f64> {
+    pub const ALL: [Measure; 6] = [
+        Measure::Angle,
+        Measure::Profile,
+        Measure::MassFlow,
+        Measure::Eq7,
+        Measure::THalf,
+        Measure::Porosity,
+    ];
+
+    /// The run's error under this measure.
+    pub fn of(self, p: &AccuracyPoint) -> Option<f64> {
         match self {
             Measure::Angle => p.angle_error_deg,
             Measure::Profile => p.profile_distance,
             Measure::MassFlow => p.mass_flow_error,
             Measure::Eq7 => p.eq7_error,
+            Measure::THalf => p.t_half_error,
+            Measure::Porosity => p.porosity_error,
         }
     }
 
-    fn name(self) -> &'static str {
+    /// The quantity's short name (`cgdem advise --quantity`).
+    pub fn quantity(self) -> &'static str {
+        match self {
+            Measure::Angle => "repose_angle",
+            Measure::Profile => "profile",
+            Measure::MassFlow => "mass_flow",
+            Measure::Eq7 => "mass_flow_eq7",
+            Measure::THalf => "t_half",
+            Measure::Porosity => "porosity",
+        }
+    }
+
+    pub fn from_quantity(name: &str) -> Option<Measure> {
+        Self::ALL.into_iter().find(|m| m.quantity() == name)
+    }
+
+    pub fn name(self) -> &'static str {
         match self {
             Measure::Angle => "repose angle vs reference",
             Measure::Profile => "heap profile vs reference",
             Measure::MassFlow => "mass flow vs reference",
             Measure::Eq7 => "mass flow vs Eq. (7)",
+            Measure::THalf => "t_half vs reference",
+            Measure::Porosity => "porosity vs reference",
         }
     }
 
@@ -340,6 +443,8 @@ impl Measure {
             Measure::Profile => "profile_distance",
             Measure::MassFlow => "mass_flow_error",
             Measure::Eq7 => "eq7_error",
+            Measure::THalf => "t_half_error",
+            Measure::Porosity => "porosity_error",
         }
     }
 
@@ -349,6 +454,8 @@ impl Measure {
             Measure::Profile => "RMS profile gap / reference heap height [-]",
             Measure::MassFlow => "|Q / Q_reference - 1| [-]",
             Measure::Eq7 => "|Q / Q_Eq.(7) - 1| [-]",
+            Measure::THalf => "|t_half / t_half,reference - 1| [-]",
+            Measure::Porosity => "|porosity - reference| [-]",
         }
     }
 
@@ -357,12 +464,16 @@ impl Measure {
             Measure::Angle => t.angle_deg,
             Measure::Profile => t.profile,
             Measure::MassFlow | Measure::Eq7 => t.mass_flow,
+            Measure::THalf => t.t_half,
+            Measure::Porosity => t.porosity,
         }
     }
 
-    fn format(self, v: f64) -> String {
+    /// A value in the measure's unit, for tables and answers.
+    pub fn format(self, v: f64) -> String {
         match self {
             Measure::Angle => format!("{v:.2} deg"),
+            Measure::Porosity => format!("{v:.4}"),
             _ => format!("{:.1}%", 100.0 * v),
         }
     }
@@ -455,9 +566,12 @@ pub(super) fn run_sweeps(
         "For each case: a reference setting (the finest affordable) and one series per knob \
          that buys speed (coarse-graining level lambda, time-step fraction of the contact \
          period, neighbour skin, SDF cell size), each point changing one knob from the \
-         reference. Errors are against the same code's reference run; the reference setting \
-         with other insertion seeds (\"floor\") shows how far a different random packing alone \
-         moves the result. Wall time is the whole run (insertion and output included) on the \
+         reference. Every setting runs with each of the sweep's insertion seeds, and a run's \
+         error is against the same code's reference run with the same seed (the same \
+         packing); a setting's error is the mean over its seeds, the error bars one standard \
+         error of that mean. The largest difference between two reference runs with \
+         different seeds (\"floor\") shows how far a different random packing alone moves the \
+         result. Wall time is the whole run (insertion and output included) on the \
          machine and thread count in the provenance; the machine is shared, so wall times \
          carry some percent of noise. Figures: error against wall time on log axes, one series \
          per knob and code, the Pareto front of each code dashed, the target dotted.",
@@ -478,8 +592,8 @@ pub(super) fn run_sweeps(
     Ok(Some(summary))
 }
 
-/// Runs the reference of every code, then each series point, then the floor seeds; codes
-/// alternate within each point so machine drift hits all alike.
+/// Runs, seed by seed, the reference of every code, then each series point; codes alternate
+/// within each point so machine drift hits all alike.
 fn run_sweep(
     sweep: &AccuracySweep,
     origin: &Path,
@@ -491,47 +605,57 @@ fn run_sweep(
     };
     let (reference_scene, _) = sweep.scene(&sweep.reference, origin).map_err(case_error)?;
     let case = reference_scene.name.clone();
-    // (series, varied knob, value, codes, seed)
-    let mut jobs: Vec<(String, Knob, f64, Vec<Code>, u64)> = Vec::new();
+    // (series, varied knob, value, codes, rule, seed)
+    let mut jobs: Vec<(String, Knob, f64, Vec<Code>, CoarseGrainRule, u64)> = Vec::new();
     let all = sweep.codes();
-    jobs.push((
-        "reference".into(),
-        Knob::Lambda,
-        0.0,
-        all.clone(),
-        sweep.seed,
-    ));
-    for s in &sweep.series {
-        for &v in &s.values {
-            if v != sweep.reference[&s.knob] {
-                jobs.push((
-                    s.knob.name().into(),
-                    s.knob.clone(),
-                    v,
-                    s.codes.clone(),
-                    sweep.seed,
-                ));
+    for &seed in &sweep.seeds {
+        jobs.push((
+            "reference".into(),
+            Knob::Lambda,
+            0.0,
+            all.clone(),
+            sweep.rule,
+            seed,
+        ));
+        for s in &sweep.series {
+            for &v in &s.values {
+                // The reference's own value is the reference, unless the rule differs.
+                if v != sweep.reference[&s.knob] || s.rule != sweep.rule {
+                    jobs.push((
+                        s.name(sweep.rule),
+                        s.knob.clone(),
+                        v,
+                        s.codes.clone(),
+                        s.rule,
+                        seed,
+                    ));
+                }
             }
         }
     }
-    for &seed in &sweep.floor_seeds {
-        jobs.push(("floor".into(), Knob::Lambda, 0.0, all.clone(), seed));
-    }
     let mut points = Vec::new();
-    for (series, knob, value, codes, seed) in jobs {
+    for (series, knob, value, codes, rule, seed) in jobs {
         let mut knobs = sweep.reference.clone();
         let (setting, value, name) = match series.as_str() {
-            "reference" | "floor" => (
+            "reference" => (
                 "reference".to_string(),
                 f64::NAN,
-                format!("{series}-seed{seed}"),
+                format!("reference-seed{seed}"),
             ),
             _ => {
                 knobs.insert(knob.clone(), value);
+                let (setting, rule_dir) = if rule == sweep.rule {
+                    (format!("{} = {value}", knob.name()), String::new())
+                } else {
+                    (
+                        format!("{} = {value}, {} rule", knob.name(), rule.name()),
+                        format!("-{}", rule.name()),
+                    )
+                };
                 (
-                    format!("{} = {value}", knob.name()),
+                    setting,
                     value,
-                    format!("{}-{value}", knob.file_name()),
+                    format!("{}-{value}{rule_dir}-seed{seed}", knob.file_name()),
                 )
             }
         };
@@ -543,7 +667,7 @@ fn run_sweep(
                 .join(&case)
                 .join("accuracy")
                 .join(format!("{}-{name}", code.name()));
-            let point = run_point(&scene, code, lambda, seed, &dir, options);
+            let point = run_point(&scene, code, lambda, rule, seed, &dir, options);
             let mut p = AccuracyPoint {
                 case: case.clone(),
                 code,
@@ -557,14 +681,9 @@ fn run_sweep(
             }
             if !options.quiet {
                 eprintln!(
-                    "{case} accuracy {} {}{}: {}{}",
+                    "{case} accuracy {} {} (seed {seed}): {}{}",
                     code.name(),
                     p.setting,
-                    if series == "floor" {
-                        format!(" (seed {seed})")
-                    } else {
-                        String::new()
-                    },
                     p.status,
                     p.reason
                         .as_deref()
@@ -582,11 +701,11 @@ fn run_point(
     scene: &Scene,
     code: Code,
     lambda: u32,
+    rule: CoarseGrainRule,
     seed: u64,
     dir: &Path,
     options: &ValidateOptions,
 ) -> AccuracyPoint {
-    let rule = CoarseGrainRule::Seed;
     let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
     // A run that stopped early (a guard, a time limit) measured nothing comparable.
     if record.partial {
@@ -624,6 +743,7 @@ fn run_point(
         value: f64::NAN,
         setting: String::new(),
         lambda,
+        cg_rule: rule,
         seed,
         status: record.status,
         reason: record.reason,
@@ -640,6 +760,16 @@ fn run_point(
         mass_flow_error: None,
         eq7_mass_flow_kg_s: conveying("eq7_mass_flow_kg_s"),
         eq7_error: None,
+        t_half_s: scene
+            .repose
+            .as_ref()
+            .filter(|_| ok)
+            .and_then(|r| FlowSeries::read(dir, &r.stage)?.t_half()),
+        t_half_error: None,
+        porosity: summary["packing"]["porosity"]
+            .as_f64()
+            .filter(|v| ok && v.is_finite()),
+        porosity_error: None,
     }
 }
 
@@ -656,8 +786,8 @@ fn read_profile(dir: &Path) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Fills each point's errors against its code's reference run.
-fn measure(points: &mut [AccuracyPoint]) {
+/// Fills each point's errors against its code's reference run with the same seed.
+pub(crate) fn measure(points: &mut [AccuracyPoint]) {
     let references: Vec<AccuracyPoint> = points
         .iter()
         .filter(|p| p.series == "reference" && p.status == "ok")
@@ -667,17 +797,112 @@ fn measure(points: &mut [AccuracyPoint]) {
         if let (Some(q), Some(eq7)) = (p.mass_flow_kg_s, p.eq7_mass_flow_kg_s) {
             p.eq7_error = Some((q / eq7 - 1.0).abs()).filter(|e| e.is_finite());
         }
-        let Some(r) = references.iter().find(|r| r.code == p.code) else {
+        let Some(r) = references
+            .iter()
+            .find(|r| r.code == p.code && r.seed == p.seed)
+        else {
             continue;
         };
-        if let (Some(a), Some(b)) = (p.repose_angle_deg, r.repose_angle_deg) {
-            p.angle_error_deg = Some((a - b).abs());
-            p.profile_distance = profile_distance(&read_profile(&r.dir), &read_profile(&p.dir));
+        p.angle_error_deg = difference(Measure::Angle, p, r);
+        p.profile_distance = difference(Measure::Profile, p, r);
+        p.mass_flow_error = difference(Measure::MassFlow, p, r);
+        p.t_half_error = difference(Measure::THalf, p, r);
+        p.porosity_error = difference(Measure::Porosity, p, r);
+    }
+}
+
+/// How far run `p` is from run `r` under measure `m` (None where either measured nothing).
+fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
+    let finite = |v: f64| Some(v).filter(|v| v.is_finite());
+    match m {
+        Measure::Angle => finite((p.repose_angle_deg? - r.repose_angle_deg?).abs()),
+        Measure::Profile => {
+            p.repose_angle_deg?;
+            r.repose_angle_deg?;
+            profile_distance(&read_profile(&r.dir), &read_profile(&p.dir))
         }
-        if let (Some(q), Some(q_ref)) = (p.mass_flow_kg_s, r.mass_flow_kg_s) {
-            p.mass_flow_error = Some((q / q_ref - 1.0).abs()).filter(|e| e.is_finite());
+        Measure::MassFlow => finite((p.mass_flow_kg_s? / r.mass_flow_kg_s? - 1.0).abs()),
+        Measure::Eq7 => finite((p.eq7_error? - r.eq7_error?).abs()),
+        Measure::THalf => finite((p.t_half_s? / r.t_half_s? - 1.0).abs()),
+        Measure::Porosity => finite((p.porosity? - r.porosity?).abs()),
+    }
+}
+
+/// The floor of a code under measure `m`: the largest difference between two of its
+/// reference runs (same setting, different insertion seeds); None with fewer than two.
+fn floor(code: Code, m: Measure, points: &[AccuracyPoint]) -> Option<f64> {
+    let references: Vec<&AccuracyPoint> = points
+        .iter()
+        .filter(|p| p.code == code && p.series == "reference" && p.status == "ok")
+        .collect();
+    let mut worst: Option<f64> = None;
+    for (k, a) in references.iter().enumerate() {
+        for b in &references[k + 1..] {
+            if let Some(d) = difference(m, b, a) {
+                worst = Some(worst.map_or(d, |w| w.max(d)));
+            }
         }
     }
+    worst
+}
+
+/// One setting of one code (the reference or a series point) over the seeds it ran with.
+pub(crate) struct Setting<'a> {
+    pub series: &'a str,
+    pub setting: &'a str,
+    pub value: f64,
+    pub runs: Vec<&'a AccuracyPoint>,
+}
+
+impl Setting<'_> {
+    /// Mean over the runs that measured `m`, with its cost `cost` (the same runs' mean), the
+    /// standard error of the mean (None with one run) and the number of runs.
+    pub fn mean(&self, m: Measure, cost: Cost) -> Option<SettingMean> {
+        let pairs: Vec<(f64, f64)> = self
+            .runs
+            .iter()
+            .filter_map(|p| Some((cost.of(p)?, m.of(p)?)))
+            .collect();
+        let n = pairs.len();
+        if n == 0 {
+            return None;
+        }
+        let cost = pairs.iter().map(|p| p.0).sum::<f64>() / n as f64;
+        let error = pairs.iter().map(|p| p.1).sum::<f64>() / n as f64;
+        let se = (n > 1).then(|| {
+            let var = pairs.iter().map(|p| (p.1 - error).powi(2)).sum::<f64>() / (n - 1) as f64;
+            (var / n as f64).sqrt()
+        });
+        Some(SettingMean { cost, error, se, n })
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SettingMean {
+    pub cost: f64,
+    pub error: f64,
+    pub se: Option<f64>,
+    pub n: usize,
+}
+
+/// The settings of `code`, in the order of the points, each with its successful runs.
+pub(crate) fn settings(code: Code, points: &[AccuracyPoint]) -> Vec<Setting<'_>> {
+    let mut out: Vec<Setting> = Vec::new();
+    for p in points.iter().filter(|p| p.code == code && p.status == "ok") {
+        match out
+            .iter_mut()
+            .find(|s| s.series == p.series && s.setting == p.setting)
+        {
+            Some(s) => s.runs.push(p),
+            None => out.push(Setting {
+                series: &p.series,
+                setting: &p.setting,
+                value: p.value,
+                runs: vec![p],
+            }),
+        }
+    }
+    out
 }
 
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {
@@ -706,22 +931,22 @@ fn write_sweep_section(
         .collect::<Vec<_>>()
         .join(", ");
     sub.paragraph(format!(
-        "Scene file {} with the overrides of variant `{}` ({}); insertion seed {}. Reference \
-         setting: {reference}.",
+        "Scene file {} with the overrides of variant `{}` ({}); insertion seeds {}. \
+         Reference setting: {reference}.",
         sweep.file.display(),
         sweep.variant,
         if shared.is_empty() { "none" } else { &shared },
-        sweep.seed
+        sweep
+            .seeds
+            .iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     ));
-    let measures: Vec<Measure> = [
-        Measure::Angle,
-        Measure::Profile,
-        Measure::MassFlow,
-        Measure::Eq7,
-    ]
-    .into_iter()
-    .filter(|m| points.iter().any(|p| m.of(p).is_some()))
-    .collect();
+    let measures: Vec<Measure> = Measure::ALL
+        .into_iter()
+        .filter(|m| points.iter().any(|p| m.of(p).is_some()))
+        .collect();
 
     let mut table = Table::new(
         [
@@ -741,7 +966,7 @@ fn write_sweep_section(
     )
     .caption("Every point: its cost and its errors");
     let mut csv = String::from(
-        "case,code,series,knob_value,setting,lambda,seed,status,n_particles,steps,particle_steps,wall_s,repose_angle_deg,angle_error_deg,profile_distance,mass_flow_kg_s,mass_flow_error,eq7_mass_flow_kg_s,eq7_error\n",
+        "case,code,series,knob_value,setting,lambda,cg_rule,seed,status,n_particles,steps,particle_steps,wall_s,repose_angle_deg,angle_error_deg,profile_distance,mass_flow_kg_s,mass_flow_error,eq7_mass_flow_kg_s,eq7_error,t_half_s,t_half_error,porosity,porosity_error\n",
     );
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
@@ -778,13 +1003,14 @@ fn write_sweep_section(
             ),
         );
         csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             p.case,
             p.code.name(),
             p.series,
             p.value,
             p.setting.replace(',', ";"),
             p.lambda,
+            p.cg_rule.name(),
             p.seed,
             p.status,
             p.n_particles.map_or(String::new(), |n| n.to_string()),
@@ -798,6 +1024,10 @@ fn write_sweep_section(
             o(p.mass_flow_error),
             o(p.eq7_mass_flow_kg_s),
             o(p.eq7_error),
+            o(p.t_half_s),
+            o(p.t_half_error),
+            o(p.porosity),
+            o(p.porosity_error),
         );
     }
     std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
@@ -845,12 +1075,12 @@ fn write_sweep_section(
         "cheapest setting within it",
         "wall s",
         "particle-steps",
-        "its error",
+        "its error (mean +- SE, seeds)",
         "reference wall s",
         "speed-up",
         "floor (other seeds)",
     ])
-    .caption("Cheapest setting within each target, per code: the fewest particle-steps (wall time beside it; on a shared machine the wall time of equal work varies too much to choose by). The reference is the yardstick: when no other point meets the target, none is named. Floor: the largest error of the reference setting with other insertion seeds; a target below it is met by chance.");
+    .caption("Cheapest setting within each target, per code: the fewest particle-steps (wall time beside it; on a shared machine the wall time of equal work varies too much to choose by). The reference is the yardstick: when no other point meets the target, none is named. A setting's error, cost and wall time are means over its seeds, the error with one standard error of the mean. Floor: the largest difference between two reference runs with different insertion seeds; a target below it is met by chance.");
     for c in &cheapest {
         let m = measure_named(&c.measure);
         let speedup = match (c.reference_wall_s, c.wall_s) {
@@ -867,7 +1097,15 @@ fn write_sweep_section(
             },
             Cell::num(fmt_opt(c.wall_s, 1)),
             Cell::num(c.particle_steps.map_or("-".into(), |n| format!("{n:.3e}"))),
-            Cell::num(c.error.map_or("-".into(), |v| m.format(v))),
+            Cell::num(c.error.map_or("-".into(), |v| {
+                format!(
+                    "{}{} ({})",
+                    m.format(v),
+                    c.error_se
+                        .map_or(String::new(), |se| format!(" +- {}", m.format(se))),
+                    c.seeds
+                )
+            })),
             Cell::num(fmt_opt(c.reference_wall_s, 1)),
             Cell::num(speedup),
             Cell::num(c.floor.map_or("-".into(), |v| m.format(v))),
@@ -879,24 +1117,18 @@ fn write_sweep_section(
 }
 
 fn measure_named(name: &str) -> Measure {
-    [
-        Measure::Angle,
-        Measure::Profile,
-        Measure::MassFlow,
-        Measure::Eq7,
-    ]
-    .into_iter()
-    .find(|m| m.name() == name)
-    .unwrap_or(Measure::Angle)
+    Measure::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .unwrap_or(Measure::Angle)
 }
 
-/// The points that are settings to choose from: the series, and the reference where its
-/// error is not zero by construction.
-fn candidates(code: Code, m: Measure, points: &[AccuracyPoint]) -> Vec<&AccuracyPoint> {
-    points
-        .iter()
-        .filter(|p| p.code == code && p.status == "ok" && p.series != "floor")
-        .filter(|p| p.series != "reference" || !m.against_reference())
+/// The settings to choose from: the series, and the reference where its error is not zero
+/// by construction.
+fn candidates(code: Code, m: Measure, points: &[AccuracyPoint]) -> Vec<Setting<'_>> {
+    settings(code, points)
+        .into_iter()
+        .filter(|s| s.series != "reference" || !m.against_reference())
         .collect()
 }
 
@@ -909,49 +1141,49 @@ fn cheapest_setting(
 ) -> CheapestSetting {
     // Chosen by particle-steps, not wall time: within one code the two are proportional at a
     // given per-step cost, and on a shared machine the wall time of equal work varied
-    // two-fold between runs (reports/accuracy/NOTE.md).
-    let found = candidates(code, m, points);
-    let cost: Vec<(f64, f64)> = found
-        .iter()
-        .map(|p| {
-            (
-                p.particle_steps.unwrap_or(f64::NAN),
-                m.of(p).unwrap_or(f64::NAN),
-            )
+    // two-fold between runs (reports/accuracy/one-seed-2026-11-22/NOTE.md). A setting's
+    // error is its mean over the seeds.
+    let found: Vec<(Setting, SettingMean)> = candidates(code, m, points)
+        .into_iter()
+        .filter_map(|s| {
+            let mean = s.mean(m, Cost::ParticleSteps)?;
+            Some((s, mean))
         })
         .collect();
-    let best = cheapest_within(&cost, m.target(targets)).map(|k| found[k]);
-    let reference = points
-        .iter()
-        .find(|p| p.code == code && p.series == "reference" && p.status == "ok");
-    let floor = points
-        .iter()
-        .filter(|p| p.code == code && p.series == "floor")
-        .filter_map(|p| m.of(p))
-        .fold(None, |a: Option<f64>, e| Some(a.map_or(e, |a| a.max(e))));
+    let cost: Vec<(f64, f64)> = found.iter().map(|(_, a)| (a.cost, a.error)).collect();
+    let best = cheapest_within(&cost, m.target(targets)).map(|k| &found[k]);
+    let reference = settings(code, points)
+        .into_iter()
+        .find(|s| s.series == "reference");
+    let mean_of = |s: &Setting, f: fn(&AccuracyPoint) -> Option<f64>| {
+        let v: Vec<f64> = s.runs.iter().filter_map(|p| f(p)).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
     CheapestSetting {
         case: case.to_string(),
         code,
         measure: m.name().into(),
         target: m.target(targets),
-        setting: best.map(|p| p.setting.clone()),
-        wall_s: best.and_then(|p| p.wall_s),
-        particle_steps: best.and_then(|p| p.particle_steps),
-        error: best.and_then(|p| m.of(p)),
-        reference_wall_s: reference.and_then(|p| p.wall_s),
-        floor,
+        setting: best.map(|(s, _)| s.setting.to_string()),
+        wall_s: best.and_then(|(s, _)| mean_of(s, |p| p.wall_s)),
+        particle_steps: best.map(|(_, a)| a.cost),
+        error: best.map(|(_, a)| a.error),
+        error_se: best.and_then(|(_, a)| a.se),
+        seeds: best.map_or(0, |(_, a)| a.n),
+        reference_wall_s: reference.as_ref().and_then(|s| mean_of(s, |p| p.wall_s)),
+        floor: floor(code, m, points),
     }
 }
 
 /// The cost a figure's x axis shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Cost {
+pub(crate) enum Cost {
     WallTime,
     ParticleSteps,
 }
 
 impl Cost {
-    fn of(self, p: &AccuracyPoint) -> Option<f64> {
+    pub fn of(self, p: &AccuracyPoint) -> Option<f64> {
         match self {
             Cost::WallTime => p.wall_s,
             Cost::ParticleSteps => p.particle_steps,
@@ -986,46 +1218,37 @@ fn error_figure(
     .log_y();
     let mut walls: Vec<f64> = Vec::new();
     for &code in codes {
-        let mut knobs: Vec<&str> = points
-            .iter()
-            .filter(|p| p.code == code)
-            .map(|p| p.series.as_str())
-            .collect();
+        let all = settings(code, points);
+        let mut knobs: Vec<&str> = all.iter().map(|s| s.series).collect();
         knobs.sort();
         knobs.dedup();
         for knob in knobs {
-            let mut series: Vec<&AccuracyPoint> = points
+            let mut series: Vec<(f64, SettingMean)> = all
                 .iter()
-                .filter(|p| p.code == code && p.series == knob && p.status == "ok")
+                .filter(|s| s.series == knob)
+                .filter_map(|s| Some((s.value, s.mean(m, cost_axis)?)))
                 .collect();
-            series.sort_by(|a, b| a.value.total_cmp(&b.value));
-            let xy: Vec<(f64, f64)> = series
-                .iter()
-                .filter_map(|p| Some((cost_axis.of(p)?, m.of(p)?)))
-                .collect();
-            walls.extend(xy.iter().map(|p| p.0));
-            if xy.is_empty() || (knob == "reference" && m.against_reference()) {
+            series.sort_by(|a, b| a.0.total_cmp(&b.0));
+            walls.extend(series.iter().map(|p| p.1.cost));
+            if series.is_empty() || (knob == "reference" && m.against_reference()) {
                 continue;
             }
-            let label = match knob {
-                "floor" => format!("{}: reference, other seeds", code.name()),
-                _ => format!("{}: {knob}", code.name()),
-            };
+            let xy = series.iter().map(|p| (p.1.cost, p.1.error)).collect();
+            let se = series.iter().map(|p| p.1.se.unwrap_or(0.0)).collect();
             let style = match knob {
-                "floor" | "reference" => SeriesStyle::Markers,
+                "reference" => SeriesStyle::Markers,
                 _ => SeriesStyle::LineMarkers,
             };
-            fig.series.push(Series::new(label, xy).style(style));
+            fig.series.push(
+                Series::new(format!("{}: {knob}", code.name()), xy)
+                    .style(style)
+                    .y_err(se),
+            );
         }
-        let found = candidates(code, m, points);
-        let cost: Vec<(f64, f64)> = found
+        let cost: Vec<(f64, f64)> = candidates(code, m, points)
             .iter()
-            .map(|p| {
-                (
-                    cost_axis.of(p).unwrap_or(f64::NAN),
-                    m.of(p).unwrap_or(f64::NAN),
-                )
-            })
+            .filter_map(|s| s.mean(m, cost_axis))
+            .map(|a| (a.cost, a.error))
             .collect();
         let front: Vec<(f64, f64)> = pareto_front(&cost)
             .into_iter()
@@ -1089,6 +1312,105 @@ mod tests {
         assert_eq!(cheapest_within(&points, 0.1), Some(0));
         assert_eq!(cheapest_within(&points, 0.001), None);
         assert_eq!(cheapest_within(&[(f64::NAN, 0.0)], 1.0), None);
+    }
+
+    fn run(series: &str, value: f64, seed: u64, angle: f64, particle_steps: f64) -> AccuracyPoint {
+        AccuracyPoint {
+            case: "c".into(),
+            code: Code::Cgdem,
+            series: series.into(),
+            value,
+            setting: format!("{series} = {value}"),
+            lambda: 1,
+            cg_rule: CoarseGrainRule::Seed,
+            seed,
+            status: "ok".into(),
+            reason: None,
+            dir: PathBuf::from("/nonexistent"),
+            reused: false,
+            n_particles: Some(100),
+            steps: Some(10),
+            particle_steps: Some(particle_steps),
+            wall_s: Some(particle_steps / 1e6),
+            repose_angle_deg: Some(angle),
+            angle_error_deg: None,
+            profile_distance: None,
+            mass_flow_kg_s: None,
+            mass_flow_error: None,
+            eq7_mass_flow_kg_s: None,
+            eq7_error: None,
+            t_half_s: None,
+            t_half_error: None,
+            porosity: None,
+            porosity_error: None,
+        }
+    }
+
+    #[test]
+    fn errors_pair_runs_by_seed_and_settings_average_over_seeds() {
+        let mut points = vec![
+            run("reference", 0.02, 1, 30.0, 1e7),
+            run("reference", 0.02, 2, 31.0, 1e7),
+            run("reference", 0.02, 3, 29.5, 1e7),
+            run("dt", 0.1, 1, 30.5, 2e6),
+            run("dt", 0.1, 2, 31.2, 2e6),
+            run("dt", 0.1, 3, 29.0, 2e6),
+            run("dt", 0.3, 1, 31.0, 1e6),
+            run("dt", 0.3, 2, 30.0, 1e6),
+            run("dt", 0.3, 3, 30.5, 1e6),
+        ];
+        // Seed 1's dynamics and packing: t_half 20% longer, porosity 0.01 higher.
+        points[0].t_half_s = Some(1.0);
+        points[3].t_half_s = Some(1.2);
+        points[0].porosity = Some(0.40);
+        points[3].porosity = Some(0.41);
+        measure(&mut points);
+        assert!((points[3].t_half_error.unwrap() - 0.2).abs() < 1e-12);
+        assert!((points[3].porosity_error.unwrap() - 0.01).abs() < 1e-12);
+        assert_eq!(points[4].t_half_error, None);
+        // Against the reference with the same seed: 0.5, 0.2, 0.5 (against seed 1's
+        // reference alone they would be 0.5, 1.2, 1.0).
+        let errors: Vec<f64> = points[3..6]
+            .iter()
+            .map(|p| p.angle_error_deg.unwrap())
+            .collect();
+        for (e, want) in errors.iter().zip([0.5, 0.2, 0.5]) {
+            assert!((e - want).abs() < 1e-12, "{errors:?}");
+        }
+        let all = settings(Code::Cgdem, &points);
+        assert_eq!(all.len(), 3);
+        let dt = all[1].mean(Measure::Angle, Cost::ParticleSteps).unwrap();
+        assert_eq!(dt.n, 3);
+        assert!((dt.error - 0.4).abs() < 1e-12, "{dt:?}");
+        // Sample standard deviation sqrt(0.03), over sqrt(3).
+        assert!((dt.se.unwrap() - 0.1).abs() < 1e-12, "{dt:?}");
+        // The reference runs' largest difference between seeds: 31.0 against 29.5.
+        assert_eq!(floor(Code::Cgdem, Measure::Angle, &points), Some(1.5));
+        // dt 0.3 errs by 1.0, 1.0, 1.0: within 1.0 it is the cheapest; within 0.5 only dt 0.1.
+        let targets = Targets {
+            angle_deg: 0.5,
+            profile: 0.05,
+            mass_flow: 0.05,
+            t_half: 0.1,
+            porosity: 0.02,
+        };
+        let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &targets, &points);
+        assert_eq!(c.setting.as_deref(), Some("dt = 0.1"));
+        assert_eq!((c.seeds, c.particle_steps), (3, Some(2e6)));
+        let loose = Targets {
+            angle_deg: 1.0,
+            ..targets
+        };
+        let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &loose, &points);
+        assert_eq!(c.setting.as_deref(), Some("dt = 0.3"));
+        assert_eq!(c.error_se, Some(0.0));
+        // A failed run drops out of its setting's mean.
+        points[4].status = "failed".into();
+        let all = settings(Code::Cgdem, &points);
+        assert_eq!(
+            all[1].mean(Measure::Angle, Cost::ParticleSteps).unwrap().n,
+            2
+        );
     }
 
     #[test]
@@ -1162,5 +1484,37 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("accuracy[0].series[0].values"), "{e}");
+        let with_seeds = |seeds: &str| {
+            suite("knob = \"time.dt_fraction\"\nvalues = [0.1]").replace(
+                "variant = \"acc\"\n",
+                &format!("variant = \"acc\"\n{seeds}\n"),
+            )
+        };
+        let ok = Suite::parse(&with_seeds("seeds = [3, 1, 2]"), Path::new("s.toml")).unwrap();
+        assert_eq!(ok.accuracy[0].seeds, vec![3, 1, 2]);
+        for bad in ["seeds = [1, 1]", "seeds = []"] {
+            let e = Suite::parse(&with_seeds(bad), Path::new("s.toml"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("accuracy[0].seeds"), "{bad}: {e}");
+        }
+        // A series under another coarse-graining rule is its own series, named by the rule.
+        let ruled = suite("knob = \"lambda\"\nvalues = [2]\ncg_rule = \"bulk-viscosity\"");
+        let ok = Suite::parse(&ruled, Path::new("s.toml")).unwrap();
+        let s0 = &ok.accuracy[0].series[0];
+        assert_eq!(s0.rule, CoarseGrainRule::BulkViscosity);
+        assert_eq!(s0.name(ok.accuracy[0].rule), "lambda (bulk-viscosity)");
+        let e = Suite::parse(&ruled.replace("bulk-viscosity", "pfm"), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("accuracy[0].series[0].cg_rule") && e.contains("pfm"),
+            "{e}"
+        );
+        // The former single seed is refused by name, not silently ignored.
+        let e = Suite::parse(&with_seeds("seed = 1"), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("seed"), "{e}");
     }
 }

@@ -1,7 +1,9 @@
 //! The codes a case runs with: cgdem itself and the two reference codes, one enum for the
 //! suites, the reports and the reference runs alike.
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Code {
     Cgdem,

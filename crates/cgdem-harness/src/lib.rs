@@ -4,6 +4,7 @@
 //! The solver core (`cgdem-core`) never depends on this crate.
 
 pub mod accuracy;
+pub mod advise;
 pub mod bench;
 pub mod code;
 pub mod dynamics;

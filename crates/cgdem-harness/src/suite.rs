@@ -270,14 +270,14 @@ impl Suite {
             } else {
                 c.cg_rules
                     .iter()
-                    .map(|name| match name.as_str() {
-                        "seed" => Ok(CoarseGrainRule::Seed),
-                        "bulk-viscosity" => Ok(CoarseGrainRule::BulkViscosity),
-                        other => Err(invalid(
-                            format!("case[{k}].cg_rules"),
-                            format!("\"{other}\""),
-                            "\"seed\" or \"bulk-viscosity\"",
-                        )),
+                    .map(|name| {
+                        CoarseGrainRule::from_name(name).ok_or_else(|| {
+                            invalid(
+                                format!("case[{k}].cg_rules"),
+                                format!("\"{name}\""),
+                                &rule_names(),
+                            )
+                        })
                     })
                     .collect::<Result<Vec<_>, _>>()?
             };
@@ -405,6 +405,15 @@ impl Suite {
             stability,
         })
     }
+}
+
+/// The coarse-graining rules' names, as an error's "allowed" text.
+pub(super) fn rule_names() -> String {
+    CoarseGrainRule::ALL
+        .iter()
+        .map(|r| format!("\"{}\"", r.name()))
+        .collect::<Vec<_>>()
+        .join(" or ")
 }
 
 #[cfg(test)]

@@ -27,6 +27,14 @@ impl CoarseGrainRule {
         }
     }
 
+    /// Every rule, in the order the documentation lists them.
+    pub const ALL: [CoarseGrainRule; 2] = [CoarseGrainRule::Seed, CoarseGrainRule::BulkViscosity];
+
+    /// The rule named `name` (its [`name`](Self::name)), if any.
+    pub fn from_name(name: &str) -> Option<CoarseGrainRule> {
+        Self::ALL.into_iter().find(|r| r.name() == name)
+    }
+
     /// Exponents of lambda for (WCA energy, dashpots, explicit time step).
     pub(crate) fn exponents(self) -> (i32, i32, i32) {
         match self {

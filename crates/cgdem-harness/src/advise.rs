@@ -1,0 +1,432 @@
+//! `cgdem advise`: from a stored coarse-graining matrix (the `accuracy` points of a
+//! `cgdem validate` report whose sweeps vary lambda under each rule against a fine
+//! reference), the coarsest level and rule that keeps a quantity within a target, and what it
+//! saves.
+//!
+//! A setting meets the target when its mean error over seeds plus its spread (twice the
+//! standard error of the mean, the `k = 2` of the verdicts) is within it, so a level that
+//! meets it by the luck of one packing is not advised. Among those, the largest lambda wins
+//! (ties: the fewest particle-steps). When none meets it, the answer is "none" with the
+//! setting that came closest.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::accuracy::{settings, AccuracyPoint, Cost, Measure};
+use super::code::Code;
+
+/// Spread = this many standard errors of the mean over seeds.
+pub const SPREAD_STANDARD_ERRORS: f64 = 2.0;
+
+#[derive(Debug, thiserror::Error)]
+pub enum AdviseError {
+    #[error("{file}: cannot read the stored matrix: {reason}; make it with `cgdem validate --suite SUITE --out DIR` (its sweeps vary lambda) and pass --matrix DIR")]
+    Matrix { file: PathBuf, reason: String },
+    #[error("{file}: no coarse-graining points for case `{case}` (cases with points: {known})")]
+    NoCase {
+        file: PathBuf,
+        case: String,
+        known: String,
+    },
+    #[error("{file}: case `{case}` has no successful fine reference run to compare with")]
+    NoReference { file: PathBuf, case: String },
+    #[error("case `{case}`: no run measured {quantity} (measured here: {measured})")]
+    NotMeasured {
+        case: String,
+        quantity: String,
+        measured: String,
+    },
+}
+
+/// One coarse-graining setting as the answer reports it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Level {
+    pub setting: String,
+    pub lambda: u32,
+    pub cg_rule: String,
+    /// Mean error over seeds and its spread (`SPREAD_STANDARD_ERRORS` standard errors; None
+    /// with one seed, when it is unknown and counted as zero).
+    pub error: f64,
+    pub spread: Option<f64>,
+    pub seeds: usize,
+    pub particle_steps: f64,
+    pub wall_s: Option<f64>,
+    /// The fine reference's particle-steps (and wall time) over this setting's.
+    pub saving_particle_steps: f64,
+    pub saving_wall: Option<f64>,
+}
+
+impl Level {
+    /// The error a target must allow: the mean plus the spread.
+    pub fn reach(&self) -> f64 {
+        self.error + self.spread.unwrap_or(0.0)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Advice {
+    pub case: String,
+    pub quantity: String,
+    pub target: f64,
+    /// The fine reference: its lambda and rule.
+    pub reference: String,
+    /// The coarsest setting within the target; None: nothing meets it.
+    pub advised: Option<Level>,
+    /// When nothing meets the target: the setting with the smallest error plus spread.
+    pub best_reached: Option<Level>,
+    /// Every coarse-grained setting considered, finest first.
+    pub considered: Vec<Level>,
+}
+
+impl Advice {
+    /// The answer in words, as the command prints it.
+    pub fn text(&self, m: Measure) -> String {
+        let level = |l: &Level| {
+            format!(
+                "lambda = {} under the {} rule: error {} {}, {:.1}x fewer particle-steps{}",
+                l.lambda,
+                l.cg_rule,
+                m.format(l.error),
+                match l.spread {
+                    Some(s) => format!("+- {} ({} seeds)", m.format(s), l.seeds),
+                    None => "(1 seed: spread unknown)".into(),
+                },
+                l.saving_particle_steps,
+                l.saving_wall
+                    .map_or(String::new(), |w| format!(", {w:.1}x less wall time"))
+            )
+        };
+        match (&self.advised, &self.best_reached) {
+            (Some(l), _) => format!(
+                "{}: {} within {}: {} (against {})",
+                self.case,
+                self.quantity,
+                m.format(self.target),
+                level(l),
+                self.reference
+            ),
+            (None, Some(l)) => format!(
+                "{}: {} within {}: none; the closest is {} (against {})",
+                self.case,
+                self.quantity,
+                m.format(self.target),
+                level(l),
+                self.reference
+            ),
+            (None, None) => format!(
+                "{}: {} within {}: none; no coarse-grained setting measured it",
+                self.case,
+                self.quantity,
+                m.format(self.target)
+            ),
+        }
+    }
+}
+
+/// Reads the `accuracy` points of a report directory's (or file's) `summary.json`.
+pub fn read_matrix(path: &Path) -> Result<(PathBuf, Vec<AccuracyPoint>), AdviseError> {
+    let file = if path.is_dir() {
+        path.join("summary.json")
+    } else {
+        path.to_path_buf()
+    };
+    let fail = |reason: String| AdviseError::Matrix {
+        file: file.clone(),
+        reason,
+    };
+    let text = std::fs::read_to_string(&file).map_err(|e| fail(e.to_string()))?;
+    let summary: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| fail(format!("not JSON: {e}")))?;
+    let points = summary
+        .get("accuracy")
+        .and_then(|a| a.get("points"))
+        .ok_or_else(|| fail("no `accuracy.points` (a report without sweeps)".into()))?;
+    let points: Vec<AccuracyPoint> = serde_json::from_value(points.clone())
+        .map_err(|e| fail(format!("`accuracy.points`: {e}")))?;
+    Ok((file, points))
+}
+
+/// The advice for `case` (a case name as in the report, e.g. `aor_hertz-fidelity`, or its
+/// scene name without the variant when only one variant has points).
+pub fn advise(
+    file: &Path,
+    points: &[AccuracyPoint],
+    case: &str,
+    m: Measure,
+    target: f64,
+) -> Result<Advice, AdviseError> {
+    let mut cases: Vec<&str> = points.iter().map(|p| p.case.as_str()).collect();
+    cases.sort();
+    cases.dedup();
+    let prefixed: Vec<&str> = cases
+        .iter()
+        .copied()
+        .filter(|c| c.strip_prefix(case).is_some_and(|v| v.starts_with('-')))
+        .collect();
+    let name = if cases.contains(&case) {
+        case
+    } else if prefixed.len() == 1 {
+        prefixed[0]
+    } else {
+        return Err(AdviseError::NoCase {
+            file: file.to_path_buf(),
+            case: case.to_string(),
+            known: cases.join(", "),
+        });
+    };
+    let mine: Vec<AccuracyPoint> = points
+        .iter()
+        .filter(|p| p.case == name && p.code == Code::Cgdem)
+        .cloned()
+        .collect();
+    let all = settings(Code::Cgdem, &mine);
+    let Some(reference) = all.iter().find(|s| s.series == "reference") else {
+        return Err(AdviseError::NoReference {
+            file: file.to_path_buf(),
+            case: name.to_string(),
+        });
+    };
+    let measured: Vec<&str> = Measure::ALL
+        .into_iter()
+        .filter(|q| mine.iter().any(|p| q.of(p).is_some()))
+        .map(Measure::quantity)
+        .collect();
+    let mean_wall = |runs: &[&AccuracyPoint]| {
+        let w: Vec<f64> = runs.iter().filter_map(|p| p.wall_s).collect();
+        (!w.is_empty()).then(|| w.iter().sum::<f64>() / w.len() as f64)
+    };
+    let reference_cost = {
+        let c: Vec<f64> = reference
+            .runs
+            .iter()
+            .filter_map(|p| p.particle_steps)
+            .collect();
+        c.iter().sum::<f64>() / c.len().max(1) as f64
+    };
+    let reference_wall = mean_wall(&reference.runs);
+    let first = reference.runs[0];
+    let mut considered: Vec<Level> = all
+        .iter()
+        .filter(|s| s.series.starts_with("lambda"))
+        .filter_map(|s| {
+            let mean = s.mean(m, Cost::ParticleSteps)?;
+            let wall = mean_wall(&s.runs);
+            Some(Level {
+                setting: s.setting.to_string(),
+                lambda: s.runs[0].lambda,
+                cg_rule: s.runs[0].cg_rule.name().to_string(),
+                error: mean.error,
+                spread: mean.se.map(|se| SPREAD_STANDARD_ERRORS * se),
+                seeds: mean.n,
+                particle_steps: mean.cost,
+                wall_s: wall,
+                saving_particle_steps: reference_cost / mean.cost,
+                saving_wall: reference_wall.zip(wall).map(|(r, w)| r / w),
+            })
+        })
+        .collect();
+    if considered.is_empty() {
+        return Err(AdviseError::NotMeasured {
+            case: name.to_string(),
+            quantity: m.quantity().to_string(),
+            measured: if measured.is_empty() {
+                "nothing".into()
+            } else {
+                measured.join(", ")
+            },
+        });
+    }
+    considered.sort_by(|a, b| {
+        a.lambda
+            .cmp(&b.lambda)
+            .then(a.cg_rule.cmp(&b.cg_rule))
+            .then(a.particle_steps.total_cmp(&b.particle_steps))
+    });
+    let advised = considered
+        .iter()
+        .filter(|l| l.reach() <= target)
+        .max_by(|a, b| {
+            a.lambda
+                .cmp(&b.lambda)
+                .then(b.particle_steps.total_cmp(&a.particle_steps))
+        })
+        .cloned();
+    let best_reached = match advised {
+        Some(_) => None,
+        None => considered
+            .iter()
+            .min_by(|a, b| a.reach().total_cmp(&b.reach()))
+            .cloned(),
+    };
+    Ok(Advice {
+        case: name.to_string(),
+        quantity: m.quantity().to_string(),
+        target,
+        reference: format!(
+            "the fine reference lambda = {} under the {} rule, {} seed{}",
+            first.lambda,
+            first.cg_rule.name(),
+            reference.runs.len(),
+            if reference.runs.len() == 1 { "" } else { "s" }
+        ),
+        advised,
+        best_reached,
+        considered,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cgdem_core::coarse_graining::CoarseGrainRule;
+
+    fn run(
+        series: &str,
+        lambda: u32,
+        rule: CoarseGrainRule,
+        seed: u64,
+        angle: f64,
+    ) -> AccuracyPoint {
+        let steps = 1e9 / (lambda as f64).powi(4);
+        AccuracyPoint {
+            case: "aor-fidelity".into(),
+            code: Code::Cgdem,
+            series: series.into(),
+            value: lambda as f64,
+            setting: format!("lambda = {lambda}, {} rule", rule.name()),
+            lambda,
+            cg_rule: rule,
+            seed,
+            status: "ok".into(),
+            reason: None,
+            dir: PathBuf::from("/nonexistent"),
+            reused: false,
+            n_particles: None,
+            steps: None,
+            particle_steps: Some(steps),
+            wall_s: Some(steps / 1e7),
+            repose_angle_deg: Some(angle),
+            angle_error_deg: None,
+            profile_distance: None,
+            mass_flow_kg_s: None,
+            mass_flow_error: None,
+            eq7_mass_flow_kg_s: None,
+            eq7_error: None,
+            t_half_s: None,
+            t_half_error: None,
+            porosity: None,
+            porosity_error: None,
+        }
+    }
+
+    /// Fine reference 30 deg; the seed rule drifts by 0.5 deg per level, the bulk-viscosity
+    /// rule by 1.5 deg but with seed noise at lambda 8.
+    fn matrix() -> Vec<AccuracyPoint> {
+        use CoarseGrainRule::{BulkViscosity as B, Seed as S};
+        let mut points = Vec::new();
+        for seed in 1..=3 {
+            let noise = [0.0, 0.1, -0.1][seed as usize - 1];
+            points.push(run("reference", 1, S, seed, 30.0 + noise));
+            for (k, lambda) in [2u32, 4, 8].into_iter().enumerate() {
+                let level = (k + 1) as f64;
+                points.push(run("lambda", lambda, S, seed, 30.0 + noise + 0.5 * level));
+                let wild = if lambda == 8 { 3.0 * noise * 10.0 } else { 0.0 };
+                points.push(run(
+                    "lambda (bulk-viscosity)",
+                    lambda,
+                    B,
+                    seed,
+                    30.0 + noise + 1.5 * level + wild,
+                ));
+            }
+        }
+        crate::accuracy::measure(&mut points);
+        points
+    }
+
+    #[test]
+    fn the_coarsest_level_within_target_plus_spread_is_advised_with_its_saving() {
+        let points = matrix();
+        let f = Path::new("m.json");
+        // Within 1.6 deg: seed rule up to lambda 8 (error 1.5, no spread) .
+        let a = advise(f, &points, "aor", Measure::Angle, 1.6).unwrap();
+        let l = a.advised.as_ref().unwrap();
+        assert_eq!((l.lambda, l.cg_rule.as_str()), (8, "seed"));
+        assert!(
+            (l.error - 1.5).abs() < 1e-9 && l.spread.unwrap() < 1e-9,
+            "{l:?}"
+        );
+        assert!((l.saving_particle_steps - 4096.0).abs() < 1e-6, "{l:?}");
+        // Within 1.2 deg: lambda 4 under the seed rule (1.0); the bulk-viscosity rule's lambda 2
+        // (1.5) does not qualify.
+        let a = advise(f, &points, "aor-fidelity", Measure::Angle, 1.2).unwrap();
+        let l = a.advised.as_ref().unwrap();
+        assert_eq!((l.lambda, l.cg_rule.as_str()), (4, "seed"));
+        assert!(a
+            .text(Measure::Angle)
+            .contains("lambda = 4 under the seed rule"));
+        // Within 0.3 deg: none, the closest being the seed rule's lambda 2 (0.5).
+        let a = advise(f, &points, "aor", Measure::Angle, 0.3).unwrap();
+        assert!(a.advised.is_none());
+        let b = a.best_reached.as_ref().unwrap();
+        assert_eq!((b.lambda, b.cg_rule.as_str()), (2, "seed"));
+        assert!(a.text(Measure::Angle).contains("none; the closest"));
+    }
+
+    #[test]
+    fn a_level_that_meets_the_target_only_by_its_mean_is_not_advised() {
+        let points = matrix();
+        // Bulk viscosity at lambda 8 errs by 4.5, 7.5, 1.5 (mean 4.5, spread 2 x 1.73): no
+        // target below 7.96 admits it, though its mean is 4.5.
+        let a = advise(Path::new("m"), &points, "aor", Measure::Angle, 5.0).unwrap();
+        let l = a.advised.unwrap();
+        assert_eq!((l.lambda, l.cg_rule.as_str()), (8, "seed"));
+        let bv8 = a
+            .considered
+            .iter()
+            .find(|l| l.lambda == 8 && l.cg_rule == "bulk-viscosity")
+            .unwrap();
+        assert!(
+            (bv8.error - 4.5).abs() < 1e-9 && bv8.reach() > 5.0,
+            "{bv8:?}"
+        );
+    }
+
+    #[test]
+    fn unknown_cases_and_unmeasured_quantities_are_named() {
+        let points = matrix();
+        let e = advise(Path::new("m.json"), &points, "screw", Measure::Angle, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.json") && e.contains("screw") && e.contains("aor-fidelity"),
+            "{e}"
+        );
+        let e = advise(Path::new("m.json"), &points, "aor", Measure::Porosity, 0.02)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("porosity") && e.contains("repose_angle"), "{e}");
+    }
+
+    #[test]
+    fn the_matrix_is_read_back_from_a_report_summary() {
+        let dir = std::env::temp_dir().join(format!("cgdem-advise-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let points = matrix();
+        let summary = serde_json::json!({ "accuracy": { "points": points, "cheapest": [] } });
+        std::fs::write(dir.join("summary.json"), summary.to_string()).unwrap();
+        let (file, read) = read_matrix(&dir).unwrap();
+        assert_eq!(file, dir.join("summary.json"));
+        assert_eq!(read.len(), points.len());
+        std::fs::write(dir.join("summary.json"), "{\"runs\": []}").unwrap();
+        let e = read_matrix(&dir).unwrap_err().to_string();
+        assert!(
+            e.contains("summary.json") && e.contains("accuracy.points"),
+            "{e}"
+        );
+        let e = read_matrix(&dir.join("absent")).unwrap_err().to_string();
+        assert!(e.contains("absent"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
