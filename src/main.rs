@@ -12,10 +12,43 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use cgdem_core::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
 use cgdem_core::geometry::accuracy::format_accuracy_table;
 use cgdem_core::geometry::screw_feeder::{self, ScrewFeederSpec};
-use cgdem_core::run::{run, RunOptions};
+use cgdem_core::run::restart::{self, RestartLoaded};
+use cgdem_core::run::{run, CheckpointOptions, RunOptions};
 use cgdem_core::scene::{Override, Scene};
 use cgdem_harness::report::sdf_study::write_sdf_accuracy_study;
 use cgdem_harness::sweep::Sweep;
+
+/// The command line of `cgdem run` that a restart file stores, to rebuild the same scene
+/// on `--resume` (the scene's digest is checked against the stored one).
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+struct RunInvocation {
+    /// Absolute, so a resume from another directory finds it.
+    case: PathBuf,
+    lambda: u32,
+    cg_rule: CoarseGrainRule,
+    seed: Option<u64>,
+    set: Vec<String>,
+    variant: Option<String>,
+    force_dt: bool,
+    keep_going: bool,
+}
+
+impl RunInvocation {
+    /// The newest usable restart file of `dir` and the command line it stored.
+    fn resumed(
+        dir: &std::path::Path,
+    ) -> Result<(RunInvocation, std::sync::Arc<RestartLoaded>), String> {
+        let loaded = restart::read_latest(dir)?;
+        let invocation = serde_json::from_str(&loaded.restart.invocation).map_err(|e| {
+            format!(
+                "{}: the stored command line does not decode: {e}",
+                loaded.path.display()
+            )
+        })?;
+        eprintln!("resuming from {}", loaded.path.display());
+        Ok((invocation, std::sync::Arc::new(loaded)))
+    }
+}
 
 /// The coarse-graining rules as command-line values (`seed`, `bulk-viscosity`).
 #[derive(Clone, Copy, ValueEnum)]
@@ -48,8 +81,9 @@ struct Cli {
 enum Command {
     /// Run a scene (a TOML case file) and write its outputs.
     Run {
-        /// The scene file, e.g. validation/cases/aor_collapse.toml.
-        case: PathBuf,
+        /// The scene file, e.g. validation/cases/aor_collapse.toml (not with --resume).
+        #[arg(required_unless_present = "resume", conflicts_with = "resume")]
+        case: Option<PathBuf>,
         /// Coarse-graining level: a power of two (1 = the original, uncoarsened system).
         /// Diameters grow by lambda, the particle count falls by lambda^3 (paper A Eq. 3-6).
         #[arg(long, default_value_t = 1)]
@@ -111,6 +145,16 @@ enum Command {
         /// and plots with the published points).
         #[arg(long)]
         sweep: Option<String>,
+        /// Write a restart file (OUT/restart.cgr, the one before kept as restart.prev.cgr)
+        /// every this many simulated seconds, at the start, at every stage end and when
+        /// SIGINT/SIGTERM stops the run. Not with --grid or --sweep.
+        #[arg(long, value_name = "SECONDS")]
+        checkpoint_every: Option<f64>,
+        /// Continue the run in DIR from its newest usable restart file: the case file and
+        /// options (--lambda, --set, ...) are the ones the run stored, and the scene's digest
+        /// must match the stored one. Outputs come out as those of an uninterrupted run.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "sweep", "set", "seed", "variant", "checkpoint_every", "grid", "strict"])]
+        resume: Option<PathBuf>,
     },
     /// Run a validation suite (validation/suites/*.toml) with cgdem and the reference codes,
     /// compare the runs and write DIR/index.html, DIR/summary.json, figures and their CSV.
@@ -729,6 +773,8 @@ fn main() -> ExitCode {
             set,
             variant,
             grid,
+            checkpoint_every,
+            resume,
         } => {
             let sweep = match sweep.as_deref().map(Sweep::parse).transpose() {
                 Ok(s) => s,
@@ -737,6 +783,54 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
+            if checkpoint_every.is_some() && sweep.is_some() {
+                eprintln!("error: --checkpoint-every: not supported with --sweep (each run of a sweep is its own run; --reuse skips the finished ones)");
+                return ExitCode::from(2);
+            }
+            if let Some(t) = checkpoint_every {
+                if !(t.is_finite() && t > 0.0) {
+                    eprintln!("error: --checkpoint-every {t}: must be a positive number of simulated seconds");
+                    return ExitCode::from(2);
+                }
+            }
+            // What rebuilds the scene: this command line, or the one a resumed run stored.
+            let (invocation, resumed) = match &resume {
+                Some(dir) => match RunInvocation::resumed(dir) {
+                    Ok((inv, loaded)) => (inv, Some(loaded)),
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return ExitCode::FAILURE;
+                    }
+                },
+                None => (
+                    RunInvocation {
+                        case: case
+                            .clone()
+                            .map(|c| std::path::absolute(&c).unwrap_or(c))
+                            .unwrap_or_default(),
+                        lambda,
+                        cg_rule: cg_rule.into(),
+                        seed,
+                        set: set.clone(),
+                        variant: variant.clone(),
+                        force_dt,
+                        keep_going,
+                    },
+                    None,
+                ),
+            };
+            let RunInvocation {
+                case,
+                lambda,
+                seed,
+                set,
+                variant,
+                force_dt,
+                keep_going,
+                ..
+            } = invocation.clone();
+            let cg_rule = invocation.cg_rule;
+            let out = resume.clone().or(out);
             // Under mpirun (a build with the `mpi` feature) each rank steps its subdomains;
             // rank 0 writes the outputs, the others write theirs into a scratch directory.
             let comm = match cgdem_core::decomposition::Comm::from_environment() {
@@ -789,7 +883,7 @@ fn main() -> ExitCode {
                         for w in &warnings {
                             eprintln!("warning: coarse-graining: {w}");
                         }
-                        coarse_grain_by(&scene, lambda, cg_rule.into()).map_err(|e| e.to_string())
+                        coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())
                     })
                     .and_then(|scene| {
                         let out_dir = out.unwrap_or_else(|| default_out_dir(&scene));
@@ -831,6 +925,11 @@ fn main() -> ExitCode {
                             keep_going,
                             stop: interrupt.as_ref().map(|i| i.flag()),
                             grid,
+                            checkpoint: checkpoint_every.map(|every| CheckpointOptions {
+                                every,
+                                invocation: serde_json::to_string(&invocation).expect("plain data"),
+                            }),
+                            resume: resumed.clone(),
                             comm: comm.clone(),
                             ..Default::default()
                         };

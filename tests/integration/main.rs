@@ -13,5 +13,6 @@ mod interrupt;
 mod physics;
 mod reference_screw;
 mod reference_stages;
+mod restart;
 mod scenes;
 mod stability;

@@ -141,8 +141,10 @@ pub(crate) fn undamped_limit(stiffness: Real, mass: Real) -> Real {
 }
 
 /// Guard state the world carries between steps.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(crate) struct GuardState {
+    /// From the scene and options, not from a restart file.
+    #[serde(skip)]
     pub settings: GuardSettings,
     /// Largest pair and wall/body overlap fractions of the last force evaluation.
     pub pair_overlap: Real,

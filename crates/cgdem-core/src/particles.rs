@@ -6,7 +6,7 @@
 use crate::math::{Real, Vec3};
 
 /// Spin, torque and inverse moment of inertia, present only for laws with rotation.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct AngularState {
     pub omega: Vec<Vec3>,
     pub torque: Vec<Vec3>,
@@ -15,7 +15,7 @@ pub struct AngularState {
 
 /// All particles of a scene. Index order follows space (re-sorted by cell now and then);
 /// `id` is the stable identity used in outputs.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Particles {
     pub id: Vec<u32>,
     pub species: Vec<u16>,

@@ -43,6 +43,69 @@ pub struct MemoryUse {
     pub history_entries: usize,
 }
 
+/// Everything a world carries from one step to the next that its scene does not give: the
+/// particles (with the forces and torques the next step's first half-kick uses), the pair
+/// list as built (its pair order is the force summation order, and its reference positions
+/// decide the next rebuild), the contact and wall histories, the bodies' poses, the
+/// counters and the guards' state. A world built from the same scene and given this state
+/// steps on bit for bit as the world it was taken from (`run::restart`).
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
+pub struct WorldState<H: PairHistory, WH: PairHistory> {
+    particles: Particles,
+    time: Real,
+    steps: u64,
+    lost: u64,
+    deleted: u64,
+    deleted_mass: Real,
+    wall_active: Vec<bool>,
+    bodies: Vec<crate::bodies::BodyState>,
+    body_loads: Vec<BodyLoad>,
+    list: VerletList,
+    history: Vec<H>,
+    wall_history: Vec<WH>,
+    reaction_force: Vec<Vec3>,
+    reaction_spin: Vec<[Vec3; 2]>,
+    old_force: Vec<Vec3>,
+    old_torque: Vec<Vec3>,
+    guard: GuardState,
+    /// The arrays' capacities, given back on restore so that `MemoryUse` (in summary.json)
+    /// and later growth are those of the run the state was taken from.
+    capacities: Vec<usize>,
+}
+
+/// Applies `$m!` to each array of a world whose capacity `MemoryUse` counts, in a fixed
+/// order (the particles' spin arrays last, when there are any).
+macro_rules! world_arrays {
+    ($w:expr, $m:ident, $angular:ident) => {{
+        $m!($w.particles.id);
+        $m!($w.particles.species);
+        $m!($w.particles.position);
+        $m!($w.particles.velocity);
+        $m!($w.particles.force);
+        $m!($w.particles.radius);
+        $m!($w.particles.mass);
+        $m!($w.particles.inv_mass);
+        $m!($w.body_loads);
+        $m!($w.history);
+        $m!($w.wall_history);
+        $m!($w.reaction_force);
+        $m!($w.reaction_spin);
+        $m!($w.old_force);
+        $m!($w.old_torque);
+        $m!($w.list.pairs);
+        $m!($w.list.out_start);
+        $m!($w.list.in_start);
+        $m!($w.list.in_pairs);
+        $m!($w.list.reference);
+        if let Some(a) = $w.particles.angular.$angular() {
+            $m!(a.omega);
+            $m!(a.torque);
+            $m!(a.inv_inertia);
+        }
+    }};
+}
+
 /// Neighbour-list settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NeighborSettings {
@@ -156,6 +219,98 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         world.guard.initial_overlap = Some(world.max_overlap_fraction());
         world.reset_energy_reference();
         world
+    }
+
+    /// The world's changing state, for a restart file; None when decomposed (`--grid`), whose
+    /// state lives in the subdomains.
+    pub fn state(&self) -> Option<WorldState<L::History, W::History>> {
+        if self.decomposition.is_some() {
+            return None;
+        }
+        let mut state = WorldState {
+            particles: self.particles.clone(),
+            time: self.time,
+            steps: self.steps,
+            lost: self.lost,
+            deleted: self.deleted,
+            deleted_mass: self.deleted_mass,
+            wall_active: self.walls.walls.iter().map(|w| w.active).collect(),
+            bodies: self.bodies.iter().map(Body::state).collect(),
+            body_loads: self.body_loads.clone(),
+            list: self.list.clone(),
+            history: self.history.clone(),
+            wall_history: self.wall_history.clone(),
+            reaction_force: self.reaction_force.clone(),
+            reaction_spin: self.reaction_spin.clone(),
+            old_force: self.old_force.clone(),
+            old_torque: self.old_torque.clone(),
+            guard: self.guard.clone(),
+            capacities: Vec::new(),
+        };
+        // The clones have their lengths as capacities; keep this world's.
+        let mut capacities = Vec::new();
+        macro_rules! record {
+            ($v:expr) => {
+                capacities.push($v.capacity())
+            };
+        }
+        world_arrays!(self, record, as_ref);
+        state.capacities = capacities;
+        Some(state)
+    }
+
+    /// Puts back a state taken by [`World::state`] from a world built from the same scene
+    /// (the guard settings stay this world's); an error when the walls or bodies differ.
+    pub fn set_state(&mut self, state: WorldState<L::History, W::History>) -> Result<(), String> {
+        if state.wall_active.len() != self.walls.walls.len()
+            || state.bodies.len() != self.bodies.len()
+        {
+            return Err(format!(
+                "the stored state has {} walls and {} bodies, the scene {} and {}",
+                state.wall_active.len(),
+                state.bodies.len(),
+                self.walls.walls.len(),
+                self.bodies.len()
+            ));
+        }
+        if self.decomposition.is_some() {
+            return Err("a decomposed world (--grid) cannot take a stored state".into());
+        }
+        for (wall, &active) in self.walls.walls.iter_mut().zip(&state.wall_active) {
+            wall.active = active;
+        }
+        for (body, s) in self.bodies.iter_mut().zip(&state.bodies) {
+            body.set_state(s);
+        }
+        let settings = std::mem::take(&mut self.guard.settings);
+        self.particles = state.particles;
+        self.time = state.time;
+        self.steps = state.steps;
+        self.lost = state.lost;
+        self.deleted = state.deleted;
+        self.deleted_mass = state.deleted_mass;
+        self.body_loads = state.body_loads;
+        self.list = state.list;
+        self.history = state.history;
+        self.wall_history = state.wall_history;
+        self.reaction_force = state.reaction_force;
+        self.reaction_spin = state.reaction_spin;
+        self.old_force = state.old_force;
+        self.old_torque = state.old_torque;
+        self.guard = state.guard;
+        self.guard.settings = settings;
+        let mut capacities = state.capacities.into_iter();
+        macro_rules! reserve {
+            ($v:expr) => {
+                if let Some(c) = capacities.next() {
+                    if c > $v.capacity() {
+                        $v.reserve_exact(c - $v.len());
+                    }
+                }
+            };
+        }
+        world_arrays!(self, reserve, as_mut);
+        Ok(())
     }
 
     /// Replaces the bodies (posed at the current time) and re-evaluates the forces.

@@ -102,7 +102,7 @@ pub fn bulk_density(c: &ConveyingSettings, position: &[Vec3], mass: &[Real]) -> 
 }
 
 /// One time-series sample during the conveying stage.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Serialize, serde::Deserialize)]
 pub struct ConveyingSample {
     pub time: Real,
     /// See [`passed_mass`].

@@ -7,7 +7,7 @@ use crate::geometry::Aabb;
 use crate::math::{Real, Vec3};
 
 /// Force on a body and torque about its axis point, from one particle or summed.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BodyLoad {
     pub force: Vec3,
     pub torque: Vec3,
@@ -18,6 +18,16 @@ impl std::ops::AddAssign for BodyLoad {
         self.force += other.force;
         self.torque += other.torque;
     }
+}
+
+/// The changing part of a body (see [`Body::state`]).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct BodyState {
+    pub started_at: Option<Real>,
+    pub rotation: DMat3,
+    pub center: Vec3,
+    pub world_bounds: (Vec3, Vec3),
+    pub load: BodyLoad,
 }
 
 /// A rigid body. The pose is a function of time (no accumulated rotation error): at time
@@ -88,6 +98,30 @@ impl Body {
             bounds = bounds.grown(self.to_world(corner));
         }
         self.world_bounds = bounds;
+    }
+
+    /// What changes as the body moves, for a restart file (the shape and motion come from
+    /// the scene).
+    pub fn state(&self) -> BodyState {
+        BodyState {
+            started_at: self.started_at,
+            rotation: self.rotation,
+            center: self.center,
+            world_bounds: (self.world_bounds.min, self.world_bounds.max),
+            load: self.load,
+        }
+    }
+
+    /// Puts the body back where [`Body::state`] found it, bit for bit.
+    pub fn set_state(&mut self, state: &BodyState) {
+        self.started_at = state.started_at;
+        self.rotation = state.rotation;
+        self.center = state.center;
+        self.world_bounds = Aabb {
+            min: state.world_bounds.0,
+            max: state.world_bounds.1,
+        };
+        self.load = state.load;
     }
 
     /// Whether the motion is running.

@@ -4,7 +4,9 @@ use crate::math::{Real, Vec3};
 
 /// Per-pair contact history (e.g. a tangential spring). Stored once per pair, kept across
 /// list rebuilds, mirrored when a re-sort swaps which particle of the pair comes first.
-pub trait PairHistory: Copy + Default + Send + Sync + PartialEq {
+pub trait PairHistory:
+    Copy + Default + Send + Sync + PartialEq + serde::Serialize + serde::de::DeserializeOwned
+{
     /// The same history seen from the other particle.
     fn mirrored(self) -> Self;
     /// `f64` words of one history, for the MPI transport of the decomposed step.

@@ -11,7 +11,9 @@ use crate::particles::Particles;
 
 /// One pair within cut-off plus skin: particle `i < j`, with `j` seen through periodic
 /// image `image` (see [`Domain::image_shift`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub struct Pair {
     pub i: u32,
     pub j: u32,
@@ -26,7 +28,7 @@ pub struct DisplacementCheck<'a> {
     pub limit_sq: Real,
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct VerletList {
     pub pairs: Vec<Pair>,
     /// Pairs whose first particle is `i`: `pairs[out_start[i]..out_start[i + 1]]`.
@@ -35,7 +37,7 @@ pub struct VerletList {
     pub in_start: Vec<u32>,
     pub in_pairs: Vec<u32>,
     /// Positions at the last build, for the displacement criterion.
-    reference: Vec<Vec3>,
+    pub(crate) reference: Vec<Vec3>,
     pub skin: Real,
     pub builds: u64,
 }
@@ -474,7 +476,7 @@ mod tests {
         assert!(list.needs_rebuild(&particles.position));
     }
 
-    #[derive(Clone, Copy, Debug, Default, PartialEq)]
+    #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
     struct Spring(Vec3);
     impl PairHistory for Spring {
         fn mirrored(self) -> Self {

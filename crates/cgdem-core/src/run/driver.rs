@@ -2,7 +2,7 @@
 //! removals, body starts, top-ups, guards, progress) and calls the output observers when
 //! they are due; the summary is assembled from what they measured.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::bodies::KinematicParticles;
@@ -22,10 +22,11 @@ use super::observers::{
     VtkFrames, Warnings,
 };
 use super::refill::RefillRegion;
+use super::restart::{self, decode, encode, DriverState, Position, Restart};
 use super::setup::{build_bodies, initial_particles_with_bodies, scene_walls};
 use super::{
-    describe_repose_rule, output_error, progress, time_step_for, Progress, RunError, RunOptions,
-    RunProgress, RunSummary, StageEnding, StageRecord,
+    describe_repose_rule, output_error, progress, time_step_for, CheckpointOptions, Progress,
+    RunError, RunOptions, RunProgress, RunSummary, StageEnding, StageRecord,
 };
 
 /// Runs a scene with its concrete laws and writes its outputs into `options.out_dir`.
@@ -36,15 +37,41 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     options: &RunOptions,
 ) -> Result<RunSummary, RunError> {
     let out = &options.out_dir;
+    let resume = options.resume.as_deref();
+    let laws = format!(
+        "{} {}",
+        std::any::type_name::<L>(),
+        std::any::type_name::<W>()
+    );
+    if options.grid.is_some() && (options.checkpoint.is_some() || resume.is_some()) {
+        return Err(RunError::NotAvailable(format!(
+            "{}: restart files (--checkpoint-every, --resume) are not supported with --grid yet: the subdomains' state is not gathered into them; run without --grid",
+            scene.source.display()
+        )));
+    }
+    if let Some(r) = resume {
+        check_resumable(scene, &r.restart, &r.path, &laws)?;
+    }
     std::fs::create_dir_all(out).map_err(|e| output_error(out, e))?;
     let (dt, scales, warning) = time_step_for(scene, &law, &wall_law, options.force_dt)?;
     let mut warnings = Warnings(Vec::new(), !options.comm.is_root());
     if let Some(w) = warning {
         warnings.push(w);
     }
-    let (mut world, n_inserted, n_body_particles) =
+    let (mut world, mut n_inserted, mut n_body_particles) =
         build_world(scene, law, wall_law, dt, &scales, options)?;
-    let mut observers = observers(scene, out)?;
+    let mut observers = observers(scene, out, resume.is_some())?;
+    let checkpoint = match (&options.checkpoint, resume) {
+        (Some(c), _) => Some(c.clone()),
+        (None, Some(r)) => Some(CheckpointOptions {
+            every: r.restart.checkpoint_every,
+            invocation: r.restart.invocation.clone(),
+        }),
+        (None, None) => None,
+    };
+    if checkpoint.is_some() && resume.is_none() {
+        restart::remove(out).map_err(|e| output_error(&out.join(restart::RESTART_FILE), e))?;
+    }
     let mut driver = Driver {
         scene,
         dt,
@@ -66,9 +93,72 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         guard_counts: Vec::new(),
         stop: options.stop.clone(),
         interrupted: false,
+        checkpoint: checkpoint.map(|c| Checkpointer {
+            next: c.every,
+            options: c,
+            digest: scene.digest(),
+            laws,
+            out: out.clone(),
+            n_inserted,
+            n_body_particles,
+        }),
     };
+    let mut start = Position {
+        stage: 0,
+        within: None,
+    };
+    let mut pending_observers = None;
+    let mut saved_refills = Vec::new();
+    match resume {
+        Some(loaded) => {
+            let r = &loaded.restart;
+            let bad = |e: String| RunError::Restart(format!("{}: {e}", loaded.path.display()));
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
+            world
+                .set_state(decode(&r.world).map_err(bad)?)
+                .map_err(bad)?;
+            let d = &r.driver;
+            driver.refilled = d.refilled;
+            driver.particle_steps = d.particle_steps;
+            driver.stages = d.stages.clone();
+            driver.guard_counts = d.guard_counts.clone();
+            saved_refills = d.refills.clone();
+            // Already printed by the run that met them.
+            warnings.0 = d.warnings.clone();
+            (n_inserted, n_body_particles) = (d.n_inserted, d.n_body_particles);
+            if let Some(c) = &mut driver.checkpoint {
+                c.next = d.next_checkpoint;
+                (c.n_inserted, c.n_body_particles) = (n_inserted, n_body_particles);
+            }
+            if r.observers.len() != observers.len() {
+                return Err(bad(format!(
+                    "{} observer states stored, the scene has {} observers",
+                    r.observers.len(),
+                    observers.len()
+                )));
+            }
+            start = r.position;
+            if start.within.is_none() {
+                restore_observers(&mut observers, &r.observers).map_err(bad)?;
+            } else {
+                pending_observers = Some((r.observers.as_slice(), loaded.path.as_path()));
+            }
+        }
+        None => driver.save_checkpoint(&world, &mut observers, &warnings, start, &[])?,
+    }
     let started = Instant::now();
-    let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings)?;
+    let stopped_by = driver.run_stages(
+        &mut world,
+        &mut observers,
+        &mut warnings,
+        Resume {
+            at: start,
+            observers: pending_observers,
+            refills: saved_refills,
+        },
+    )?;
     driver.progress.finish();
     // Under MPI every rank gathers the final state (rank 0 writes it).
     world.sync_particles();
@@ -218,6 +308,7 @@ fn build_world<L: PairLaw, W: WallLaw>(
 fn observers<'s, L: PairLaw, W: WallLaw>(
     scene: &'s Scene,
     out: &Path,
+    resuming: bool,
 ) -> Result<Vec<Scheduled<'s, L, W>>, RunError> {
     let conveying = scene.conveying.as_ref().and_then(|c| {
         scene
@@ -234,6 +325,7 @@ fn observers<'s, L: PairLaw, W: WallLaw>(
         scene,
         out.join("timeseries.csv"),
         conveying,
+        resuming,
     )?));
     if scene.output.vtk_interval > 0.0 {
         list.push(Box::new(VtkFrames::new(
@@ -288,6 +380,63 @@ struct Driver<'s> {
     /// `RunOptions::stop`, polled at the end of every step.
     stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     interrupted: bool,
+    checkpoint: Option<Checkpointer>,
+}
+
+/// Writes the restart files (`--checkpoint-every`).
+struct Checkpointer {
+    options: CheckpointOptions,
+    /// The simulated time of the next periodic restart file.
+    next: Real,
+    digest: String,
+    laws: String,
+    out: PathBuf,
+    n_inserted: usize,
+    n_body_particles: usize,
+}
+
+/// Where a resumed run starts: the position, and the observers' and top-ups' states to
+/// put back once the stage has begun again (when resuming within a stage).
+struct Resume<'r> {
+    at: Position,
+    observers: Option<(&'r [Vec<u8>], &'r Path)>,
+    refills: Vec<(usize, usize, u64)>,
+}
+
+fn restore_observers<L: PairLaw, W: WallLaw>(
+    observers: &mut [Scheduled<'_, L, W>],
+    states: &[Vec<u8>],
+) -> Result<(), String> {
+    for (o, state) in observers.iter_mut().zip(states) {
+        o.restore(state)?;
+    }
+    Ok(())
+}
+
+/// Refuses a restart file written for another scene or law combination.
+fn check_resumable(
+    scene: &Scene,
+    restart: &Restart,
+    path: &Path,
+    laws: &str,
+) -> Result<(), RunError> {
+    let digest = scene.digest();
+    if restart.scene_digest != digest {
+        return Err(RunError::Restart(format!(
+            "{}: written for a scene with digest {}, but {} (with the stored options) now has digest {digest}: the case file or a file it reads changed since the run began",
+            path.display(),
+            restart.scene_digest,
+            scene.source.display()
+        )));
+    }
+    if restart.laws != laws {
+        return Err(RunError::Restart(format!(
+            "{}: written for the laws {}, this scene runs {laws}",
+            path.display(),
+            restart.laws
+        )));
+    }
+    Ok(())
 }
 
 /// A top-up of the current stage: (insertion, region, particles it held at the stage start,
@@ -295,47 +444,67 @@ struct Driver<'s> {
 type Refill<'r> = (usize, &'r RefillRegion, usize, u64);
 
 impl Driver<'_> {
-    /// Runs every stage; returns the guard trip that stopped the run, if one did.
+    /// Runs every stage from `resume.at` on; returns the guard trip that stopped the run, if
+    /// one did.
     fn run_stages<L: PairLaw, W: WallLaw>(
         &mut self,
         world: &mut World<L, W>,
         observers: &mut [Scheduled<'_, L, W>],
         warnings: &mut Warnings,
+        resume: Resume<'_>,
     ) -> Result<Option<GuardTrip>, RunError> {
-        for stage in &self.scene.stages {
+        let mut within = resume.at.within;
+        let mut saved_refills = Some(resume.refills);
+        for (index, stage) in self.scene.stages.iter().enumerate().skip(resume.at.stage) {
             world.sync_particles();
-            world.reset_energy_reference();
-            for name in &stage.remove_walls {
-                world.walls.remove(name);
-            }
-            for b in &self.scene.bodies {
-                if b.start_stage.as_deref() == Some(stage.name.as_str()) {
-                    world.start_body(&b.name);
+            // Resuming within this stage: its start (walls, bodies, energy reference) is in
+            // the restored state already.
+            let resumed = within.take();
+            if resumed.is_none() {
+                world.reset_energy_reference();
+                for name in &stage.remove_walls {
+                    world.walls.remove(name);
+                }
+                for b in &self.scene.bodies {
+                    if b.start_stage.as_deref() == Some(stage.name.as_str()) {
+                        world.start_body(&b.name);
+                    }
                 }
             }
             self.progress.stage(&stage.name);
             let clock = StageClock {
                 stage,
-                start: world.time,
+                start: resumed.map_or(world.time, |(_, start)| start),
                 dt: self.dt,
             };
             for o in observers.iter_mut() {
                 o.stage_begins(world, &clock);
             }
-            let start_steps = world.steps;
-            let ending = match self.run_stage(world, observers, &clock, warnings)? {
-                Ok(ending) => ending,
-                Err(trip) => {
-                    self.record(
-                        stage,
-                        &clock,
-                        world,
-                        start_steps,
-                        StageEnding::Guard(trip.kind),
-                    );
-                    return Ok(Some(trip));
-                }
+            if let (Some(_), Some((states, path))) = (resumed, resume.observers) {
+                restore_observers(observers, states)
+                    .map_err(|e| RunError::Restart(format!("{}: {e}", path.display())))?;
+            }
+            let done = resumed.map_or(0, |(steps, _)| steps);
+            let start_steps = world.steps - done;
+            let refills = if resumed.is_some() {
+                saved_refills.take()
+            } else {
+                None
             };
+            let ending =
+                match self.run_stage(world, observers, &clock, warnings, index, done, refills)? {
+                    Ok(ending) => ending,
+                    Err(trip) => {
+                        self.record(
+                            stage,
+                            &clock,
+                            world,
+                            start_steps,
+                            StageEnding::Guard(trip.kind),
+                        );
+                        return Ok(Some(trip));
+                    }
+                };
             if matches!(ending, StageEnding::Interrupted) {
                 // Not a stage end: the stage-end samples are not taken.
                 self.record(stage, &clock, world, start_steps, ending);
@@ -354,18 +523,28 @@ impl Driver<'_> {
                 o.observer().stage_ends(world, &clock, warnings)?;
             }
             self.record(stage, &clock, world, start_steps, ending);
+            let next = Position {
+                stage: index + 1,
+                within: None,
+            };
+            self.save_checkpoint(world, observers, warnings, next, &[])?;
         }
         Ok(None)
     }
 
-    /// Steps one stage until its end; `Err(trip)` when a guard stops the run.
-    #[allow(clippy::type_complexity)]
+    /// Steps one stage (stage `index`, `done` steps of it already taken) until its end;
+    /// `Err(trip)` when a guard stops the run. `saved_refills`: the top-ups' counters of a
+    /// resumed stage.
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
     fn run_stage<L: PairLaw, W: WallLaw>(
         &mut self,
         world: &mut World<L, W>,
         observers: &mut [Scheduled<'_, L, W>],
         clock: &StageClock,
         warnings: &mut Warnings,
+        index: usize,
+        done: u64,
+        saved_refills: Option<Vec<(usize, usize, u64)>>,
     ) -> Result<Result<StageEnding, GuardTrip>, RunError> {
         let duration = match clock.stage.end {
             StageEnd::Duration(d) => d,
@@ -380,11 +559,19 @@ impl Driver<'_> {
                     .as_ref()
                     .is_some_and(|r| r.stage == clock.stage.name)
             })
-            .map(|(k, region)| (*k, region, region.count(&world.particles), 0))
+            .map(|(k, region)| {
+                let saved = saved_refills
+                    .as_ref()
+                    .and_then(|s| s.iter().find(|(i, _, _)| i == k));
+                match saved {
+                    Some(&(_, target, count)) => (*k, region, target, count),
+                    None => (*k, region, region.count(&world.particles), 0),
+                }
+            })
             .collect();
         let stage_steps = (duration / self.dt).round() as u64;
         let mut ending = Ok(StageEnding::Duration(duration));
-        'steps: for k in 1..=stage_steps {
+        'steps: for k in done + 1..=stage_steps {
             world.step();
             self.particle_steps += world.particle_count() as u64;
             if let Some(trip) = world.take_guard_trip() {
@@ -421,6 +608,23 @@ impl Driver<'_> {
             } else {
                 stop
             };
+            let due = self
+                .checkpoint
+                .as_ref()
+                .is_some_and(|c| world.time + 0.5 * self.dt >= c.next);
+            if stop || due {
+                if let Some(c) = &mut self.checkpoint {
+                    while world.time + 0.5 * self.dt >= c.next {
+                        c.next += c.options.every;
+                    }
+                }
+                let counters: Vec<_> = refills.iter().map(|&(i, _, t, n)| (i, t, n)).collect();
+                let here = Position {
+                    stage: index,
+                    within: Some((k, clock.start)),
+                };
+                self.save_checkpoint(world, observers, warnings, here, &counters)?;
+            }
             if stop {
                 self.interrupted = true;
                 ending = Ok(StageEnding::Interrupted);
@@ -430,6 +634,52 @@ impl Driver<'_> {
         drop(refills);
         self.refill_regions = refill_regions;
         Ok(ending)
+    }
+
+    /// Writes a restart file for `position` (nothing without `--checkpoint-every`).
+    fn save_checkpoint<L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &World<L, W>,
+        observers: &mut [Scheduled<'_, L, W>],
+        warnings: &Warnings,
+        position: Position,
+        refills: &[(usize, usize, u64)],
+    ) -> Result<(), RunError> {
+        let Some(c) = &self.checkpoint else {
+            return Ok(());
+        };
+        let path = c.out.join(restart::RESTART_FILE);
+        let Some(state) = world.state() else {
+            return Err(RunError::NotAvailable(
+                "restart files are not supported with --grid".into(),
+            ));
+        };
+        let observers = observers
+            .iter_mut()
+            .map(|o| o.observer().save())
+            .collect::<Result<Vec<_>, _>>()?;
+        let file = Restart {
+            invocation: c.options.invocation.clone(),
+            scene_digest: c.digest.clone(),
+            laws: c.laws.clone(),
+            checkpoint_every: c.options.every,
+            position,
+            world: encode(&state),
+            driver: DriverState {
+                refilled: self.refilled,
+                particle_steps: self.particle_steps,
+                stages: self.stages.clone(),
+                guard_counts: self.guard_counts.clone(),
+                refills: refills.to_vec(),
+                next_checkpoint: c.next,
+                warnings: warnings.0.clone(),
+                n_inserted: c.n_inserted,
+                n_body_particles: c.n_body_particles,
+            },
+            observers,
+        };
+        restart::write(&c.out, &file).map_err(|e| output_error(&path, e))?;
+        Ok(())
     }
 
     /// Under --keep-going: warn once per guard and count the rest; a new energy reference,

@@ -11,6 +11,7 @@ pub mod memory;
 mod observers;
 mod progress;
 mod refill;
+pub mod restart;
 mod setup;
 
 pub use hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
@@ -58,6 +59,21 @@ pub struct RunOptions {
     pub grid: Option<crate::decomposition::GridSpec>,
     /// The MPI ranks a `--grid` run is spread over (`mpirun`); one process by default.
     pub comm: crate::decomposition::Comm,
+    /// Write restart files (`--checkpoint-every`), see [`restart`].
+    pub checkpoint: Option<CheckpointOptions>,
+    /// Continue the run this restart file was written by, in `out_dir` (`--resume`); the
+    /// scene must be the one it ran (same digest). It keeps checkpointing as it did.
+    pub resume: Option<std::sync::Arc<restart::RestartLoaded>>,
+}
+
+/// When to write restart files and what to store for the caller.
+#[derive(Clone, Debug)]
+pub struct CheckpointOptions {
+    /// Simulated seconds between restart files (also one at the start, at every stage end
+    /// and when the stop flag ends the run).
+    pub every: Real,
+    /// Stored as is: what the caller needs to rebuild the scene on resume.
+    pub invocation: String,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -108,6 +124,8 @@ pub enum RunError {
         estimate: String,
         available: String,
     },
+    #[error("{0}")]
+    Restart(String),
     #[error("{file}: run interrupted at t = {time_s:.6e} s (step {step}); the outputs written so far are kept in {}", out_dir.display())]
     Interrupted {
         file: String,

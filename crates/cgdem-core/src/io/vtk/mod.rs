@@ -44,6 +44,15 @@ pub struct FrameBytes {
 }
 
 /// The series a run writes into one directory.
+/// What a VTK output has written: the frame count and each series' frames.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct VtkState {
+    pub frames: usize,
+    pub particles: Vec<(f64, String)>,
+    pub bodies: Option<Vec<(f64, String)>>,
+    pub contacts: Option<Vec<(f64, String)>>,
+}
+
 pub struct VtkOutput {
     dir: PathBuf,
     frames: usize,
@@ -103,6 +112,41 @@ impl VtkOutput {
             });
         }
         Ok(out)
+    }
+
+    /// The series' frames so far, for a restart file.
+    pub fn state(&self) -> VtkState {
+        VtkState {
+            frames: self.frames,
+            particles: self.particles.frames().to_vec(),
+            bodies: self.bodies.as_ref().map(|(s, _)| s.frames().to_vec()),
+            contacts: self.contacts.as_ref().map(|s| s.frames().to_vec()),
+        }
+    }
+
+    /// Takes the frames of a [`VtkOutput::state`] and rewrites the `.pvd` indexes to them
+    /// (frames a killed run wrote after its checkpoint are written again).
+    pub fn restore(&mut self, state: VtkState) -> Result<(), String> {
+        if state.bodies.is_some() != self.bodies.is_some()
+            || state.contacts.is_some() != self.contacts.is_some()
+        {
+            return Err("the stored VTK series differ from the scene's".into());
+        }
+        self.frames = state.frames;
+        let mut series: Vec<(&mut PvdSeries, Vec<(f64, String)>)> =
+            vec![(&mut self.particles, state.particles)];
+        if let (Some((s, _)), Some(f)) = (self.bodies.as_mut(), state.bodies) {
+            series.push((s, f));
+        }
+        if let (Some(s), Some(f)) = (self.contacts.as_mut(), state.contacts) {
+            series.push((s, f));
+        }
+        for (s, frames) in series {
+            let path = s.path().to_path_buf();
+            s.set_frames(frames)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        Ok(())
     }
 
     /// Frames written so far.

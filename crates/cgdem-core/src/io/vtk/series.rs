@@ -20,6 +20,21 @@ impl PvdSeries {
         &self.path
     }
 
+    /// The frames so far: (time, file).
+    pub fn frames(&self) -> &[(f64, String)] {
+        &self.frames
+    }
+
+    /// Replaces the frames (a resumed run's, as at its checkpoint) and rewrites the index
+    /// when there is one to write.
+    pub fn set_frames(&mut self, frames: Vec<(f64, String)>) -> std::io::Result<()> {
+        self.frames = frames;
+        match self.frames.pop() {
+            Some((time, file)) => self.push(time, file),
+            None => Ok(()),
+        }
+    }
+
     /// Adds a frame and rewrites the index (through a rename), so the series stays readable
     /// if the run stops early.
     pub fn push(&mut self, time: f64, file: String) -> std::io::Result<()> {

@@ -10,6 +10,7 @@ use crate::scene::{ConveyingSettings, Scene};
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
+use super::super::restart::{decode, encode};
 use super::super::{RunError, RunSummary};
 use super::{Due, Flow, Observer, StageClock, Warnings};
 
@@ -112,6 +113,29 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ConveyingMeter<'_> {
         if self.measuring {
             self.window = Some((clock.start + self.settings.discard, world.time));
         }
+        Ok(())
+    }
+
+    fn save(&mut self) -> Result<Vec<u8>, RunError> {
+        Ok(encode(&(
+            self.next_row,
+            &self.samples,
+            self.torque_sum,
+            self.power_sum,
+            self.torque_steps,
+            self.window,
+        )))
+    }
+
+    fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+        (
+            self.next_row,
+            self.samples,
+            self.torque_sum,
+            self.power_sum,
+            self.torque_steps,
+            self.window,
+        ) = decode(state)?;
         Ok(())
     }
 

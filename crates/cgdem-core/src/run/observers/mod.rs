@@ -93,6 +93,16 @@ pub(crate) trait Observer<L: PairLaw, W: WallLaw> {
     ) -> Result<(), RunError> {
         Ok(())
     }
+    /// The observer's changing state for a restart file (what it has written made durable
+    /// first); the scene and the stage give the rest.
+    fn save(&mut self) -> Result<Vec<u8>, RunError> {
+        Ok(Vec::new())
+    }
+    /// Puts back a state from [`Observer::save`] (after `stage_begins` when resuming within
+    /// a stage), cutting what it writes back to that moment.
+    fn restore(&mut self, _state: &[u8]) -> Result<(), String> {
+        Ok(())
+    }
     /// The run ended (`stopped`: by a guard); the observer writes its last outputs and puts
     /// its results into the summary.
     fn finish(
@@ -142,6 +152,12 @@ impl<'s, L: PairLaw, W: WallLaw> Scheduled<'s, L, W> {
         let flow = self.observer.observe(world, clock)?;
         self.due = self.observer.due();
         Ok(flow)
+    }
+
+    pub(crate) fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+        self.observer.restore(state)?;
+        self.due = self.observer.due();
+        Ok(())
     }
 
     pub(crate) fn observer(&mut self) -> &mut (dyn Observer<L, W> + 's) {

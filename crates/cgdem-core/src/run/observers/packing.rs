@@ -10,6 +10,7 @@ use crate::scene::{PackingSettings, Scene};
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
+use super::super::restart::{decode, encode};
 use super::super::{output_error, RunError, RunSummary};
 use super::{Due, Flow, Observer, StageClock, Warnings};
 
@@ -75,6 +76,15 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for PackingMeter<'_> {
                 clock.stage.name
             )),
         }
+        Ok(())
+    }
+
+    fn save(&mut self) -> Result<Vec<u8>, RunError> {
+        Ok(encode(&self.result))
+    }
+
+    fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+        self.result = decode(state)?;
         Ok(())
     }
 

@@ -13,6 +13,7 @@ use crate::scene::{ReposeSettings, Scene};
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
+use super::super::restart::{decode, encode};
 use super::super::{
     headline_sample, output_error, profile_csv, repose_csv, ReposeSample, RunError, RunSummary,
     SampleTrigger,
@@ -121,6 +122,15 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ReposeMeter<'_> {
                 SampleTrigger::StageEnd,
             )?;
         }
+        Ok(())
+    }
+
+    fn save(&mut self) -> Result<Vec<u8>, RunError> {
+        Ok(encode(&(self.next, &self.samples, self.measured)))
+    }
+
+    fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+        (self.next, self.samples, self.measured) = decode(state)?;
         Ok(())
     }
 

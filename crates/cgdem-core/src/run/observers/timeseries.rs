@@ -3,6 +3,7 @@
 //! settling stage, whose condition is judged at these rows.
 
 use std::fs::File;
+use std::io::{Seek, SeekFrom};
 use std::path::PathBuf;
 
 use crate::contact::PairLaw;
@@ -11,6 +12,7 @@ use crate::scene::{ConveyingSettings, Scene, StageEnd};
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
+use super::super::restart::{decode, encode};
 use super::super::{output_error, RunError, StageEnding, TIMESERIES_COLUMNS};
 use super::conveying::conveying_sample;
 use super::repose::heap_profile;
@@ -32,7 +34,23 @@ impl<'s> TimeSeries<'s> {
         scene: &'s Scene,
         path: PathBuf,
         conveying: Option<(&'s ConveyingSettings, usize)>,
+        resuming: bool,
     ) -> Result<Self, RunError> {
+        if resuming {
+            // The file of the run being resumed: `restore` cuts it back to the checkpoint.
+            let file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&path)
+                .map_err(|e| output_error(&path, e))?;
+            return Ok(TimeSeries {
+                scene,
+                path,
+                file: csv::Writer::from_writer(file),
+                next_row: 0.0,
+                conveying,
+                settle: None,
+            });
+        }
         let file = File::create(&path).map_err(|e| output_error(&path, e))?;
         let mut series = TimeSeries {
             scene,
@@ -122,5 +140,39 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
             }
         }
         Ok(Flow::Continue)
+    }
+
+    /// The next row's time and the file's length so far (every row is flushed as written).
+    fn save(&mut self) -> Result<Vec<u8>, RunError> {
+        let len = self
+            .file
+            .flush()
+            .and_then(|()| self.file.get_ref().sync_data())
+            .and_then(|()| self.file.get_ref().metadata())
+            .map_err(|e| output_error(&self.path, e))?
+            .len();
+        Ok(encode(&(self.next_row, len)))
+    }
+
+    /// Cuts the file back to its length at the checkpoint: rows a killed run wrote after it
+    /// are written again.
+    fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+        let len: u64;
+        (self.next_row, len) = decode(state)?;
+        // `&File` seeks and truncates; the writer's buffer is empty (flushed every row).
+        let mut file: &File = self.file.get_ref();
+        let actual = file
+            .metadata()
+            .map_err(|e| format!("{}: {e}", self.path.display()))?
+            .len();
+        if actual < len {
+            return Err(format!(
+                "{}: {actual} bytes, shorter than the {len} bytes at the checkpoint",
+                self.path.display()
+            ));
+        }
+        file.set_len(len)
+            .and_then(|()| file.seek(SeekFrom::Start(len)).map(|_| ()))
+            .map_err(|e| format!("{}: {e}", self.path.display()))
     }
 }

@@ -10,6 +10,7 @@ use crate::scene::Scene;
 use crate::simulation::World;
 use crate::walls::WallLaw;
 
+use super::super::restart::{decode, encode};
 use super::super::{output_error, RunError};
 use super::{Due, Flow, Observer, StageClock};
 
@@ -43,5 +44,15 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for VtkFrames {
             .write_frame(world)
             .map_err(|e| output_error(&self.dir, e))?;
         Ok(Flow::Continue)
+    }
+
+    fn save(&mut self) -> Result<Vec<u8>, RunError> {
+        Ok(encode(&(self.next_frame, self.series.state())))
+    }
+
+    fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+        let series;
+        (self.next_frame, series) = decode(state)?;
+        self.series.restore(series)
     }
 }

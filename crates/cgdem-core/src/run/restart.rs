@@ -1,0 +1,308 @@
+//! Restart files (`--checkpoint-every`, `--resume`): the whole state of a run, so that a run
+//! killed at any moment goes on from its last checkpoint and writes exactly the outputs the
+//! uninterrupted run writes.
+//!
+//! File layout: a 32-byte header (magic `CGDEMRST`, format version u32, payload length u64,
+//! CRC-32 of the payload u32, 8 reserved zero bytes; little endian), then the payload, a
+//! [`Restart`] in bincode. The writer writes `restart.cgr.tmp`, syncs it, renames the current
+//! `restart.cgr` to `restart.prev.cgr` and the new file to `restart.cgr`: at every moment one
+//! complete, checked file exists. The reader takes `restart.cgr` and falls back to
+//! `restart.prev.cgr` when the first is missing, torn or corrupt (named in a warning).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::guard::GuardKind;
+use crate::math::Real;
+
+use super::StageRecord;
+
+pub const RESTART_FILE: &str = "restart.cgr";
+pub const PREVIOUS_RESTART_FILE: &str = "restart.prev.cgr";
+const MAGIC: &[u8; 8] = b"CGDEMRST";
+/// Bumped whenever the payload's layout changes; an older file is refused by name.
+pub const FORMAT_VERSION: u32 = 1;
+const HEADER_LEN: usize = 32;
+
+/// Where in the stage list a checkpoint was taken.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Position {
+    /// The stage to continue with.
+    pub stage: usize,
+    /// Steps of that stage already taken, with the time it began; None: it has not begun
+    /// (the checkpoint was taken at the end of the stage before, or at the start).
+    pub within: Option<(u64, Real)>,
+}
+
+/// The driver's counters and the state of a stage's top-ups.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DriverState {
+    pub refilled: u64,
+    pub particle_steps: u64,
+    pub stages: Vec<StageRecord>,
+    pub guard_counts: Vec<(GuardKind, u64)>,
+    /// The current stage's top-ups: (insertion, particles at the stage start, top-ups so far).
+    pub refills: Vec<(usize, usize, u64)>,
+    pub next_checkpoint: Real,
+    pub warnings: Vec<String>,
+    pub n_inserted: usize,
+    pub n_body_particles: usize,
+}
+
+/// One restart file's content.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Restart {
+    /// What the caller needs to rebuild the scene (the command line of `cgdem run`), opaque
+    /// to the solver.
+    pub invocation: String,
+    /// `Scene::digest` of the scene the run simulates: a resume with another scene is refused.
+    pub scene_digest: String,
+    /// The scene's law combination (`L`, `W` type names), checked before decoding the world.
+    pub laws: String,
+    /// `--checkpoint-every`, kept by the resumed run.
+    pub checkpoint_every: Real,
+    pub position: Position,
+    /// `WorldState<L::History, W::History>` in bincode.
+    pub world: Vec<u8>,
+    pub driver: DriverState,
+    /// Each observer's state, in the driver's observer order.
+    pub observers: Vec<Vec<u8>>,
+}
+
+impl std::fmt::Debug for RestartLoaded {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "RestartLoaded({})", self.path.display())
+    }
+}
+
+/// A restart file read back, with the file it came from and warnings about newer files
+/// that could not be used.
+#[derive(Clone)]
+pub struct RestartLoaded {
+    pub restart: Restart,
+    pub path: PathBuf,
+    pub warnings: Vec<String>,
+}
+
+pub(crate) fn encode<T: Serialize>(value: &T) -> Vec<u8> {
+    bincode::serialize(value).expect("in-memory bincode of plain data cannot fail")
+}
+
+pub(crate) fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, String> {
+    bincode::deserialize(bytes).map_err(|e| e.to_string())
+}
+
+/// The file bytes of a restart: header and payload.
+pub fn to_bytes(restart: &Restart) -> Vec<u8> {
+    let payload = encode(restart);
+    let mut bytes = Vec::with_capacity(HEADER_LEN + payload.len());
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+    bytes.extend_from_slice(&[0; 8]);
+    bytes.extend_from_slice(&payload);
+    bytes
+}
+
+/// Checks the header and checksum and decodes the payload; the error says what is wrong.
+pub fn from_bytes(bytes: &[u8]) -> Result<Restart, String> {
+    if bytes.len() < HEADER_LEN {
+        return Err(format!(
+            "{} bytes, shorter than the {HEADER_LEN}-byte header (torn write)",
+            bytes.len()
+        ));
+    }
+    if &bytes[..8] != MAGIC {
+        return Err("not a cgdem restart file (no CGDEMRST magic)".into());
+    }
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+    let version = word(8);
+    if version != FORMAT_VERSION {
+        return Err(format!(
+            "format version {version}, this cgdem reads version {FORMAT_VERSION}"
+        ));
+    }
+    if bytes[24..HEADER_LEN] != [0; 8] {
+        return Err("reserved header bytes are not zero: the file is corrupt".into());
+    }
+    let len = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
+    let payload = &bytes[HEADER_LEN..];
+    if payload.len() as u64 != len {
+        return Err(format!(
+            "payload of {} bytes, the header says {len} (torn or truncated)",
+            payload.len()
+        ));
+    }
+    let stored = word(20);
+    let actual = crc32fast::hash(payload);
+    if stored != actual {
+        return Err(format!(
+            "checksum mismatch (CRC-32 {actual:08x}, the header says {stored:08x}): the file is corrupt"
+        ));
+    }
+    decode(payload).map_err(|e| format!("payload does not decode: {e}"))
+}
+
+/// Writes `restart` into `dir` atomically, keeping the previous file as
+/// `restart.prev.cgr` until the new one is complete and synced.
+pub fn write(dir: &Path, restart: &Restart) -> std::io::Result<PathBuf> {
+    let path = dir.join(RESTART_FILE);
+    let tmp = dir.join(format!("{RESTART_FILE}.tmp"));
+    let written = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(&to_bytes(restart))?;
+        file.sync_all()
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    if path.exists() {
+        std::fs::rename(&path, dir.join(PREVIOUS_RESTART_FILE))?;
+    }
+    std::fs::rename(&tmp, &path)?;
+    // The renames themselves reach the disk with the directory.
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(path)
+}
+
+/// Removes the restart files of an earlier run in `dir` (a fresh run starts its own).
+pub fn remove(dir: &Path) -> std::io::Result<()> {
+    for name in [RESTART_FILE, PREVIOUS_RESTART_FILE] {
+        match std::fs::remove_file(dir.join(name)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Reads the newest usable restart file of `dir`: `restart.cgr`, else `restart.prev.cgr`
+/// (with a warning naming the file refused and why); an error naming both when neither is
+/// usable.
+pub fn read_latest(dir: &Path) -> Result<RestartLoaded, String> {
+    let mut warnings = Vec::new();
+    let mut reasons = Vec::new();
+    for name in [RESTART_FILE, PREVIOUS_RESTART_FILE] {
+        let path = dir.join(name);
+        let result = std::fs::read(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| from_bytes(&bytes));
+        match result {
+            Ok(restart) => {
+                return Ok(RestartLoaded {
+                    restart,
+                    path,
+                    warnings,
+                })
+            }
+            Err(e) => {
+                if name == RESTART_FILE {
+                    warnings.push(format!(
+                        "{}: not usable ({e}); using {PREVIOUS_RESTART_FILE}",
+                        path.display()
+                    ));
+                }
+                reasons.push(format!("{}: {e}", path.display()));
+            }
+        }
+    }
+    Err(format!(
+        "no usable restart file in {}: {}",
+        dir.display(),
+        reasons.join("; ")
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Restart {
+        Restart {
+            invocation: "case.toml".into(),
+            scene_digest: "abc".into(),
+            laws: "L W".into(),
+            checkpoint_every: 0.1,
+            position: Position {
+                stage: 1,
+                within: Some((7, 0.5)),
+            },
+            world: vec![1, 2, 3, 4, 5],
+            driver: DriverState {
+                refilled: 3,
+                particle_steps: 99,
+                stages: Vec::new(),
+                guard_counts: vec![(GuardKind::Overlap, 2)],
+                refills: vec![(0, 10, 1)],
+                next_checkpoint: 0.25,
+                warnings: vec!["w".into()],
+                n_inserted: 10,
+                n_body_particles: 0,
+            },
+            observers: vec![vec![9; 17]],
+        }
+    }
+
+    #[test]
+    fn round_trip_and_every_flipped_byte_is_refused() {
+        let bytes = to_bytes(&sample());
+        let back = from_bytes(&bytes).unwrap();
+        assert_eq!(back.position, sample().position);
+        assert_eq!(back.world, sample().world);
+        for k in 0..bytes.len() {
+            let mut bad = bytes.clone();
+            bad[k] ^= 0x10;
+            assert!(from_bytes(&bad).is_err(), "flipped byte {k} accepted");
+        }
+        for n in 0..bytes.len() {
+            assert!(
+                from_bytes(&bytes[..n]).is_err(),
+                "truncated to {n} accepted"
+            );
+        }
+    }
+
+    #[test]
+    fn falls_back_to_the_previous_file_and_names_the_bad_one() {
+        let dir = std::env::temp_dir().join(format!("cgdem-restart-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        remove(&dir).unwrap();
+        assert!(read_latest(&dir).unwrap_err().contains(RESTART_FILE));
+        let mut first = sample();
+        first.driver.refilled = 1;
+        write(&dir, &first).unwrap();
+        write(&dir, &sample()).unwrap();
+        assert_eq!(read_latest(&dir).unwrap().restart.driver.refilled, 3);
+        // Truncate the newest: the previous one is used, with a warning naming the file.
+        let path = dir.join(RESTART_FILE);
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+        let loaded = read_latest(&dir).unwrap();
+        assert_eq!(loaded.restart.driver.refilled, 1);
+        assert!(
+            loaded.warnings[0].contains("restart.cgr"),
+            "{:?}",
+            loaded.warnings
+        );
+        // Both bad: an error naming both.
+        let prev = dir.join(PREVIOUS_RESTART_FILE);
+        let mut bytes = std::fs::read(&prev).unwrap();
+        bytes[40] ^= 1;
+        std::fs::write(&prev, &bytes).unwrap();
+        let err = read_latest(&dir).unwrap_err();
+        assert!(
+            err.contains("restart.cgr")
+                && err.contains("restart.prev.cgr")
+                && err.contains("checksum"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

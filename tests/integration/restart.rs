@@ -1,0 +1,187 @@
+//! Restart files: a run resumed from a checkpoint writes exactly the outputs of the
+//! uninterrupted run (cmp), whatever a killed run left after the checkpoint; a truncated or
+//! corrupt restart file is refused by name and the previous one is used.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("restart")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.parent().unwrap()).unwrap();
+    dir
+}
+
+fn cgdem(args: &[&str], out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cgdem"))
+        .args(args)
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+fn resume(dir: &Path, threads: &str) -> Output {
+    cgdem(&["run", "--quiet", "--threads", threads, "--resume"], dir)
+}
+
+/// Every file below `dir` (relative), restart files left out.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if !p.to_string_lossy().ends_with(".cgr") {
+                found.push(p.strip_prefix(dir).unwrap().to_path_buf());
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+/// summary.json without its wall-clock fields (they differ between any two runs) and the
+/// thread count (the resume runs on another one).
+fn summary(dir: &Path) -> serde_json::Value {
+    let mut s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for k in ["wall_s", "particle_steps_per_s", "threads"] {
+        s.as_object_mut().unwrap().remove(k);
+    }
+    s
+}
+
+fn assert_same_outputs(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    assert_eq!(fa, fb, "different output files");
+    for f in &fa {
+        if f.as_os_str() == "summary.json" {
+            assert_eq!(summary(a), summary(b), "summary.json differs");
+        } else {
+            assert!(
+                std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
+                "{} differs from the uninterrupted run's",
+                f.display()
+            );
+        }
+    }
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        if e.path().is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+/// A copy of the uninterrupted run as a kill after its last periodic checkpoint leaves it:
+/// outputs ahead of the checkpoint, a torn time-series row, no summary, the newest restart
+/// file damaged by `damage`; the resume must fall back to restart.prev.cgr.
+fn killed_copy(reference: &Path, name: &str, damage: impl Fn(&mut Vec<u8>)) -> PathBuf {
+    let dir = tmp(name);
+    copy_dir(reference, &dir);
+    std::fs::remove_file(dir.join("summary.json")).unwrap();
+    let mut series = std::fs::read(dir.join("timeseries.csv")).unwrap();
+    series.extend_from_slice(b"9.99e-1,collapse,1.2");
+    std::fs::write(dir.join("timeseries.csv"), series).unwrap();
+    let path = dir.join("restart.cgr");
+    let mut bytes = std::fs::read(&path).unwrap();
+    damage(&mut bytes);
+    std::fs::write(&path, bytes).unwrap();
+    dir
+}
+
+#[test]
+fn resumed_runs_write_the_uninterrupted_outputs_and_refuse_damaged_restart_files() {
+    let reference = tmp("reference");
+    let args = [
+        "run",
+        "tests/data/tiny_hertz_collapse.toml",
+        "--quiet",
+        "--threads",
+        "1",
+        "--set",
+        "output.vtk_interval=0.05",
+        "--checkpoint-every",
+        "0.12",
+        "--out",
+    ];
+    let run = cgdem(&args, &reference);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(reference.join("restart.prev.cgr").is_file());
+    assert!(reference.join("vtk/particles.pvd").is_file());
+    for (name, damage) in [
+        (
+            "truncated",
+            Box::new(|b: &mut Vec<u8>| b.truncate(b.len() / 2)) as Box<dyn Fn(&mut Vec<u8>)>,
+        ),
+        (
+            "flipped",
+            Box::new(|b: &mut Vec<u8>| {
+                let k = b.len() - 100;
+                b[k] ^= 0x04;
+            }),
+        ),
+    ] {
+        let dir = killed_copy(&reference, name, damage);
+        // Another thread count than the run's: the file does not depend on it.
+        let out = resume(&dir, "2");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{name}: {stderr}");
+        assert!(
+            stderr.contains("restart.cgr: not usable")
+                && stderr.contains("resuming from")
+                && stderr.contains("restart.prev.cgr"),
+            "{name}: {stderr}"
+        );
+        assert_same_outputs(&reference, &dir);
+    }
+    // Both files damaged: an error naming both, nothing resumed.
+    let dir = killed_copy(&reference, "both", |b| b.truncate(10));
+    let prev = dir.join("restart.prev.cgr");
+    let mut bytes = std::fs::read(&prev).unwrap();
+    let k = bytes.len() / 2;
+    bytes[k] ^= 0x01;
+    std::fs::write(&prev, bytes).unwrap();
+    let out = resume(&dir, "1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("restart.cgr") && stderr.contains("restart.prev.cgr: checksum mismatch"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn checkpoints_are_refused_with_grid() {
+    let out = tmp("grid");
+    let run = cgdem(
+        &[
+            "run",
+            "tests/data/tiny_hertz_collapse.toml",
+            "--quiet",
+            "--grid",
+            "2",
+            "--checkpoint-every",
+            "0.1",
+            "--out",
+        ],
+        &out,
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(stderr.contains("not supported with --grid"), "{stderr}");
+}
