@@ -140,7 +140,12 @@ mod tests {
                 }
             }
             let width = 2.0 * 0.03 + skin;
-            borders(&mut subs, &grid, width, &crate::decomposition::Comm::local());
+            borders(
+                &mut subs,
+                &grid,
+                width,
+                &crate::decomposition::Comm::local(),
+            );
             // Global pairs by id: (lower id, higher id, image offset of the higher seen from
             // the lower), found once when both are owned by one subdomain, twice otherwise.
             let key = |a: u32, b: u32, xa: Vec3, xb: Vec3| {
