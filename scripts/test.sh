@@ -18,6 +18,8 @@ cargo test --release --workspace
 # The VTK series read by meshio (installed from PyPI if missing) and checked against cgdem's
 # own state on three short runs (seconds).
 bash scripts/check-vtk-meshio.sh
+# A full disk while writing outputs: a clear error and the files written before intact.
+bash scripts/check-full-disk.sh
 
 # The smoke suite: every part of the harness on a small collapse (a few minutes).
 report=target/smoke-report

@@ -229,7 +229,11 @@ fn write_frame_file(path: &Path, parts: &[Vec<u8>]) -> Result<(), String> {
     std::fs::File::create(&tmp)
         .and_then(|mut file| parts.iter().try_for_each(|part| file.write_all(part)))
         .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|e| format!("{}: {e}", path.display()))
+        .map_err(|e| {
+            // A full disk leaves no half frame behind, only the frames written before.
+            let _ = std::fs::remove_file(&tmp);
+            format!("{}: {e}", path.display())
+        })
 }
 
 fn total_len(parts: &[Vec<u8>]) -> usize {
