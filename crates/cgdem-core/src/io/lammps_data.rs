@@ -114,8 +114,7 @@ fn is_keyword(content: &str) -> bool {
 /// Reads a data file's text; `file` is named in errors.
 pub fn parse_data(text: &str, file: &Path) -> Result<DataFile, DataFileError> {
     let r = Reader { file };
-    // (line number, content without comment, comment)
-    let lines: Vec<(usize, &str, &str)> = text
+    let lines: Vec<Line> = text
         .lines()
         .enumerate()
         .skip(1) // the title line, as LAMMPS skips it
@@ -124,7 +123,83 @@ pub fn parse_data(text: &str, file: &Path) -> Result<DataFile, DataFileError> {
             (k + 1, content.trim(), comment.trim())
         })
         .collect();
+    let (n_atoms, atom_types, lo, hi, mut k) = parse_header(&r, &lines)?;
 
+    let mut atoms: Option<Vec<DataAtom>> = None;
+    // (section line, rows)
+    let mut velocity_rows: Option<(usize, Vec<VelocityRow>)> = None;
+    let mut skipped_seen: Vec<&str> = Vec::new();
+    while k < lines.len() {
+        let (line, keyword, comment) = lines[k];
+        k += 1;
+        let start = k;
+        while k < lines.len() && !is_keyword(lines[k].1) {
+            k += 1;
+        }
+        let rows = lines[start..k]
+            .iter()
+            .filter(|(_, content, _)| !content.is_empty());
+        match keyword {
+            "Atoms" => {
+                if atoms.is_some() {
+                    return Err(r.error(Some(line), "Atoms", "a second section", "one"));
+                }
+                atoms = Some(parse_atoms(&r, line, comment, rows, n_atoms, atom_types)?);
+            }
+            "Velocities" => {
+                if velocity_rows.is_some() {
+                    return Err(r.error(Some(line), "Velocities", "a second section", "one"));
+                }
+                velocity_rows = Some((line, parse_velocity_rows(&r, rows)?));
+            }
+            name if SKIPPED_SECTIONS.contains(&name) && !skipped_seen.contains(&name) => {
+                skipped_seen.push(name);
+            }
+            other => return Err(r.error(
+                Some(line),
+                "section",
+                format!("\"{other}\""),
+                "`Atoms # sphere`, `Velocities` (and `Masses`, `Pair Coeffs`, skipped), each once",
+            )),
+        }
+    }
+    let atoms = match atoms {
+        Some(a) => a,
+        None if n_atoms == 0 => Vec::new(),
+        None => {
+            return Err(r.error(
+                None,
+                "Atoms",
+                "missing",
+                "an `Atoms # sphere` section: atom-ID atom-type diameter density x y z",
+            ))
+        }
+    };
+    let velocities = match velocity_rows {
+        None => None,
+        Some((header, rows)) => Some(match_velocities(&r, &atoms, header, rows)?),
+    };
+    Ok(DataFile {
+        atom_types,
+        lo,
+        hi,
+        atoms,
+        velocities,
+    })
+}
+
+/// A `Velocities` row: (line, atom-ID, vx vy vz wx wy wz).
+type VelocityRow = (usize, u64, [Real; 6]);
+
+/// A line of the file: (line number, content without comment, comment).
+type Line<'a> = (usize, &'a str, &'a str);
+
+/// The header before the first section: (atoms, atom types, box lo, box hi, index of the
+/// first section's line).
+fn parse_header(
+    r: &Reader,
+    lines: &[Line],
+) -> Result<(u64, u64, Vec3, Vec3, usize), DataFileError> {
     let mut n_atoms = None;
     let mut atom_types = None;
     let mut bounds: [Option<(Real, Real)>; 3] = [None; 3];
@@ -203,199 +278,166 @@ pub fn parse_data(text: &str, file: &Path) -> Result<DataFile, DataFileError> {
         hi[axis] = h;
     }
 
-    let mut atoms: Option<Vec<DataAtom>> = None;
-    // (section line, rows of (line, atom-ID, vx vy vz wx wy wz))
-    type VelocityRows = (usize, Vec<(usize, u64, [Real; 6])>);
-    let mut velocity_rows: Option<VelocityRows> = None;
-    let mut skipped_seen: Vec<&str> = Vec::new();
-    while k < lines.len() {
-        let (line, keyword, comment) = lines[k];
-        k += 1;
-        let start = k;
-        while k < lines.len() && !is_keyword(lines[k].1) {
-            k += 1;
-        }
-        let rows = lines[start..k]
-            .iter()
-            .filter(|(_, content, _)| !content.is_empty());
-        match keyword {
-            "Atoms" => {
-                if atoms.is_some() {
-                    return Err(r.error(Some(line), "Atoms", "a second section", "one"));
-                }
-                if !["", "sphere", "granular"].contains(&comment) {
-                    return Err(r.error(
-                        Some(line),
-                        "Atoms",
-                        format!("\"Atoms # {comment}\""),
-                        "`Atoms # sphere` (LIGGGHTS: `# granular`): atom-ID atom-type diameter density x y z",
-                    ));
-                }
-                let mut list = Vec::new();
-                let mut first_line: HashMap<u64, usize> = HashMap::new();
-                for &(row, content, _) in rows {
-                    let t: Vec<&str> = content.split_whitespace().collect();
-                    if t.len() != 7 && t.len() != 10 {
-                        return Err(r.error(
-                            Some(row),
-                            "Atoms",
-                            format!("{} columns", t.len()),
-                            "7 columns, atom-ID atom-type diameter density x y z (and optionally 3 image flags)",
-                        ));
-                    }
-                    let field = |c: usize| format!("Atoms {}", ATOM_COLUMNS[c]);
-                    let id = r.count(row, field(0), t[0])?;
-                    if id == 0 {
-                        return Err(r.error(Some(row), field(0), 0, "a whole number >= 1"));
-                    }
-                    if let Some(previous) = first_line.insert(id, row) {
-                        return Err(r.error(
-                            Some(row),
-                            field(0),
-                            id,
-                            format!("each atom-ID once (this one is also on line {previous})"),
-                        ));
-                    }
-                    let atom_type = r.count(row, field(1), t[1])?;
-                    if atom_type == 0 || atom_type > atom_types {
-                        return Err(r.error(
-                            Some(row),
-                            field(1),
-                            atom_type,
-                            format!("1 to {atom_types} (the header's `atom types`)"),
-                        ));
-                    }
-                    for (c, flag) in t.iter().enumerate().skip(7) {
-                        if flag.parse::<i64>().is_err() {
-                            return Err(r.error(
-                                Some(row),
-                                format!("Atoms image flag {}", c - 6),
-                                flag,
-                                "an integer",
-                            ));
-                        }
-                    }
-                    list.push(DataAtom {
-                        line: row,
-                        id,
-                        atom_type,
-                        diameter: r.positive(row, field(2), t[2])?,
-                        density: r.positive(row, field(3), t[3])?,
-                        position: Vec3::new(
-                            r.real(row, field(4), t[4])?,
-                            r.real(row, field(5), t[5])?,
-                            r.real(row, field(6), t[6])?,
-                        ),
-                    });
-                }
-                if list.len() as u64 != n_atoms {
-                    return Err(r.error(
-                        Some(line),
-                        "Atoms",
-                        format!("{} lines", list.len()),
-                        format!("one line per atom: {n_atoms} (the header's `atoms`)"),
-                    ));
-                }
-                atoms = Some(list);
-            }
-            "Velocities" => {
-                if velocity_rows.is_some() {
-                    return Err(r.error(Some(line), "Velocities", "a second section", "one"));
-                }
-                let mut list = Vec::new();
-                for &(row, content, _) in rows {
-                    let t: Vec<&str> = content.split_whitespace().collect();
-                    if t.len() != 7 {
-                        return Err(r.error(
-                            Some(row),
-                            "Velocities",
-                            format!("{} columns", t.len()),
-                            "7 columns, atom-ID vx vy vz wx wy wz",
-                        ));
-                    }
-                    let field = |c: usize| format!("Velocities {}", VELOCITY_COLUMNS[c]);
-                    let id = r.count(row, field(0), t[0])?;
-                    let mut values = [0.0; 6];
-                    for (c, v) in values.iter_mut().enumerate() {
-                        *v = r.real(row, field(c + 1), t[c + 1])?;
-                    }
-                    list.push((row, id, values));
-                }
-                velocity_rows = Some((line, list));
-            }
-            name if SKIPPED_SECTIONS.contains(&name) && !skipped_seen.contains(&name) => {
-                skipped_seen.push(name);
-            }
-            other => return Err(r.error(
-                Some(line),
-                "section",
-                format!("\"{other}\""),
-                "`Atoms # sphere`, `Velocities` (and `Masses`, `Pair Coeffs`, skipped), each once",
-            )),
-        }
+    Ok((n_atoms, atom_types, lo, hi, k))
+}
+
+/// The `Atoms # sphere` section starting on `line` (its comment `comment`), with its `rows`.
+fn parse_atoms<'a>(
+    r: &Reader,
+    line: usize,
+    comment: &str,
+    rows: impl Iterator<Item = &'a Line<'a>>,
+    n_atoms: u64,
+    atom_types: u64,
+) -> Result<Vec<DataAtom>, DataFileError> {
+    if !["", "sphere", "granular"].contains(&comment) {
+        return Err(r.error(
+            Some(line),
+            "Atoms",
+            format!("\"Atoms # {comment}\""),
+            "`Atoms # sphere` (LIGGGHTS: `# granular`): atom-ID atom-type diameter density x y z",
+        ));
     }
-    let atoms = match atoms {
-        Some(a) => a,
-        None if n_atoms == 0 => Vec::new(),
-        None => {
+    let mut list = Vec::new();
+    let mut first_line: HashMap<u64, usize> = HashMap::new();
+    for &(row, content, _) in rows {
+        let t: Vec<&str> = content.split_whitespace().collect();
+        if t.len() != 7 && t.len() != 10 {
             return Err(r.error(
-                None,
+                Some(row),
                 "Atoms",
-                "missing",
-                "an `Atoms # sphere` section: atom-ID atom-type diameter density x y z",
-            ))
+                format!("{} columns", t.len()),
+                "7 columns, atom-ID atom-type diameter density x y z (and optionally 3 image flags)",
+            ));
         }
-    };
-    let velocities = match velocity_rows {
-        None => None,
-        Some((header, rows)) => {
-            let index: HashMap<u64, usize> =
-                atoms.iter().enumerate().map(|(k, a)| (a.id, k)).collect();
-            let mut out: Vec<Option<DataVelocity>> = vec![None; atoms.len()];
-            for (row, id, v) in rows {
-                let Some(&k) = index.get(&id) else {
-                    return Err(r.error(
-                        Some(row),
-                        "Velocities atom-ID",
-                        id,
-                        "an atom-ID of the `Atoms` section",
-                    ));
-                };
-                if let Some(previous) = &out[k] {
-                    return Err(r.error(
-                        Some(row),
-                        "Velocities atom-ID",
-                        id,
-                        format!(
-                            "each atom-ID once (this one is also on line {})",
-                            previous.line
-                        ),
-                    ));
-                }
-                out[k] = Some(DataVelocity {
-                    line: row,
-                    velocity: Vec3::new(v[0], v[1], v[2]),
-                    omega: Vec3::new(v[3], v[4], v[5]),
-                });
-            }
-            if let Some(k) = out.iter().position(Option::is_none) {
+        let field = |c: usize| format!("Atoms {}", ATOM_COLUMNS[c]);
+        let id = r.count(row, field(0), t[0])?;
+        if id == 0 {
+            return Err(r.error(Some(row), field(0), 0, "a whole number >= 1"));
+        }
+        if let Some(previous) = first_line.insert(id, row) {
+            return Err(r.error(
+                Some(row),
+                field(0),
+                id,
+                format!("each atom-ID once (this one is also on line {previous})"),
+            ));
+        }
+        let atom_type = r.count(row, field(1), t[1])?;
+        if atom_type == 0 || atom_type > atom_types {
+            return Err(r.error(
+                Some(row),
+                field(1),
+                atom_type,
+                format!("1 to {atom_types} (the header's `atom types`)"),
+            ));
+        }
+        for (c, flag) in t.iter().enumerate().skip(7) {
+            if flag.parse::<i64>().is_err() {
                 return Err(r.error(
-                    Some(header),
-                    "Velocities",
-                    format!("no line for atom-ID {}", atoms[k].id),
-                    "one line per atom of the `Atoms` section",
+                    Some(row),
+                    format!("Atoms image flag {}", c - 6),
+                    flag,
+                    "an integer",
                 ));
             }
-            Some(out.into_iter().flatten().collect())
         }
-    };
-    Ok(DataFile {
-        atom_types,
-        lo,
-        hi,
-        atoms,
-        velocities,
-    })
+        list.push(DataAtom {
+            line: row,
+            id,
+            atom_type,
+            diameter: r.positive(row, field(2), t[2])?,
+            density: r.positive(row, field(3), t[3])?,
+            position: Vec3::new(
+                r.real(row, field(4), t[4])?,
+                r.real(row, field(5), t[5])?,
+                r.real(row, field(6), t[6])?,
+            ),
+        });
+    }
+    if list.len() as u64 != n_atoms {
+        return Err(r.error(
+            Some(line),
+            "Atoms",
+            format!("{} lines", list.len()),
+            format!("one line per atom: {n_atoms} (the header's `atoms`)"),
+        ));
+    }
+    Ok(list)
+}
+
+/// The `Velocities` section's rows: (line, atom-ID, vx vy vz wx wy wz).
+fn parse_velocity_rows<'a>(
+    r: &Reader,
+    rows: impl Iterator<Item = &'a Line<'a>>,
+) -> Result<Vec<VelocityRow>, DataFileError> {
+    let mut list = Vec::new();
+    for &(row, content, _) in rows {
+        let t: Vec<&str> = content.split_whitespace().collect();
+        if t.len() != 7 {
+            return Err(r.error(
+                Some(row),
+                "Velocities",
+                format!("{} columns", t.len()),
+                "7 columns, atom-ID vx vy vz wx wy wz",
+            ));
+        }
+        let field = |c: usize| format!("Velocities {}", VELOCITY_COLUMNS[c]);
+        let id = r.count(row, field(0), t[0])?;
+        let mut values = [0.0; 6];
+        for (c, v) in values.iter_mut().enumerate() {
+            *v = r.real(row, field(c + 1), t[c + 1])?;
+        }
+        list.push((row, id, values));
+    }
+    Ok(list)
+}
+
+/// Each atom's velocity and spin from the `Velocities` rows (section on line `header`):
+/// every atom once, no other atom-ID.
+fn match_velocities(
+    r: &Reader,
+    atoms: &[DataAtom],
+    header: usize,
+    rows: Vec<VelocityRow>,
+) -> Result<Vec<DataVelocity>, DataFileError> {
+    let index: HashMap<u64, usize> = atoms.iter().enumerate().map(|(k, a)| (a.id, k)).collect();
+    let mut out: Vec<Option<DataVelocity>> = vec![None; atoms.len()];
+    for (row, id, v) in rows {
+        let Some(&k) = index.get(&id) else {
+            return Err(r.error(
+                Some(row),
+                "Velocities atom-ID",
+                id,
+                "an atom-ID of the `Atoms` section",
+            ));
+        };
+        if let Some(previous) = &out[k] {
+            return Err(r.error(
+                Some(row),
+                "Velocities atom-ID",
+                id,
+                format!(
+                    "each atom-ID once (this one is also on line {})",
+                    previous.line
+                ),
+            ));
+        }
+        out[k] = Some(DataVelocity {
+            line: row,
+            velocity: Vec3::new(v[0], v[1], v[2]),
+            omega: Vec3::new(v[3], v[4], v[5]),
+        });
+    }
+    if let Some(k) = out.iter().position(Option::is_none) {
+        return Err(r.error(
+            Some(header),
+            "Velocities",
+            format!("no line for atom-ID {}", atoms[k].id),
+            "one line per atom of the `Atoms` section",
+        ));
+    }
+    Ok(out.into_iter().flatten().collect())
 }
 
 fn g(x: Real) -> String {

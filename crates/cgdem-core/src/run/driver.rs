@@ -103,62 +103,28 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             n_body_particles,
         }),
     };
-    let mut start = Position {
-        stage: 0,
-        within: None,
-    };
-    let mut pending_observers = None;
-    let mut saved_refills = Vec::new();
-    match resume {
+    let resume_at = match resume {
         Some(loaded) => {
-            let r = &loaded.restart;
-            let bad = |e: String| RunError::Restart(format!("{}: {e}", loaded.path.display()));
-            for w in &loaded.warnings {
-                eprintln!("warning: {w}");
-            }
-            world
-                .set_state(decode(&r.world).map_err(bad)?)
-                .map_err(bad)?;
-            let d = &r.driver;
-            driver.refilled = d.refilled;
-            driver.particle_steps = d.particle_steps;
-            driver.stages = d.stages.clone();
-            driver.guard_counts = d.guard_counts.clone();
-            saved_refills = d.refills.clone();
-            // Already printed by the run that met them.
-            warnings.0 = d.warnings.clone();
-            (n_inserted, n_body_particles) = (d.n_inserted, d.n_body_particles);
-            if let Some(c) = &mut driver.checkpoint {
-                c.next = d.next_checkpoint;
-                (c.n_inserted, c.n_body_particles) = (n_inserted, n_body_particles);
-            }
-            if r.observers.len() != observers.len() {
-                return Err(bad(format!(
-                    "{} observer states stored, the scene has {} observers",
-                    r.observers.len(),
-                    observers.len()
-                )));
-            }
-            start = r.position;
-            if start.within.is_none() {
-                restore_observers(&mut observers, &r.observers).map_err(bad)?;
-            } else {
-                pending_observers = Some((r.observers.as_slice(), loaded.path.as_path()));
+            let (at, counts) =
+                driver.resume_from(&mut world, &mut observers, &mut warnings, loaded)?;
+            (n_inserted, n_body_particles) = counts;
+            at
+        }
+        None => {
+            let start = Position {
+                stage: 0,
+                within: None,
+            };
+            driver.save_checkpoint(&world, &mut observers, &warnings, start, &[])?;
+            Resume {
+                at: start,
+                observers: None,
+                refills: Vec::new(),
             }
         }
-        None => driver.save_checkpoint(&world, &mut observers, &warnings, start, &[])?,
-    }
+    };
     let started = Instant::now();
-    let stopped_by = driver.run_stages(
-        &mut world,
-        &mut observers,
-        &mut warnings,
-        Resume {
-            at: start,
-            observers: pending_observers,
-            refills: saved_refills,
-        },
-    )?;
+    let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings, resume_at)?;
     driver.progress.finish();
     // Under MPI every rank gathers the final state (rank 0 writes it).
     world.sync_particles();
@@ -175,45 +141,19 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             world.lost
         ));
     }
-    let mut summary = RunSummary {
-        case: scene.name.clone(),
-        code: "cgdem".into(),
-        lambda: scene.lambda,
-        cg_rule: scene.cg_rule,
-        n_particles: world.particles.len(),
-        n_particles_inserted: n_inserted,
-        n_particles_refilled: driver.refilled,
-        n_body_particles,
-        lost_particles: world.lost,
-        steps: world.steps,
-        dt_s: dt,
-        contact_period_s: scales.shortest_period,
-        stable_dt_s: scales.stable_limit,
-        simulated_s: world.time,
+    let mut summary = base_summary(
+        scene,
+        &world,
+        &mut driver,
+        Counts {
+            inserted: n_inserted,
+            body_particles: n_body_particles,
+        },
+        (dt, &scales),
         wall_s,
-        particle_steps: driver.particle_steps,
-        particle_steps_per_s: driver.particle_steps as Real / wall_s.max(1e-9),
-        threads: rayon::current_num_threads(),
-        repose_angle_deg: None,
-        repose_fit_r2: None,
-        repose_rule: describe_repose_rule(scene),
-        runout_m: None,
-        repose_samples: Vec::new(),
-        stages: std::mem::take(&mut driver.stages),
-        deleted_particles: world.deleted,
-        deleted_mass_kg: world.deleted_mass,
-        conveying: None,
-        packing: None,
-        warnings: Vec::new(),
-        stopped_by: stopped_by.clone(),
-        guard_peaks: Some(world.guard_peaks()),
-        scene_file: scene.source.display().to_string(),
-        scene_digest: scene.digest(),
-        cgdem_version: env!("CARGO_PKG_VERSION").into(),
-        final_state: options.keep_final_state.then(|| world.particles.clone()),
-        memory: Some(world.memory_use()),
-        decomposition: world.decomposition_summary(),
-    };
+        stopped_by.clone(),
+        options,
+    );
     for o in &mut observers {
         o.observer()
             .finish(&world, stopped_by.is_some(), &mut summary, &mut warnings)?;
@@ -235,6 +175,65 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             out_dir: out.clone(),
         }),
         None => Ok(summary),
+    }
+}
+
+/// The inserted and body particle counts of a run.
+struct Counts {
+    inserted: usize,
+    body_particles: usize,
+}
+
+/// The summary of a finished (or stopped) run before its observers add their results.
+#[allow(clippy::too_many_arguments)]
+fn base_summary<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    world: &World<L, W>,
+    driver: &mut Driver,
+    counts: Counts,
+    (dt, scales): (Real, &crate::timestep::Timescales),
+    wall_s: Real,
+    stopped_by: Option<GuardTrip>,
+    options: &RunOptions,
+) -> RunSummary {
+    RunSummary {
+        case: scene.name.clone(),
+        code: "cgdem".into(),
+        lambda: scene.lambda,
+        cg_rule: scene.cg_rule,
+        n_particles: world.particles.len(),
+        n_particles_inserted: counts.inserted,
+        n_particles_refilled: driver.refilled,
+        n_body_particles: counts.body_particles,
+        lost_particles: world.lost,
+        steps: world.steps,
+        dt_s: dt,
+        contact_period_s: scales.shortest_period,
+        stable_dt_s: scales.stable_limit,
+        simulated_s: world.time,
+        wall_s,
+        particle_steps: driver.particle_steps,
+        particle_steps_per_s: driver.particle_steps as Real / wall_s.max(1e-9),
+        threads: rayon::current_num_threads(),
+        repose_angle_deg: None,
+        repose_fit_r2: None,
+        repose_rule: describe_repose_rule(scene),
+        runout_m: None,
+        repose_samples: Vec::new(),
+        stages: std::mem::take(&mut driver.stages),
+        deleted_particles: world.deleted,
+        deleted_mass_kg: world.deleted_mass,
+        conveying: None,
+        packing: None,
+        warnings: Vec::new(),
+        stopped_by,
+        guard_peaks: Some(world.guard_peaks()),
+        scene_file: scene.source.display().to_string(),
+        scene_digest: scene.digest(),
+        cgdem_version: env!("CARGO_PKG_VERSION").into(),
+        final_state: options.keep_final_state.then(|| world.particles.clone()),
+        memory: Some(world.memory_use()),
+        decomposition: world.decomposition_summary(),
     }
 }
 
@@ -446,6 +445,56 @@ type Refill<'r> = (usize, &'r RefillRegion, usize, u64);
 impl Driver<'_> {
     /// Runs every stage from `resume.at` on; returns the guard trip that stopped the run, if
     /// one did.
+    /// Takes over a stored run: the world's state, the driver's counters and warnings, and
+    /// where the stage loop goes on (observers restored now, or at their stage's start when
+    /// the run stopped within a stage); with the inserted and body particle counts.
+    fn resume_from<'r, L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &mut World<L, W>,
+        observers: &mut [Scheduled<'_, L, W>],
+        warnings: &mut Warnings,
+        loaded: &'r restart::RestartLoaded,
+    ) -> Result<(Resume<'r>, (usize, usize)), RunError> {
+        let r = &loaded.restart;
+        let bad = |e: String| RunError::Restart(format!("{}: {e}", loaded.path.display()));
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        world
+            .set_state(decode(&r.world).map_err(bad)?)
+            .map_err(bad)?;
+        let d = &r.driver;
+        self.refilled = d.refilled;
+        self.particle_steps = d.particle_steps;
+        self.stages = d.stages.clone();
+        self.guard_counts = d.guard_counts.clone();
+        // Already printed by the run that met them.
+        warnings.0 = d.warnings.clone();
+        if let Some(c) = &mut self.checkpoint {
+            c.next = d.next_checkpoint;
+            (c.n_inserted, c.n_body_particles) = (d.n_inserted, d.n_body_particles);
+        }
+        if r.observers.len() != observers.len() {
+            return Err(bad(format!(
+                "{} observer states stored, the scene has {} observers",
+                r.observers.len(),
+                observers.len()
+            )));
+        }
+        let mut pending = None;
+        if r.position.within.is_none() {
+            restore_observers(observers, &r.observers).map_err(bad)?;
+        } else {
+            pending = Some((r.observers.as_slice(), loaded.path.as_path()));
+        }
+        let resume = Resume {
+            at: r.position,
+            observers: pending,
+            refills: d.refills.clone(),
+        };
+        Ok((resume, (d.n_inserted, d.n_body_particles)))
+    }
+
     fn run_stages<L: PairLaw, W: WallLaw>(
         &mut self,
         world: &mut World<L, W>,
