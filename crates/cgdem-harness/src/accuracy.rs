@@ -1312,7 +1312,7 @@ fn error_figure(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::suite::Suite;
 
@@ -1344,7 +1344,15 @@ mod tests {
         assert_eq!(cheapest_within(&[(f64::NAN, 0.0)], 1.0), None);
     }
 
-    fn run(series: &str, value: f64, seed: u64, angle: f64, particle_steps: f64) -> AccuracyPoint {
+    /// A successful cgdem run at lambda 1 (seed rule) with its angle and cost; shared by
+    /// the advise tests.
+    pub(crate) fn run(
+        series: &str,
+        value: f64,
+        seed: u64,
+        angle: f64,
+        particle_steps: f64,
+    ) -> AccuracyPoint {
         AccuracyPoint {
             case: "c".into(),
             code: Code::Cgdem,

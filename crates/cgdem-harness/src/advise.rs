@@ -291,32 +291,13 @@ mod tests {
         let steps = 1e9 / (lambda as f64).powi(4);
         AccuracyPoint {
             case: "aor-fidelity".into(),
-            code: Code::Cgdem,
-            series: series.into(),
-            value: lambda as f64,
             setting: format!("lambda = {lambda}, {} rule", rule.name()),
             lambda,
             cg_rule: rule,
-            seed,
-            status: crate::runs::Outcome::Ok,
-            reason: None,
-            dir: PathBuf::from("/nonexistent"),
-            reused: false,
             n_particles: None,
             steps: None,
-            particle_steps: Some(steps),
             wall_s: Some(steps / 1e7),
-            repose_angle_deg: Some(angle),
-            angle_error_deg: None,
-            profile_distance: None,
-            mass_flow_kg_s: None,
-            mass_flow_error: None,
-            eq7_mass_flow_kg_s: None,
-            eq7_error: None,
-            t_half_s: None,
-            t_half_error: None,
-            porosity: None,
-            porosity_error: None,
+            ..crate::accuracy::tests::run(series, lambda as f64, seed, angle, steps)
         }
     }
 
