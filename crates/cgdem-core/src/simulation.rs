@@ -474,23 +474,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             v.capacity() * std::mem::size_of::<T>()
         }
         let p = &self.particles;
-        let mut particle_bytes = bytes(&p.id)
-            + bytes(&p.species)
-            + bytes(&p.position)
-            + bytes(&p.velocity)
-            + bytes(&p.force)
-            + bytes(&p.radius)
-            + bytes(&p.mass)
-            + bytes(&p.inv_mass)
+        let particle_bytes = p.array_bytes()
             + bytes(&self.wall_history)
             + bytes(&self.body_loads)
             + bytes(&self.old_force)
             + bytes(&self.old_torque)
             + self.list.particle_bytes();
-        if let Some(a) = &p.angular {
-            particle_bytes += bytes(&a.omega) + bytes(&a.torque) + bytes(&a.inv_inertia);
-        }
-        MemoryUse {
+        let global = MemoryUse {
             particles: p.len(),
             particle_bytes,
             pairs: self.list.pairs.len(),
@@ -499,6 +489,21 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 + bytes(&self.reaction_force)
                 + bytes(&self.reaction_spin),
             history_entries: self.history.len(),
+        };
+        match &self.decomposition {
+            // This rank's subdomains (ghosts included) and their lists, per particle it
+            // owns, plus the world's arrays the outputs read (gathered when read, on every
+            // rank: all particles; the global list stays empty).
+            Some(d) => {
+                let local = d.memory_use();
+                MemoryUse {
+                    particle_bytes: global.particle_bytes
+                        + global.pair_bytes
+                        + local.particle_bytes,
+                    ..local
+                }
+            }
+            None => global,
         }
     }
 

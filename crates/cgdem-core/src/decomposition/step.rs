@@ -17,7 +17,7 @@ use crate::domain::{Domain, NO_IMAGE};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::Particles;
-use crate::simulation::{larger, pair_force, ForceView, Owner, ParticleState};
+use crate::simulation::{larger, pair_force, ForceView, MemoryUse, Owner, ParticleState};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -369,6 +369,42 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 })
             });
         per_sub.iter().map(|w| w[0]).sum()
+    }
+
+    /// The arrays of the subdomains this rank steps: particles (owned and ghosts), wall
+    /// histories, send lists, forward buffers and list references as per-particle bytes;
+    /// pairs and their histories as per-pair bytes (a pair across a boundary is listed, and
+    /// counted, on both sides).
+    pub fn memory_use(&self) -> MemoryUse {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let mut m = MemoryUse {
+            particles: 0,
+            particle_bytes: 0,
+            pairs: 0,
+            pair_bytes: 0,
+            history_entries: 0,
+        };
+        for sub in self.owned() {
+            m.particles += sub.n_owned;
+            m.particle_bytes += sub.particles.array_bytes()
+                + bytes(&sub.wall_history)
+                + bytes(&sub.list.out_start)
+                + bytes(&sub.list.reference)
+                + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
+                + bytes(&sub.receives);
+            m.pairs += sub.list.pairs.len();
+            m.pair_bytes += bytes(&sub.list.pairs) + bytes(&sub.list.history);
+            m.history_entries += sub.list.history.len();
+        }
+        m.particle_bytes += self
+            .buffers
+            .iter()
+            .flatten()
+            .map(|States(b)| bytes(b))
+            .sum::<usize>();
+        m
     }
 
     /// Pairs listed over all subdomains (a pair across a boundary twice).
