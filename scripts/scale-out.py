@@ -15,8 +15,9 @@ layer w thick around them (all 26 neighbours):
     forward = m latency + g bytes / bandwidth     m messages per step
     reductions = 2 log2(P) latency   the rebuild decision and the guard's overlaps
 The current transport routes with one MPI_Alltoallv: every rank meets every other, so
-m = P - 1; a neighbour exchange (26 point-to-point messages, as LAMMPS's Comm) has m = 26.
-Both are printed.
+m = P - 1; the forward's point-to-point exchange meets each neighbouring subdomain's rank,
+m = 26; LAMMPS's Comm stages it by dimension (x, then y carrying x's ghosts, then z), m = 6
+(not built). All three are printed.
 
 Usage: python3 scripts/scale-out.py [--c NS] [--bytes-per-ghost B] [--latency-us L]
                                     [--bandwidth-gbs G] [--csv OUT]
@@ -61,7 +62,7 @@ def main():
     rows = []
     print("cores | transport | particles per core | ghosts per core | compute us | exchange us | step us | efficiency | run hours")
     for p in (64, 256, 1024):
-        for name, m in (("alltoallv", p - 1), ("neighbours", 26)):
+        for name, m in (("alltoallv", p - 1), ("neighbours", 26), ("staged", 6)):
             n, g, comp, comm, step = project(p, c, args.bytes_per_ghost, lat, bw, m)
             eff = c * n / step
             hours = step * STEPS / 3600
