@@ -25,9 +25,10 @@ fn scene() -> Scene {
     Scene::load_with_overrides(&file, &overrides).expect("scene")
 }
 
-/// With the default balance (`--balance 1.1`).
+/// Balanced at any imbalance (`--balance 1.0`): with 40 beads the planes move at most
+/// rebuilds, so the histories travel to new owners as often as they can.
 fn run_with(grid: Option<GridSpec>, threads: usize, name: &str) -> RunSummary {
-    run_balanced(grid, BalanceSpec::default(), threads, name)
+    run_balanced(grid, BalanceSpec::Shift(1.0), threads, name)
 }
 
 fn run_balanced(
@@ -76,8 +77,7 @@ fn decomposed_runs_follow_the_undecomposed_trajectories_to_rounding() {
     ] {
         let summary = run_with(Some(grid), 2, name);
         assert_eq!(summary.steps, reference.steps, "{name}");
-        // The collapse carries the beads across the start's planes: these runs compare
-        // balanced decompositions, whose planes moved.
+        // These runs compare decompositions whose planes moved.
         let shifts = summary.decomposition.as_ref().unwrap().shifts;
         assert!(shifts > 0, "{name}: the planes never moved");
         assert_eq!(summary.lost_particles, reference.lost_particles, "{name}");
@@ -136,18 +136,19 @@ fn a_grid_the_step_cannot_take_is_refused_with_the_reason() {
 #[test]
 fn balancing_moves_the_planes_after_the_collapse_and_the_static_split_stays_behind() {
     let grid = Some(GridSpec::Given([2, 1, 1]));
-    let on = run_balanced(grid, BalanceSpec::Shift(1.1), 2, "balance-on");
+    // The collapse carries beads across the start's plane: 22 of the 40 on one side.
+    let on = run_balanced(grid, BalanceSpec::Shift(1.05), 2, "balance-on");
     let off = run_balanced(grid, BalanceSpec::Off, 2, "balance-off");
     let (on, off) = (on.decomposition.unwrap(), off.decomposition.unwrap());
-    assert_eq!(on.balance_threshold, Some(1.1));
+    assert_eq!(on.balance_threshold, Some(1.05));
     assert!(on.shifts > 0);
     // After a rebuild the subdomains are within the threshold: either the planes held it
     // or they moved.
     let worst = on.imbalance_max_after_first_shift.unwrap();
-    assert!(worst <= 1.1 && on.imbalance <= 1.1, "{on:?}");
+    assert!(worst <= 1.05 && on.imbalance <= 1.05, "{on:?}");
     // The start's planes would not have held it.
-    assert!(on.static_imbalance_max > 1.1, "{on:?}");
+    assert!(on.static_imbalance_max > 1.05, "{on:?}");
     assert_eq!((off.balance_threshold, off.shifts), (None, 0));
     assert_eq!(off.imbalance_max_after_first_shift, None);
-    assert!(off.static_imbalance_max > 1.1, "{off:?}");
+    assert!(off.static_imbalance_max > 1.05, "{off:?}");
 }
