@@ -125,6 +125,14 @@ enum Command {
         /// subdomains; the outputs are bitwise those of the same grid on threads.
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
+        /// With --grid: at each list rebuild, when the imbalance (most particles in one
+        /// subdomain over the mean) passes this threshold, move the cut planes so that each
+        /// slab along each axis holds the same number of particles (LAMMPS `fix balance
+        /// ... shift`), never thinner than the ghost layer; `off` keeps the start's planes.
+        /// At least 1.0. summary.json's `decomposition` gives the shifts and the imbalance
+        /// the start's planes would give.
+        #[arg(long, value_name = "THRESH|off", default_value_t, requires = "grid")]
+        balance: cgdem_core::decomposition::BalanceSpec,
         /// With `--sweep rpm=` or `screw_ratio=`: a run directory whose summary.json holds
         /// the same scene (digest) is not run again, so a sweep can be resumed or extended.
         #[arg(long)]
@@ -773,6 +781,7 @@ fn main() -> ExitCode {
             set,
             variant,
             grid,
+            balance,
             checkpoint_every,
             resume,
         } => {
@@ -925,6 +934,7 @@ fn main() -> ExitCode {
                             keep_going,
                             stop: interrupt.as_ref().map(|i| i.flag()),
                             grid,
+                            balance,
                             checkpoint: checkpoint_every.map(|every| CheckpointOptions {
                                 every,
                                 invocation: serde_json::to_string(&invocation).expect("plain data"),

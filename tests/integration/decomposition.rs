@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use cgdem_core::decomposition::GridSpec;
+use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{run, RunOptions, RunSummary};
@@ -25,12 +25,24 @@ fn scene() -> Scene {
     Scene::load_with_overrides(&file, &overrides).expect("scene")
 }
 
+/// Balanced at any imbalance (`--balance 1.0`): with 40 beads the planes move at most
+/// rebuilds, so the histories travel to new owners as often as they can.
 fn run_with(grid: Option<GridSpec>, threads: usize, name: &str) -> RunSummary {
+    run_balanced(grid, BalanceSpec::Shift(1.0), threads, name)
+}
+
+fn run_balanced(
+    grid: Option<GridSpec>,
+    balance: BalanceSpec,
+    threads: usize,
+    name: &str,
+) -> RunSummary {
     let out_dir = std::env::temp_dir().join(format!("cgdem-decomposition-{name}"));
     let options = RunOptions {
         out_dir,
         keep_final_state: true,
         grid,
+        balance,
         ..Default::default()
     };
     let pool = rayon::ThreadPoolBuilder::new()
@@ -65,6 +77,9 @@ fn decomposed_runs_follow_the_undecomposed_trajectories_to_rounding() {
     ] {
         let summary = run_with(Some(grid), 2, name);
         assert_eq!(summary.steps, reference.steps, "{name}");
+        // These runs compare decompositions whose planes moved.
+        let shifts = summary.decomposition.as_ref().unwrap().shifts;
+        assert!(shifts > 0, "{name}: the planes never moved");
         assert_eq!(summary.lost_particles, reference.lost_particles, "{name}");
         let b = by_id(summary.final_state.as_ref().unwrap());
         assert_eq!(a.len(), b.len());
@@ -116,4 +131,24 @@ fn a_grid_the_step_cannot_take_is_refused_with_the_reason() {
         e.contains("--grid 1x10x1") && e.contains("thinner than the ghost layer"),
         "{e}"
     );
+}
+
+#[test]
+fn balancing_moves_the_planes_after_the_collapse_and_the_static_split_stays_behind() {
+    let grid = Some(GridSpec::Given([2, 1, 1]));
+    // The collapse carries beads across the start's plane: 22 of the 40 on one side.
+    let on = run_balanced(grid, BalanceSpec::Shift(1.05), 2, "balance-on");
+    let off = run_balanced(grid, BalanceSpec::Off, 2, "balance-off");
+    let (on, off) = (on.decomposition.unwrap(), off.decomposition.unwrap());
+    assert_eq!(on.balance_threshold, Some(1.05));
+    assert!(on.shifts > 0);
+    // After a rebuild the subdomains are within the threshold: either the planes held it
+    // or they moved.
+    let worst = on.imbalance_max_after_first_shift.unwrap();
+    assert!(worst <= 1.05 && on.imbalance <= 1.05, "{on:?}");
+    // The start's planes would not have held it.
+    assert!(on.static_imbalance_max > 1.05, "{on:?}");
+    assert_eq!((off.balance_threshold, off.shifts), (None, 0));
+    assert_eq!(off.imbalance_max_after_first_shift, None);
+    assert!(off.static_imbalance_max > 1.05, "{off:?}");
 }

@@ -14,7 +14,8 @@ use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::decomposition::step::{Decomposition, Physics};
-use crate::decomposition::{choose_counts, Comm, Grid, GridSpec, HistoryRows};
+use crate::decomposition::HistoryRows;
+use crate::decomposition::{balance, choose_counts, BalanceSpec, Comm, Grid, GridSpec};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
 use crate::guard::{
@@ -418,7 +419,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 for _ in 0..positions.len() {
                     rows.push(&[]);
                 }
+                let balance = d.balance.clone();
                 self.decompose(d.grid, rows, d.comm);
+                if let Some(d) = self.decomposition.as_mut() {
+                    d.balance = balance;
+                }
             }
             _ => self.rebuild(),
         }
@@ -871,7 +876,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 choose_counts(count, extent, self.domain.periodic)
             }
         };
-        let grid = Grid::balanced(counts, &self.domain, &p.position);
+        let mut grid = Grid::balanced(counts, &self.domain, &p.position);
+        if grid.check_width(self.ghost_width()).is_err() {
+            // By count the planes crowd where the particles do: moved apart to a ghost layer
+            // (as a balance shift would be); refused only if no placement is thick enough.
+            balance::clamp_to_width(&mut grid, self.ghost_width());
+        }
         grid.check_width(self.ghost_width())?;
         if comm.size() > grid.len() {
             return Err(format!(
@@ -903,6 +913,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.reaction_force = Vec::new();
         self.reaction_spin = Vec::new();
         Ok(())
+    }
+
+    /// `--balance`: whether the cut planes move by count at a rebuild when the imbalance
+    /// passes the threshold (call after `set_grid`; nothing to do undecomposed).
+    pub fn set_balance(&mut self, spec: BalanceSpec) {
+        if let Some(d) = self.decomposition.as_mut() {
+            d.balance.threshold = spec.threshold();
+        }
     }
 
     /// The ghost layer: largest diameter plus the law's reach plus the skin.
@@ -969,12 +987,24 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let mean = counts.iter().sum::<usize>() as Real / counts.len().max(1) as Real;
         let most = counts.iter().copied().max().unwrap_or(0) as Real;
         let bytes = d.comm.sum(d.bytes_sent) as Real;
+        // What the start's planes would give the particles where they are now (those the
+        // next rebuild keeps).
+        let stop_on_lost = self.guard.settings.stop_on_lost;
+        let domain = &self.domain;
+        let keep = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
+        let b = &d.balance;
+        let static_now = balance::imbalance(&d.counts_over(&[&b.start], domain, &keep)[0]);
         Some(crate::run::DecompositionSummary {
             grid: d.grid.counts,
             ranks: d.comm.size(),
             subdomain_particles: counts,
             imbalance: if mean > 0.0 { most / mean } else { 1.0 },
             bytes_sent_between_ranks_per_step: bytes / self.steps.max(1) as Real,
+            balance_threshold: b.threshold,
+            shifts: b.shifts,
+            imbalance_max_after_first_shift: b.worst_after_first_shift,
+            static_imbalance: static_now,
+            static_imbalance_max: b.static_worst.max(static_now),
         })
     }
 

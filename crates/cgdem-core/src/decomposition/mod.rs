@@ -4,6 +4,8 @@
 //! skin thick. Four phases, one file each:
 //!
 //! - [`grid`]: the subdomain grid and its cut planes (by particle count);
+//! - [`balance`]: at a list rebuild, the cut planes move by count when the imbalance passes
+//!   a threshold (LAMMPS `fix balance ... shift`);
 //! - [`exchange`]: at a list rebuild, particles that left their subdomain move to the new
 //!   owner with every per-particle array that must travel (wall history, contact history
 //!   rows);
@@ -17,6 +19,7 @@
 //! Each phase packs what travels into buffers and unpacks them on the other side: threads in
 //! one process read them in place, MPI ranks send the same buffers ([`transport`]).
 
+pub mod balance;
 pub mod borders;
 pub mod exchange;
 pub mod forward;
@@ -25,6 +28,7 @@ pub mod list;
 pub mod step;
 pub mod transport;
 
+pub use balance::BalanceSpec;
 pub use grid::{choose_counts, Grid, GridSpec};
 pub use transport::Comm;
 

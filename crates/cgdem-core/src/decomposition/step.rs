@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::balance::{imbalance, Balance};
 use super::borders::borders;
 use super::exchange::exchange;
 use super::forward::{pack, unpack, States};
@@ -48,6 +49,8 @@ pub struct Decomposition<H, WH> {
     pub total: usize,
     /// Bytes this rank sent to other ranks (exchange, borders, forward) since the start.
     pub bytes_sent: u64,
+    /// Whether and how the cut planes follow the particles, and what it saw.
+    pub balance: Balance,
     buffers: Vec<Vec<States>>,
     /// Words each rank sends here in a forward, fixed between rebuilds.
     forward_counts: Option<Vec<usize>>,
@@ -90,6 +93,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             sub.n_owned += 1;
         }
         let mut d = Decomposition {
+            balance: Balance::new(grid.clone(), None),
             grid,
             subdomains,
             width,
@@ -138,8 +142,8 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             .filter(move |sub| comm.owns(sub.index, count))
     }
 
-    /// A list rebuild: histories into rows, exchange (dropping particles `keep` refuses),
-    /// borders, lists.
+    /// A list rebuild: histories into rows, the cut planes moved if the balance asks,
+    /// exchange (dropping particles `keep` refuses), borders, lists.
     pub fn rebuild(
         &mut self,
         domain: &Domain,
@@ -150,6 +154,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         self.owned_mut().for_each(|sub| {
             sub.rows = sub.list.rows(&sub.particles.id, sub.n_owned);
         });
+        self.rebalance(domain, keep);
         self.bytes_sent += exchange(
             &mut self.subdomains,
             &self.grid,
@@ -159,8 +164,17 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             &self.comm,
         );
         self.borders_and_lists(resort);
-        let here: usize = self.owned().map(|s| s.n_owned).sum();
-        self.total = self.comm.sum(here as u64) as usize;
+        let counts = self.owned_counts();
+        self.total = counts.iter().sum::<u64>() as usize;
+        let now = imbalance(&counts);
+        let b = &mut self.balance;
+        if b.shifts > 0 {
+            b.worst_after_first_shift = Some(b.worst_after_first_shift.unwrap_or(0.0).max(now));
+        }
+        if b.threshold.is_none() {
+            // The planes never moved: the owned counts are the static split's.
+            b.static_worst = b.static_worst.max(now);
+        }
     }
 
     /// The owned particles of all subdomains side by side (the world's arrays after a

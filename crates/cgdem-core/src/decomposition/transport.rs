@@ -170,6 +170,16 @@ impl Comm {
         }
     }
 
+    /// The element-wise sum of `v` over the ranks: exact in any order for integer counts
+    /// below 2^53, which is all it is used for.
+    #[allow(unused_variables)]
+    pub fn sum_each(&self, v: &mut [Real]) {
+        #[cfg(feature = "mpi")]
+        if let Some(m) = &self.mpi {
+            m.all_reduce(v, mpi::collective::SystemOperation::sum());
+        }
+    }
+
     /// Every rank's `mine`, in rank order.
     #[allow(unused_variables)]
     pub fn all_gather(&self, mine: Vec<Real>) -> Vec<Vec<Real>> {

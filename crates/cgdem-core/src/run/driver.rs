@@ -299,6 +299,7 @@ fn build_world<L: PairLaw, W: WallLaw>(
         world.set_grid(spec, options.comm.clone()).map_err(|e| {
             RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
         })?;
+        world.set_balance(options.balance);
     }
     Ok((world, n_inserted, n_body_particles))
 }

@@ -57,6 +57,9 @@ pub struct RunOptions {
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Split the box into these subdomains with ghost layers (`--grid`); None: one world.
     pub grid: Option<crate::decomposition::GridSpec>,
+    /// With `grid`: move the cut planes by count when the imbalance passes a threshold
+    /// (`--balance`; on at 1.1 by default).
+    pub balance: crate::decomposition::BalanceSpec,
     /// The MPI ranks a `--grid` run is spread over (`mpirun`); one process by default.
     pub comm: crate::decomposition::Comm,
     /// Write restart files (`--checkpoint-every`), see [`restart`].
@@ -304,6 +307,21 @@ pub struct DecompositionSummary {
     pub subdomain_particles: Vec<usize>,
     /// Most particles in one subdomain over the mean, at the end (1 is perfect balance).
     pub imbalance: Real,
+    /// `--balance`: the imbalance past which the cut planes moved at a rebuild (none: off).
+    #[serde(default)]
+    pub balance_threshold: Option<Real>,
+    /// Rebuilds at which the cut planes moved.
+    #[serde(default)]
+    pub shifts: u64,
+    /// The largest imbalance the subdomains had after a rebuild, from the first shift on.
+    #[serde(default)]
+    pub imbalance_max_after_first_shift: Option<Real>,
+    /// The imbalance the start's cut planes (by count, never moved) would give at the end.
+    #[serde(default)]
+    pub static_imbalance: Real,
+    /// The largest imbalance the start's cut planes gave or would have given at a rebuild.
+    #[serde(default)]
+    pub static_imbalance_max: Real,
     /// Bytes the ranks sent each other per step, averaged over the run (exchange, borders,
     /// forward; 0 in one process, where the threads read the buffers in place).
     pub bytes_sent_between_ranks_per_step: Real,
