@@ -9,7 +9,9 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use cgdem_core::coarse_graining::{coarse_grain_by, coarse_grain_warnings, CoarseGrainRule};
+use cgdem_core::coarse_graining::{
+    coarse_grain_by, coarse_grain_checks, CgSeverity, CoarseGrainRule,
+};
 use cgdem_core::geometry::accuracy::format_accuracy_table;
 use cgdem_core::geometry::screw_feeder::{self, ScrewFeederSpec};
 use cgdem_core::run::restart::{self, RestartLoaded};
@@ -50,11 +52,14 @@ impl RunInvocation {
     }
 }
 
-/// The coarse-graining rules as command-line values (`seed`, `bulk-viscosity`).
+/// The coarse-graining rules as command-line values (`seed`, `bulk-viscosity`,
+/// `scaled-particle`, `liggghts-pfm`).
 #[derive(Clone, Copy, ValueEnum)]
 enum CgRule {
     Seed,
     BulkViscosity,
+    ScaledParticle,
+    LiggghtsPfm,
 }
 
 impl From<CgRule> for CoarseGrainRule {
@@ -62,6 +67,8 @@ impl From<CgRule> for CoarseGrainRule {
         match rule {
             CgRule::Seed => CoarseGrainRule::Seed,
             CgRule::BulkViscosity => CoarseGrainRule::BulkViscosity,
+            CgRule::ScaledParticle => CoarseGrainRule::ScaledParticle,
+            CgRule::LiggghtsPfm => CoarseGrainRule::LiggghtsPfm,
         }
     }
 }
@@ -88,9 +95,12 @@ enum Command {
         /// Diameters grow by lambda, the particle count falls by lambda^3 (paper A Eq. 3-6).
         #[arg(long, default_value_t = 1)]
         lambda: u32,
-        /// Coarse-graining rule: `seed` (paper A: eps' = lambda^3 eps, gamma' = lambda^2 gamma)
-        /// or `bulk-viscosity` (eps' = lambda eps, gamma' = lambda gamma: keeps gamma/d, so
-        /// viscous flows keep their speed; see reference/COARSE_GRAINING.md).
+        /// Coarse-graining rule. WCA: `seed` (paper A: eps' = lambda^3 eps, gamma' = lambda^2
+        /// gamma) or `bulk-viscosity` (eps' = lambda eps, gamma' = lambda gamma: keeps gamma/d,
+        /// so viscous flows keep their speed). Hertz: `seed` (every contact force x lambda^2),
+        /// `scaled-particle` (the same material in larger particles) or `liggghts-pfm`
+        /// (LIGGGHTS-PFM's coarsegraining, cohesion scaled like the weight). What each keeps:
+        /// reference/COARSE_GRAINING.md.
         #[arg(long, value_enum, default_value_t = CgRule::Seed)]
         cg_rule: CgRule,
         /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
@@ -113,8 +123,9 @@ enum Command {
         /// radius, energy growing without work): warn once per guard and go on.
         #[arg(long)]
         keep_going: bool,
-        /// Refuse to coarse-grain where the scaling rule is inconsistent for the scene's
-        /// model (gravity, cohesion, rolling with Hertz), instead of warning.
+        /// Refuse to coarse-grain where the rule cannot keep what it states for a parameter of
+        /// the scene (e.g. the seed rule with van der Waals cohesion under gravity: the Bond
+        /// number), naming the rule and the parameter, instead of warning.
         #[arg(long)]
         strict: bool,
         /// Split the box into subdomains with ghost layers, each stepped on its own thread
@@ -881,16 +892,22 @@ fn main() -> ExitCode {
             let result = pool.install(|| {
                 load_scene(&case, &set, variant.as_deref(), seed)
                     .and_then(|scene| {
-                        let warnings = coarse_grain_warnings(&scene, lambda);
-                        if strict && !warnings.is_empty() {
+                        let checks = coarse_grain_checks(&scene, lambda, cg_rule);
+                        let refused: Vec<String> = checks
+                            .iter()
+                            .filter(|c| c.severity == CgSeverity::Inconsistent)
+                            .map(|c| format!("{}: {}", c.parameter, c.message))
+                            .collect();
+                        if strict && !refused.is_empty() {
                             return Err(format!(
-                                "{}: --strict: coarse-graining by lambda = {lambda} is inconsistent:\n  {}",
+                                "{}: --strict: the {} rule cannot keep this scene consistent at lambda = {lambda}:\n  {}",
                                 case.display(),
-                                warnings.join("\n  ")
+                                cg_rule.name(),
+                                refused.join("\n  ")
                             ));
                         }
-                        for w in &warnings {
-                            eprintln!("warning: coarse-graining: {w}");
+                        for c in &checks {
+                            eprintln!("warning: coarse-graining: {c}");
                         }
                         coarse_grain_by(&scene, lambda, cg_rule).map_err(|e| e.to_string())
                     })

@@ -281,3 +281,53 @@ fn a_scene_needing_more_memory_than_the_machine_has_is_refused_at_once() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(elapsed < std::time::Duration::from_secs(1), "{elapsed:?}");
 }
+
+/// `--strict` refuses what the rule cannot keep, naming the rule and the parameter; a rule
+/// not defined for the model is refused with the ones that are. Both before any step.
+#[test]
+fn strict_names_the_rule_and_the_parameter_it_cannot_keep() {
+    let run = |rule: &str| {
+        cgdem()
+            .args([
+                "run",
+                "validation/cases/packing_vdw.toml",
+                "--lambda",
+                "4",
+                "--cg-rule",
+                rule,
+                "--strict",
+                "--quiet",
+                "--out",
+                std::env::temp_dir()
+                    .join(format!("cgdem-strict-{}-{rule}", std::process::id()))
+                    .to_str()
+                    .unwrap(),
+            ])
+            .output()
+            .unwrap()
+    };
+    let out = run("seed");
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--strict: the seed rule")
+            && stderr.contains("hamaker_constant")
+            && stderr.contains("Bond number"),
+        "{stderr}"
+    );
+    let out = run("scaled-particle");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success()
+            && stderr.contains("the scaled-particle rule")
+            && stderr.contains("gamma_n_yang"),
+        "{stderr}"
+    );
+    let out = run("bulk-viscosity");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("\"hertz\"") && stderr.contains("liggghts-pfm"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"));
+}

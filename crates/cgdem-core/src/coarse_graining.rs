@@ -22,8 +22,12 @@ use crate::timestep::TimeStepRequest;
 pub enum CoarseGrainError {
     #[error("lambda = {0} is not allowed: lambda must be a power of two (1, 2, 4, 8, ...)")]
     NotPowerOfTwo(u32),
-    #[error("the {0:?} coarse-graining rule is defined for the seed's WCA model only; use the seed rule for Hertz scenes")]
-    RuleNotDefined(CoarseGrainRule),
+    #[error("the {} coarse-graining rule is not defined for model = \"{model}\" scenes; use {allowed} (reference/COARSE_GRAINING.md)", .rule.name())]
+    RuleNotDefined {
+        rule: CoarseGrainRule,
+        model: &'static str,
+        allowed: String,
+    },
     #[error(
         "{file}: at lambda = {lambda} the particles ({diameter:.4e} m) no longer fit: {reason}"
     )]
@@ -37,16 +41,37 @@ pub enum CoarseGrainError {
     GivenParticles { file: String, lambda: u32 },
 }
 
-/// Hertz parameters under `phi'(r) = lambda^3 phi(r / lambda)`, i.e. every contact force
-/// `F'(x') = lambda^2 F(x' / lambda)` at the same velocities (reference/COARSE_GRAINING_HERTZ.md):
-/// Young's modulus, Poisson's ratio, restitution, friction and rolling friction unchanged;
-/// Yang's `gamma_n` (s) times lambda; Hamaker constant times lambda^3, `h_min` and the
-/// cohesion cut-off times lambda.
+/// Hertz parameters under the seed's rule, `phi'(r) = lambda^3 phi(r / lambda)`, i.e. every
+/// contact force `F'(x') = lambda^2 F(x' / lambda)` at the same velocities
+/// (reference/COARSE_GRAINING_HERTZ.md): Young's modulus, Poisson's ratio, restitution,
+/// friction and rolling friction unchanged; Yang's `gamma_n` (s) times lambda; Hamaker
+/// constant times lambda^3, `h_min` and the cohesion cut-off times lambda.
 pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
+    coarse_grain_hertz_by(h, l, CoarseGrainRule::Seed)
+}
+
+/// Hertz parameters under `rule` (reference/COARSE_GRAINING.md, "Hertz-Mindlin rules"). The
+/// elastic constants, restitution, friction and rolling friction are kept by every rule; they
+/// differ in Yang's `gamma_n` and in the van der Waals cohesion:
+///
+/// | rule | `gamma_n` (Yang) | Hamaker constant | `h_min`, cut-off | vdW force at the scaled gap |
+/// |---|---|---|---|---|
+/// | seed | x lambda | x lambda^3 | x lambda | x lambda^2 (like the contact forces) |
+/// | scaled-particle | unchanged | unchanged | unchanged | same material: x lambda near contact |
+/// | liggghts-pfm | x lambda | x lambda^4 | x lambda | x lambda^3 (like the weight) |
+///
+/// Rules other than these three are not defined for Hertz: the scene is returned unchanged
+/// (`coarse_grain_by` refuses them first).
+pub fn coarse_grain_hertz_by(h: &HertzSettings, l: f64, rule: CoarseGrainRule) -> HertzSettings {
+    let (damping, hamaker) = match rule {
+        CoarseGrainRule::Seed => (1, 3),
+        CoarseGrainRule::LiggghtsPfm => (1, 4),
+        CoarseGrainRule::ScaledParticle | CoarseGrainRule::BulkViscosity => return h.clone(),
+    };
     let mut out = h.clone();
     if let HertzDampingKind::Yang { gamma_n } = h.damping {
         out.damping = HertzDampingKind::Yang {
-            gamma_n: gamma_n * l,
+            gamma_n: gamma_n * l.powi(damping),
         };
     }
     if let CohesionKind::VanDerWaals {
@@ -56,7 +81,7 @@ pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
     } = h.cohesion
     {
         out.cohesion = CohesionKind::VanDerWaals {
-            hamaker_constant: hamaker_constant * l.powi(3),
+            hamaker_constant: hamaker_constant * l.powi(hamaker),
             h_min: h_min * l,
             cutoff: cutoff.map(|c| c * l),
         };
@@ -64,30 +89,80 @@ pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
     out
 }
 
-/// Where coarse-graining the scene by `lambda` is not consistent, with the reason (like
-/// LIGGGHTS-PFM's model check). Empty for lambda = 1 and for the seed's WCA scenes, whose
-/// rule is paper A's.
-pub fn coarse_grain_warnings(scene: &Scene, lambda: u32) -> Vec<String> {
-    let mut warnings = Vec::new();
+/// How far a rule departs from what it keeps for a parameter of the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CgSeverity {
+    /// A known cost of every Hertz rule, stated in the documentation: a warning.
+    Note,
+    /// The rule cannot keep what it states for this parameter: a warning, an error under
+    /// `cgdem run --strict`.
+    Inconsistent,
+}
+
+/// One finding of [`coarse_grain_checks`]: the rule, the scene parameter and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CgCheck {
+    pub rule: CoarseGrainRule,
+    /// The scene's name of the parameter (`hamaker_constant`, `gamma_n_yang`, `gravity`,
+    /// `rolling_friction`).
+    pub parameter: &'static str,
+    pub severity: CgSeverity,
+    pub message: String,
+}
+
+impl std::fmt::Display for CgCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} rule, {}: {}",
+            self.rule.name(),
+            self.parameter,
+            self.message
+        )
+    }
+}
+
+/// Where coarse-graining the scene by `lambda` under `rule` is not consistent, like
+/// LIGGGHTS-PFM's `model_check`. Empty for lambda = 1, for the seed's WCA scenes (whose rules
+/// are exact similarities) and for a rule not defined for the scene's model (refused by
+/// `coarse_grain_by`).
+pub fn coarse_grain_checks(scene: &Scene, lambda: u32, rule: CoarseGrainRule) -> Vec<CgCheck> {
+    let mut checks = Vec::new();
     let ContactSettings::Hertz(h) = &scene.contact else {
-        return warnings;
+        return checks;
     };
-    if lambda <= 1 {
-        return warnings;
+    if lambda <= 1 || !rule.defined_for("hertz") {
+        return checks;
     }
     let l = lambda as f64;
-    if scene.gravity.length() > 0.0 {
-        warnings.push(format!("gravity: weights scale as lambda^3 but contact forces as lambda^2, so weight/contact-force ratios (overlap under load, Bond number) grow {l}x at lambda = {lambda}"));
-    }
-    if let CohesionKind::VanDerWaals { .. } = h.cohesion {
-        if scene.gravity.length() > 0.0 {
-            warnings.push(format!("cohesion: the granular Bond number F_vdw(h_min) / (m g) falls {l}x at lambda = {lambda}; cohesion-controlled structure (porosity of fine powders) is not preserved"));
-        }
+    let gravity = scene.gravity.length() > 0.0;
+    let mut push = |parameter, severity, message: String| {
+        checks.push(CgCheck {
+            rule,
+            parameter,
+            severity,
+            message,
+        })
+    };
+    if gravity {
+        push("gravity", CgSeverity::Note, format!("weights scale as lambda^3 but Hertz contact forces at the scaled overlap as lambda^2 (Young's modulus is kept), so a contact under load overlaps lambda^(2/3) = {:.2} times more of its diameter at lambda = {lambda}", l.powf(2.0 / 3.0)));
     }
     if h.rolling != RollingKind::None {
-        warnings.push(format!("rolling: the torque mu_r R_eff |F_n| scales like r x F (lambda^3) and is formally consistent, but one parcel stands for lambda^3 = {} real particles whose rolling contacts (and the shape effects mu_r stands for) are not resolved; mu_r calibrated on real particles is unverified for parcels at lambda = {lambda} (LIGGGHTS flags rolling models under coarse-graining)", l.powi(3)));
+        push("rolling_friction", CgSeverity::Note, format!("mu_r is kept: the rolling torque mu_r R_eff |F_n| keeps its ratio to r x F and, where contact forces carry the weight, to the weight's torque m g R; but one parcel stands for lambda^3 = {} real particles whose rolling contacts (and the shapes mu_r stands for) are not resolved, so mu_r calibrated on real particles is unverified for parcels (LIGGGHTS-PFM flags every rolling model under coarsegraining)", l.powi(3)));
     }
-    warnings
+    if let CohesionKind::VanDerWaals { .. } = h.cohesion {
+        match (rule, gravity) {
+            (CoarseGrainRule::Seed, true) => push("hamaker_constant", CgSeverity::Inconsistent, format!("the Hamaker constant scales as lambda^3 so the cohesion follows the contact forces (lambda^2), not the weight (lambda^3): the Bond number F_vdw(h_min) / (m g) falls {l}x at lambda = {lambda}, and cohesion-controlled structure (the porosity of fine powders) is not kept; the liggghts-pfm rule keeps it")),
+            (CoarseGrainRule::ScaledParticle, _) => push("hamaker_constant", CgSeverity::Inconsistent, format!("same material: the van der Waals force near contact grows only as R (lambda) while contact forces grow as lambda^2 and weights as lambda^3: the Bond number F_vdw(h_min) / (m g) falls {}x at lambda = {lambda}", l * l)),
+            (CoarseGrainRule::LiggghtsPfm, false) => push("hamaker_constant", CgSeverity::Inconsistent, format!("the rule scales the cohesion like the weight (Hamaker constant x lambda^4) to keep the Bond number; without gravity there is no weight, and the cohesion only grows {l}x relative to the contact forces at lambda = {lambda}")),
+            (CoarseGrainRule::LiggghtsPfm, true) => push("hamaker_constant", CgSeverity::Note, format!("the Bond number is kept (Hamaker constant x lambda^4, h_min x lambda), but the cohesion, like the weight, grows lambda times relative to the unchanged elastic stiffness: cohesive overlaps per diameter grow lambda^(2/3) = {:.2} times at lambda = {lambda}", l.powf(2.0 / 3.0))),
+            _ => {}
+        }
+    }
+    if let (CoarseGrainRule::ScaledParticle, HertzDampingKind::Yang { .. }) = (rule, h.damping) {
+        push("gamma_n_yang", CgSeverity::Inconsistent, format!("same material: Yang's gamma_n is kept, so the dashpot force at the same velocity grows lambda times while a similar collision needs lambda^2: the restitution of a parcel pair differs from the fine pair's at lambda = {lambda} (seed and liggghts-pfm scale gamma_n by lambda)"));
+    }
+    checks
 }
 
 /// Returns the scene coarse-grained by `lambda` relative to its current level, by the
@@ -112,7 +187,17 @@ pub fn coarse_grain_by(
         });
     }
     let l = lambda as f64;
-    let (energy, damping, time) = rule.exponents();
+    let model = match &scene.contact {
+        ContactSettings::Wca(_) => "wca",
+        ContactSettings::Hertz(_) => "hertz",
+    };
+    if !rule.defined_for(model) {
+        return Err(CoarseGrainError::RuleNotDefined {
+            rule,
+            model,
+            allowed: CoarseGrainRule::names_for(model),
+        });
+    }
     let mut out = scene.clone();
     out.lambda = scene.lambda * lambda;
     out.cg_rule = rule;
@@ -120,19 +205,19 @@ pub fn coarse_grain_by(
         s.diameter *= l;
     }
     out.contact = match &scene.contact {
-        ContactSettings::Wca(w) => ContactSettings::Wca(WcaSettings {
-            epsilon: w.epsilon * l.powi(energy),
-            sigma: w.sigma * l,
-            gamma_n: w.gamma_n * l.powi(damping),
-            gamma_t: w.gamma_t * l.powi(damping),
-        }),
-        ContactSettings::Hertz(_) if rule != CoarseGrainRule::Seed => {
-            return Err(CoarseGrainError::RuleNotDefined(rule));
+        ContactSettings::Wca(w) => {
+            let (energy, damping) = rule.wca_exponents().expect("a WCA rule");
+            ContactSettings::Wca(WcaSettings {
+                epsilon: w.epsilon * l.powi(energy),
+                sigma: w.sigma * l,
+                gamma_n: w.gamma_n * l.powi(damping),
+                gamma_t: w.gamma_t * l.powi(damping),
+            })
         }
-        ContactSettings::Hertz(h) => ContactSettings::Hertz(coarse_grain_hertz(h, l)),
+        ContactSettings::Hertz(h) => ContactSettings::Hertz(coarse_grain_hertz_by(h, l, rule)),
     };
     if let TimeStepRequest::Explicit(dt) = scene.time_step {
-        out.time_step = TimeStepRequest::Explicit(dt * l.powi(time));
+        out.time_step = TimeStepRequest::Explicit(dt * l.powi(rule.time_exponent()));
     }
     for ins in &mut out.insertions {
         if let InsertAmount::Lattice(lattice) = &mut ins.amount {
@@ -364,21 +449,207 @@ mod hertz_tests {
         assert!((h1 / h0 - l).abs() < 1e-12);
     }
 
+    fn case(name: &str) -> Scene {
+        Scene::load(
+            &std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+                .join("validation/cases")
+                .join(name),
+        )
+        .unwrap()
+    }
+
+    fn vdw(h: &HertzSettings) -> (f64, f64, Option<f64>) {
+        match h.cohesion {
+            CohesionKind::VanDerWaals {
+                hamaker_constant,
+                h_min,
+                cutoff,
+            } => (hamaker_constant, h_min, cutoff),
+            CohesionKind::None => panic!("vdw lost"),
+        }
+    }
+
+    fn yang(h: &HertzSettings) -> f64 {
+        match h.damping {
+            HertzDampingKind::Yang { gamma_n } => gamma_n,
+            HertzDampingKind::Restitution => panic!("yang lost"),
+        }
+    }
+
+    /// The exact factor of each parameter under each Hertz rule at lambda = 2 and 4.
     #[test]
-    fn hertz_scenes_warn_where_coarse_graining_is_inconsistent_and_the_seed_does_not() {
-        let case = |name: &str| {
-            Scene::load(
-                &std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-                    .join("validation/cases")
-                    .join(name),
-            )
-            .unwrap()
+    fn each_hertz_rule_scales_each_parameter_by_its_stated_power_of_lambda() {
+        let mut h = paper_b();
+        h.cohesion = CohesionKind::VanDerWaals {
+            hamaker_constant: 6.5e-20,
+            h_min: 4e-10,
+            cutoff: Some(1e-8),
         };
+        // (rule, lambda, gamma_n, Hamaker, h_min and cut-off factors)
+        let expected = [
+            (CoarseGrainRule::Seed, 2.0, 2.0, 8.0, 2.0),
+            (CoarseGrainRule::Seed, 4.0, 4.0, 64.0, 4.0),
+            (CoarseGrainRule::ScaledParticle, 2.0, 1.0, 1.0, 1.0),
+            (CoarseGrainRule::ScaledParticle, 4.0, 1.0, 1.0, 1.0),
+            (CoarseGrainRule::LiggghtsPfm, 2.0, 2.0, 16.0, 2.0),
+            (CoarseGrainRule::LiggghtsPfm, 4.0, 4.0, 256.0, 4.0),
+        ];
+        let (a0, h0, c0) = vdw(&h);
+        for (rule, l, gamma, hamaker, length) in expected {
+            let g = coarse_grain_hertz_by(&h, l, rule);
+            let kept = |g: &HertzSettings| {
+                (
+                    g.youngs_modulus,
+                    g.poisson_ratio,
+                    g.restitution,
+                    g.friction,
+                    g.rolling_friction,
+                    g.rolling,
+                    g.tangential,
+                )
+            };
+            assert_eq!(
+                kept(&g),
+                kept(&h),
+                "{rule:?}: elastic, friction, rolling kept"
+            );
+            let (a1, h1, c1) = vdw(&g);
+            assert_eq!(yang(&g), yang(&h) * gamma, "{rule:?} lambda {l}: gamma_n");
+            assert_eq!(a1, a0 * hamaker, "{rule:?} lambda {l}: Hamaker constant");
+            assert_eq!(h1, h0 * length, "{rule:?} lambda {l}: h_min");
+            assert_eq!(c1, c0.map(|c| c * length), "{rule:?} lambda {l}: cut-off");
+        }
+    }
+
+    /// What each rule keeps, at the scaled state x' = lambda x: the seed's rule every contact
+    /// force x lambda^2; liggghts-pfm the van der Waals force x lambda^3, like the weight (the
+    /// Bond number); scaled-particle the material (vdW force x lambda near contact only).
+    #[test]
+    fn the_vdw_force_at_the_scaled_gap_follows_the_contact_forces_the_weight_or_the_material() {
+        use crate::contact::cohesion::vdw_force;
+        let h = paper_b();
+        let (a0, h0, _) = vdw(&h);
+        let r = 2.5e-5;
+        for l in [2.0, 4.0] {
+            for (rule, power) in [
+                (CoarseGrainRule::Seed, 2),
+                (CoarseGrainRule::LiggghtsPfm, 3),
+            ] {
+                let (a1, h1, _) = vdw(&coarse_grain_hertz_by(&h, l, rule));
+                for gap in [h0, 3.0 * h0, 30.0 * h0] {
+                    let ratio = vdw_force(a1, l * r, l * r, l * gap) / vdw_force(a0, r, r, gap);
+                    assert!((ratio / l.powi(power) - 1.0).abs() < 1e-12, "{rule:?}");
+                }
+                assert!((h1 / h0 - l).abs() < 1e-15);
+            }
+            let (a1, h1, _) = vdw(&coarse_grain_hertz_by(
+                &h,
+                l,
+                CoarseGrainRule::ScaledParticle,
+            ));
+            let ratio = vdw_force(a1, l * r, l * r, h1) / vdw_force(a0, r, r, h0);
+            assert!(
+                (ratio / l - 1.0).abs() < 1e-4,
+                "near contact F ~ A R / h^2: {ratio}"
+            );
+        }
+    }
+
+    #[test]
+    fn rules_are_refused_for_the_model_they_are_not_defined_for() {
+        let wca = case("aor_collapse.toml");
         let hertz = case("hertz_settle.toml");
-        assert!(coarse_grain_warnings(&hertz, 1).is_empty());
-        let warnings = coarse_grain_warnings(&hertz, 2);
-        assert_eq!(warnings.len(), 2, "{warnings:?}");
-        assert!(warnings[0].starts_with("gravity") && warnings[1].starts_with("rolling"));
-        assert!(coarse_grain_warnings(&case("aor_collapse.toml"), 8).is_empty());
+        for rule in [
+            CoarseGrainRule::ScaledParticle,
+            CoarseGrainRule::LiggghtsPfm,
+        ] {
+            let e = coarse_grain_by(&wca, 2, rule).unwrap_err().to_string();
+            assert!(
+                e.contains(rule.name()) && e.contains("\"wca\"") && e.contains("bulk-viscosity"),
+                "{e}"
+            );
+            assert!(coarse_grain_by(&hertz, 2, rule).is_ok());
+        }
+        let e = coarse_grain_by(&hertz, 2, CoarseGrainRule::BulkViscosity)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("bulk-viscosity") && e.contains("liggghts-pfm"),
+            "{e}"
+        );
+    }
+
+    /// The collapse's scene (restitution dashpot, no cohesion) gets the same parameters under
+    /// every Hertz rule, so the fidelity suite runs it under one.
+    #[test]
+    fn without_yang_damping_or_cohesion_the_hertz_rules_coincide() {
+        let scene = case("aor_hertz.toml");
+        let seed = coarse_grain_by(&scene, 4, CoarseGrainRule::Seed).unwrap();
+        for rule in [
+            CoarseGrainRule::ScaledParticle,
+            CoarseGrainRule::LiggghtsPfm,
+        ] {
+            let other = coarse_grain_by(&scene, 4, rule).unwrap();
+            assert_eq!(other.contact, seed.contact);
+            assert_eq!(other.species, seed.species);
+            assert_eq!(other.time_step, seed.time_step);
+        }
+    }
+
+    #[test]
+    fn checks_name_the_rule_and_the_parameter_and_strict_refuses_only_inconsistencies() {
+        let settle = case("hertz_settle.toml");
+        assert!(coarse_grain_checks(&settle, 1, CoarseGrainRule::Seed).is_empty());
+        let notes = coarse_grain_checks(&settle, 2, CoarseGrainRule::Seed);
+        let names: Vec<_> = notes.iter().map(|c| (c.parameter, c.severity)).collect();
+        assert_eq!(
+            names,
+            [
+                ("gravity", CgSeverity::Note),
+                ("rolling_friction", CgSeverity::Note)
+            ]
+        );
+        assert!(
+            coarse_grain_checks(&case("aor_collapse.toml"), 8, CoarseGrainRule::Seed).is_empty()
+        );
+        let packing = case("packing_vdw.toml");
+        let inconsistent = |rule| {
+            coarse_grain_checks(&packing, 4, rule)
+                .into_iter()
+                .filter(|c| c.severity == CgSeverity::Inconsistent)
+                .map(|c| c.parameter)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(inconsistent(CoarseGrainRule::Seed), ["hamaker_constant"]);
+        assert_eq!(
+            inconsistent(CoarseGrainRule::ScaledParticle),
+            ["hamaker_constant", "gamma_n_yang"]
+        );
+        assert!(inconsistent(CoarseGrainRule::LiggghtsPfm).is_empty());
+        let c = &coarse_grain_checks(&packing, 4, CoarseGrainRule::Seed)
+            .into_iter()
+            .find(|c| c.severity == CgSeverity::Inconsistent)
+            .unwrap();
+        let text = c.to_string();
+        assert!(
+            text.starts_with("seed rule, hamaker_constant:") && text.contains("4x"),
+            "{text}"
+        );
+        // Without gravity the Bond-number law has no weight to follow.
+        let mut weightless = packing.clone();
+        weightless.gravity = crate::math::Vec3::ZERO;
+        assert_eq!(
+            inconsistent_of(&weightless, CoarseGrainRule::LiggghtsPfm),
+            ["hamaker_constant"]
+        );
+        assert!(inconsistent_of(&weightless, CoarseGrainRule::Seed).is_empty());
+    }
+
+    fn inconsistent_of(scene: &Scene, rule: CoarseGrainRule) -> Vec<&'static str> {
+        coarse_grain_checks(scene, 4, rule)
+            .into_iter()
+            .filter(|c| c.severity == CgSeverity::Inconsistent)
+            .map(|c| c.parameter)
+            .collect()
     }
 }

@@ -96,6 +96,8 @@ pub struct Targets {
     pub t_half: f64,
     /// Absolute porosity difference.
     pub porosity: f64,
+    /// Relative difference of the mean pore diameter in particle diameters.
+    pub pore_size: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -130,6 +132,7 @@ pub(super) struct RawSweep {
     mass_flow_target: Option<f64>,
     t_half_target: Option<f64>,
     porosity_target: Option<f64>,
+    pore_size_target: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -269,6 +272,7 @@ impl AccuracySweep {
                 mass_flow: target("mass_flow_target", raw.mass_flow_target, 0.05)?,
                 t_half: target("t_half_target", raw.t_half_target, 0.1)?,
                 porosity: target("porosity_target", raw.porosity_target, 0.02)?,
+                pore_size: target("pore_size_target", raw.pore_size_target, 0.1)?,
             },
         })
     }
@@ -349,6 +353,13 @@ pub struct AccuracyPoint {
     /// |porosity - the reference run's|.
     #[serde(default)]
     pub porosity_error: Option<f64>,
+    /// Mean pore diameter of a packing (`packing.mean_pore_diameter_m`) over the diameter of
+    /// the run's particles (parcels): pores of a similar packing scale with its particles.
+    #[serde(default)]
+    pub pore_diameter_d: Option<f64>,
+    /// |pore_diameter_d / the reference run's - 1|.
+    #[serde(default)]
+    pub pore_size_error: Option<f64>,
 }
 
 /// The cheapest point within a target error, per case, code and error measure.
@@ -388,16 +399,18 @@ pub enum Measure {
     Eq7,
     THalf,
     Porosity,
+    PoreSize,
 }
 
 impl Measure {
-    pub const ALL: [Measure; 6] = [
+    pub const ALL: [Measure; 7] = [
         Measure::Angle,
         Measure::Profile,
         Measure::MassFlow,
         Measure::Eq7,
         Measure::THalf,
         Measure::Porosity,
+        Measure::PoreSize,
     ];
 
     /// The run's error under this measure.
@@ -409,6 +422,7 @@ impl Measure {
             Measure::Eq7 => p.eq7_error,
             Measure::THalf => p.t_half_error,
             Measure::Porosity => p.porosity_error,
+            Measure::PoreSize => p.pore_size_error,
         }
     }
 
@@ -421,6 +435,7 @@ impl Measure {
             Measure::Eq7 => "mass_flow_eq7",
             Measure::THalf => "t_half",
             Measure::Porosity => "porosity",
+            Measure::PoreSize => "pore_size",
         }
     }
 
@@ -436,6 +451,7 @@ impl Measure {
             Measure::Eq7 => "mass flow vs Eq. (7)",
             Measure::THalf => "t_half vs reference",
             Measure::Porosity => "porosity vs reference",
+            Measure::PoreSize => "pore size (in diameters) vs reference",
         }
     }
 
@@ -447,6 +463,7 @@ impl Measure {
             Measure::Eq7 => "eq7_error",
             Measure::THalf => "t_half_error",
             Measure::Porosity => "porosity_error",
+            Measure::PoreSize => "pore_size_error",
         }
     }
 
@@ -458,6 +475,7 @@ impl Measure {
             Measure::Eq7 => "|Q / Q_Eq.(7) - 1| [-]",
             Measure::THalf => "|t_half / t_half,reference - 1| [-]",
             Measure::Porosity => "|porosity - reference| [-]",
+            Measure::PoreSize => "|pore diameter / d over the reference's - 1| [-]",
         }
     }
 
@@ -468,6 +486,7 @@ impl Measure {
             Measure::MassFlow | Measure::Eq7 => t.mass_flow,
             Measure::THalf => t.t_half,
             Measure::Porosity => t.porosity,
+            Measure::PoreSize => t.pore_size,
         }
     }
 
@@ -723,6 +742,7 @@ fn run_point(
     if record.status == Outcome::Ok
         && record.repose_angle_deg.is_none()
         && summary["conveying"]["mass_flow_kg_s"].as_f64().is_none()
+        && summary["packing"]["porosity"].as_f64().is_none()
     {
         record.status = Outcome::Failed;
         record.reason = Some(format!(
@@ -773,6 +793,11 @@ fn run_point(
             .as_f64()
             .filter(|v| ok && v.is_finite()),
         porosity_error: None,
+        pore_diameter_d: summary["packing"]["mean_pore_diameter_m"]
+            .as_f64()
+            .map(|pore| pore / (scene.max_diameter() * lambda as f64))
+            .filter(|v| ok && v.is_finite() && *v > 0.0),
+        pore_size_error: None,
     }
 }
 
@@ -807,6 +832,7 @@ pub(crate) fn measure(points: &mut [AccuracyPoint]) {
         p.mass_flow_error = difference(Measure::MassFlow, p, r);
         p.t_half_error = difference(Measure::THalf, p, r);
         p.porosity_error = difference(Measure::Porosity, p, r);
+        p.pore_size_error = difference(Measure::PoreSize, p, r);
     }
 }
 
@@ -824,6 +850,7 @@ fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
         Measure::Eq7 => finite((p.eq7_error? - r.eq7_error?).abs()),
         Measure::THalf => finite((p.t_half_s? / r.t_half_s? - 1.0).abs()),
         Measure::Porosity => finite((p.porosity? - r.porosity?).abs()),
+        Measure::PoreSize => finite((p.pore_diameter_d? / r.pore_diameter_d? - 1.0).abs()),
     }
 }
 
@@ -992,6 +1019,8 @@ fn write_sweep_section(
         "t_half_error",
         "porosity",
         "porosity_error",
+        "pore_diameter_d",
+        "pore_size_error",
     ]);
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
@@ -1005,9 +1034,10 @@ fn write_sweep_section(
                 Cell::fail(format!("failed: {}", p.reason.clone().unwrap_or_default()))
             }
         };
-        let result = match (p.repose_angle_deg, p.mass_flow_kg_s) {
-            (Some(a), _) => format!("{a:.2} deg"),
-            (_, Some(q)) => format!("{q:.3} kg/s"),
+        let result = match (p.repose_angle_deg, p.mass_flow_kg_s, p.porosity) {
+            (Some(a), _, _) => format!("{a:.2} deg"),
+            (_, Some(q), _) => format!("{q:.3} kg/s"),
+            (_, _, Some(e)) => format!("porosity {e:.4}"),
             _ => "-".into(),
         };
         table.row(
@@ -1055,6 +1085,8 @@ fn write_sweep_section(
             o(p.t_half_error),
             o(p.porosity),
             o(p.porosity_error),
+            o(p.pore_diameter_d),
+            o(p.pore_size_error),
         ]);
     }
     std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
@@ -1141,8 +1173,133 @@ fn write_sweep_section(
         ]);
     }
     sub.table(choice);
+    if sweep.series.iter().any(|s| s.knob == Knob::Lambda) {
+        write_matrix(sub, case, &measures, &sweep.targets, points, dir)?;
+    }
     sub.table(table);
     Ok(cheapest)
+}
+
+/// The coarse-graining matrix of a sweep over lambda (cgdem's runs): for each error measure,
+/// each lambda and rule with its mean error over seeds, its spread (as `cgdem advise` counts
+/// it) and what it saves against the fine reference; a table and `matrix.csv`.
+fn write_matrix(
+    sub: &mut Section,
+    case: &str,
+    measures: &[Measure],
+    targets: &Targets,
+    points: &[AccuracyPoint],
+    dir: &Path,
+) -> Result<(), ValidateError> {
+    use crate::advise::SPREAD_STANDARD_ERRORS;
+    let code = Code::Cgdem;
+    let all = settings(code, points);
+    let Some(reference) = all.iter().find(|s| s.series == "reference") else {
+        return Ok(());
+    };
+    let mean_of = |s: &Setting, f: fn(&AccuracyPoint) -> Option<f64>| {
+        let v: Vec<f64> = s.runs.iter().filter_map(|p| f(p)).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    let reference_steps = mean_of(reference, |p| p.particle_steps);
+    let reference_wall = mean_of(reference, |p| p.wall_s);
+    let mut table = Table::new([
+        "quantity",
+        "rule",
+        "lambda",
+        "particles",
+        "error (mean +- spread, seeds)",
+        "within target",
+        "particle-steps saved",
+        "wall time saved",
+    ])
+    .caption(format!(
+        "Coarse-graining matrix: each level and rule against the fine reference ({}, rule {}), error = mean over seeds, spread = {SPREAD_STANDARD_ERRORS} standard errors of the mean (what `cgdem advise` adds to the mean); within target when mean + spread is. Savings: the reference's mean particle-steps (wall time) over the setting's. CSV: matrix.csv beside the figures.",
+        reference.setting,
+        reference.runs[0].cg_rule.name()
+    ));
+    let mut csv = CsvBuffer::new([
+        "case",
+        "quantity",
+        "cg_rule",
+        "lambda",
+        "setting",
+        "seeds",
+        "n_particles",
+        "error_mean",
+        "error_se",
+        "error_reach",
+        "target",
+        "within_target",
+        "particle_steps",
+        "wall_s",
+        "saving_particle_steps",
+        "saving_wall",
+    ]);
+    let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+    for &m in measures {
+        for s in all.iter().filter(|s| {
+            s.series.starts_with("lambda") || (s.series == "reference" && !m.against_reference())
+        }) {
+            let Some(mean) = s.mean(m, Cost::ParticleSteps) else {
+                continue;
+            };
+            let spread = mean.se.map(|se| SPREAD_STANDARD_ERRORS * se);
+            let reach = mean.error + spread.unwrap_or(0.0);
+            let target = m.target(targets);
+            let wall = mean_of(s, |p| p.wall_s);
+            let particles = mean_of(s, |p| p.n_particles.map(|n| n as f64));
+            let saving_steps = reference_steps.map(|r| r / mean.cost);
+            let saving_wall = reference_wall.zip(wall).map(|(r, w)| r / w);
+            let first = s.runs[0];
+            table.row([
+                Cell::text(m.quantity()),
+                Cell::text(first.cg_rule.name()),
+                Cell::num(first.lambda.to_string()),
+                Cell::num(particles.map_or("-".into(), |n| format!("{n:.0}"))),
+                Cell::num(format!(
+                    "{}{} ({})",
+                    m.format(mean.error),
+                    spread.map_or(" (spread unknown)".into(), |v| format!(
+                        " +- {}",
+                        m.format(v)
+                    )),
+                    mean.n
+                )),
+                if reach <= target {
+                    Cell::pass(format!("yes ({})", m.format(target)))
+                } else {
+                    Cell::fail(format!("no ({})", m.format(target)))
+                },
+                Cell::num(saving_steps.map_or("-".into(), |v| format!("{v:.1}x"))),
+                Cell::num(saving_wall.map_or("-".into(), |v| format!("{v:.1}x"))),
+            ]);
+            csv.row([
+                case.to_string(),
+                m.quantity().to_string(),
+                first.cg_rule.name().to_string(),
+                first.lambda.to_string(),
+                s.setting.replace(',', ";"),
+                mean.n.to_string(),
+                o(particles),
+                o(Some(mean.error)),
+                o(mean.se),
+                o(Some(reach)),
+                o(Some(target)),
+                (reach <= target).to_string(),
+                o(Some(mean.cost)),
+                o(wall),
+                o(saving_steps),
+                o(saving_wall),
+            ]);
+        }
+    }
+    let path = dir.join("matrix.csv");
+    csv.bytes()
+        .and_then(|bytes| write_atomic(&path, bytes))
+        .map_err(|e| output_error(&path, e))?;
+    sub.table(table);
+    Ok(())
 }
 
 fn measure_named(name: &str) -> Measure {
@@ -1381,6 +1538,8 @@ pub(crate) mod tests {
             t_half_error: None,
             porosity: None,
             porosity_error: None,
+            pore_diameter_d: None,
+            pore_size_error: None,
         }
     }
 
@@ -1402,9 +1561,14 @@ pub(crate) mod tests {
         points[3].t_half_s = Some(1.2);
         points[0].porosity = Some(0.40);
         points[3].porosity = Some(0.41);
+        // Pores of 0.8 diameters in the reference, 0.6 in the point: 25% smaller.
+        points[0].pore_diameter_d = Some(0.8);
+        points[3].pore_diameter_d = Some(0.6);
         measure(&mut points);
         assert!((points[3].t_half_error.unwrap() - 0.2).abs() < 1e-12);
         assert!((points[3].porosity_error.unwrap() - 0.01).abs() < 1e-12);
+        assert!((points[3].pore_size_error.unwrap() - 0.25).abs() < 1e-12);
+        assert_eq!(points[4].pore_size_error, None);
         assert_eq!(points[4].t_half_error, None);
         // Against the reference with the same seed: 0.5, 0.2, 0.5 (against seed 1's
         // reference alone they would be 0.5, 1.2, 1.0).
@@ -1431,6 +1595,7 @@ pub(crate) mod tests {
             mass_flow: 0.05,
             t_half: 0.1,
             porosity: 0.02,
+            pore_size: 0.1,
         };
         let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &targets, &points);
         assert_eq!(c.setting.as_deref(), Some("dt = 0.1"));
@@ -1478,9 +1643,13 @@ pub(crate) mod tests {
                     for &v in &s.values {
                         let mut knobs = sweep.reference.clone();
                         knobs.insert(s.knob.clone(), v);
-                        sweep.scene(&knobs, &path).unwrap_or_else(|e| {
+                        let (scene, lambda) = sweep.scene(&knobs, &path).unwrap_or_else(|e| {
                             panic!("{}: {} = {v}: {e}", path.display(), s.knob.name())
                         });
+                        // The level fits the box under the series' rule (e.g. lambda 8 in
+                        // the fidelity suite's deep Hertz box).
+                        cgdem_core::coarse_graining::coarse_grain_by(&scene, lambda, s.rule)
+                            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
                     }
                 }
             }

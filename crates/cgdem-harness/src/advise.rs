@@ -410,4 +410,104 @@ mod tests {
         assert!(e.contains("absent"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
+
+    /// `cgdem advise` on the stored matrix (reports/cg_fidelity, made by `cgdem validate
+    /// --suite cg_fidelity`): for every case, every quantity it measured and two targets (the
+    /// suite's and twice it), the answer is the one the report's own matrix table
+    /// (`matrix.csv`, mean + spread per rule and lambda) gives: the coarsest level within the
+    /// target (ties: fewest particle-steps), or none; with the same error and saving.
+    #[test]
+    fn advice_on_the_stored_matrix_is_the_coarsest_level_its_matrix_table_puts_within_target() {
+        use crate::csv_table::CsvTable;
+        let root = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../reports/cg_fidelity"
+        ));
+        let (file, points) = read_matrix(root).unwrap();
+        let mut cases: Vec<&str> = points.iter().map(|p| p.case.as_str()).collect();
+        cases.sort();
+        cases.dedup();
+        assert!(cases.len() >= 4, "{cases:?}");
+        let mut answered = 0;
+        for case in cases {
+            let csv = root.join("figures/accuracy").join(case).join("matrix.csv");
+            let table = CsvTable::read(&csv).unwrap();
+            let col = |n: &str| table.column(n).unwrap();
+            let (quantity, rule, lambda, setting) = (
+                col("quantity"),
+                col("cg_rule"),
+                col("lambda"),
+                col("setting"),
+            );
+            let (error, reach, target, steps, saving) = (
+                col("error_mean"),
+                col("error_reach"),
+                col("target"),
+                col("particle_steps"),
+                col("saving_particle_steps"),
+            );
+            let mut quantities: Vec<String> = table
+                .rows()
+                .map(|r| r.text(quantity).unwrap().to_string())
+                .collect();
+            quantities.dedup();
+            for q in quantities {
+                let m = Measure::from_quantity(&q).unwrap();
+                let rows: Vec<_> = table
+                    .rows()
+                    .filter(|r| r.text(quantity).unwrap() == q)
+                    .filter(|r| r.text(setting).unwrap() != "reference")
+                    .map(|r| {
+                        (
+                            r.text(rule).unwrap().to_string(),
+                            r.parse::<u32>(lambda).unwrap(),
+                            r.parse::<f64>(error).unwrap(),
+                            r.parse::<f64>(reach).unwrap(),
+                            r.parse::<f64>(target).unwrap(),
+                            r.parse::<f64>(steps).unwrap(),
+                            r.parse::<f64>(saving).unwrap(),
+                        )
+                    })
+                    .collect();
+                if rows.is_empty() {
+                    continue;
+                }
+                for t in [rows[0].4, 2.0 * rows[0].4] {
+                    let a = advise(&file, &points, case, m, t).unwrap();
+                    let expected = rows
+                        .iter()
+                        .filter(|r| r.3 <= t * (1.0 + 1e-9))
+                        .max_by(|a, b| a.1.cmp(&b.1).then(b.5.total_cmp(&a.5)));
+                    match (&a.advised, expected) {
+                        (Some(l), Some(e)) => {
+                            assert_eq!(
+                                (l.cg_rule.as_str(), l.lambda),
+                                (e.0.as_str(), e.1),
+                                "{case} {q} {t}"
+                            );
+                            assert!(
+                                (l.error / e.2 - 1.0).abs() < 1e-5 || (l.error - e.2).abs() < 1e-12,
+                                "{case} {q}: {} vs {}",
+                                l.error,
+                                e.2
+                            );
+                            assert!(
+                                (l.saving_particle_steps / e.6 - 1.0).abs() < 1e-5,
+                                "{case} {q}"
+                            );
+                        }
+                        (None, None) => assert!(a.best_reached.is_some(), "{case} {q}"),
+                        (got, want) => {
+                            panic!("{case} {q} target {t}: advise {got:?}, matrix {want:?}")
+                        }
+                    }
+                    answered += 1;
+                }
+            }
+        }
+        assert!(
+            answered >= 8,
+            "two targets for each of the four cases: {answered}"
+        );
+    }
 }

@@ -443,10 +443,7 @@ fn write_status(
 }
 
 fn rule_name(rule: CoarseGrainRule) -> &'static str {
-    match rule {
-        CoarseGrainRule::Seed => "seed",
-        CoarseGrainRule::BulkViscosity => "bulk-viscosity",
-    }
+    rule.name()
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -639,11 +636,10 @@ fn angles_by_group(runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<f64>> {
 }
 
 fn rule_of(index: u8) -> CoarseGrainRule {
-    if index == CoarseGrainRule::Seed as u8 {
-        CoarseGrainRule::Seed
-    } else {
-        CoarseGrainRule::BulkViscosity
-    }
+    CoarseGrainRule::ALL
+        .into_iter()
+        .find(|r| *r as u8 == index)
+        .unwrap_or_default()
 }
 
 /// The pairs a case compares: codes against each other at each level and rule ("codes"),

@@ -1,21 +1,35 @@
 //! The coarse-graining rule a scene was built with (the transform is `coarse_graining`).
 
-/// Which quantities a coarse-graining keeps. Both scale diameters by `lambda` and masses by
-/// `lambda^3` and keep the damping ratio (hence each contact's restitution); they differ in
-/// how the contact energy and the dashpots scale (derivation: reference/COARSE_GRAINING.md).
+/// Which quantities a coarse-graining keeps. Every rule scales diameters by `lambda` and
+/// masses by `lambda^3` and keeps each contact's restitution; they differ in how the contact
+/// energy, the dashpots and the cohesion scale (derivations: reference/COARSE_GRAINING.md).
+/// `Seed` and `BulkViscosity` are defined for the seed's WCA model, `Seed`, `ScaledParticle`
+/// and `LiggghtsPfm` for Hertz-Mindlin.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum CoarseGrainRule {
     /// Paper A: `phi'(r) = lambda^3 phi(r/lambda)`, `gamma' = lambda^2 gamma`,
     /// `dt' = lambda dt`. Keeps each contact's restitution and the overlap per diameter under
     /// the same velocity; the bulk viscosity `~ gamma/d` grows by `lambda`, so viscous flows
-    /// run `lambda` times slower.
+    /// run `lambda` times slower. For Hertz: every contact force `F'(lambda x) = lambda^2 F(x)`
+    /// (Yang's `gamma_n` times lambda, Hamaker constant times lambda^3, `h_min` times lambda).
     #[default]
     Seed,
     /// `phi'(r) = lambda phi(r/lambda)`, `gamma' = lambda gamma`, `dt' = lambda^2 dt`. Keeps
     /// each contact's restitution and the bulk viscosity `~ gamma/d`, so viscous flows run at
-    /// the same speed; contacts are softer (period `lambda^2` longer).
+    /// the same speed; contacts are softer (period `lambda^2` longer). WCA only.
     BulkViscosity,
+    /// Hertz only: the same material in larger particles. Every material constant unchanged
+    /// (Young's modulus, Poisson's ratio, restitution, friction, rolling friction, Yang's
+    /// `gamma_n`, Hamaker constant, `h_min`, the cohesion cut-off).
+    ScaledParticle,
+    /// Hertz only: LIGGGHTS-PFM's `coarsegraining` (radius times the factor, Young's modulus,
+    /// Poisson's ratio, restitution and friction unchanged, the neighbour skin in diameters)
+    /// with a stated law for what it leaves unscaled: rolling friction unchanged, the van der
+    /// Waals cohesion scaled like the weight (Hamaker constant times lambda^4, `h_min` and the
+    /// cut-off times lambda: the Bond number `F_vdw / (m g)` is kept at every scaled gap) and
+    /// Yang's `gamma_n` times lambda (restitution kept).
+    LiggghtsPfm,
 }
 
 impl CoarseGrainRule {
@@ -24,22 +38,60 @@ impl CoarseGrainRule {
         match self {
             CoarseGrainRule::Seed => "seed",
             CoarseGrainRule::BulkViscosity => "bulk-viscosity",
+            CoarseGrainRule::ScaledParticle => "scaled-particle",
+            CoarseGrainRule::LiggghtsPfm => "liggghts-pfm",
         }
     }
 
     /// Every rule, in the order the documentation lists them.
-    pub const ALL: [CoarseGrainRule; 2] = [CoarseGrainRule::Seed, CoarseGrainRule::BulkViscosity];
+    pub const ALL: [CoarseGrainRule; 4] = [
+        CoarseGrainRule::Seed,
+        CoarseGrainRule::BulkViscosity,
+        CoarseGrainRule::ScaledParticle,
+        CoarseGrainRule::LiggghtsPfm,
+    ];
 
     /// The rule named `name` (its [`name`](Self::name)), if any.
     pub fn from_name(name: &str) -> Option<CoarseGrainRule> {
         Self::ALL.into_iter().find(|r| r.name() == name)
     }
 
-    /// Exponents of lambda for (WCA energy, dashpots, explicit time step).
-    pub(crate) fn exponents(self) -> (i32, i32, i32) {
+    /// Whether the rule is defined for the seed's WCA model (`wca`) or for Hertz (`hertz`).
+    pub fn defined_for(self, model: &str) -> bool {
+        use CoarseGrainRule::*;
+        match model {
+            "wca" => matches!(self, Seed | BulkViscosity),
+            "hertz" => matches!(self, Seed | ScaledParticle | LiggghtsPfm),
+            _ => false,
+        }
+    }
+
+    /// The rules defined for `model`, as words for messages (`"seed" or "bulk-viscosity"`).
+    pub fn names_for(model: &str) -> String {
+        Self::ALL
+            .into_iter()
+            .filter(|r| r.defined_for(model))
+            .map(|r| format!("\"{}\"", r.name()))
+            .collect::<Vec<_>>()
+            .join(" or ")
+    }
+
+    /// Exponents of lambda for the WCA energy and dashpots (None for the Hertz-only rules).
+    pub(crate) fn wca_exponents(self) -> Option<(i32, i32)> {
         match self {
-            CoarseGrainRule::Seed => (3, 2, 1),
-            CoarseGrainRule::BulkViscosity => (1, 1, 2),
+            CoarseGrainRule::Seed => Some((3, 2)),
+            CoarseGrainRule::BulkViscosity => Some((1, 1)),
+            CoarseGrainRule::ScaledParticle | CoarseGrainRule::LiggghtsPfm => None,
+        }
+    }
+
+    /// Exponent of lambda for an explicit time step: the contact period grows by lambda
+    /// under every rule but bulk-viscosity's (lambda^2). For Hertz with Young's modulus
+    /// unchanged the contact time `~ (m^2 / (R Y^2 v))^(1/5)` grows by lambda.
+    pub(crate) fn time_exponent(self) -> i32 {
+        match self {
+            CoarseGrainRule::BulkViscosity => 2,
+            _ => 1,
         }
     }
 }
