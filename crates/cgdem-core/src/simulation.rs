@@ -453,9 +453,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     fn in_delete_region(&self, p: Vec3) -> bool {
-        self.delete_regions
-            .iter()
-            .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
+        in_delete_region(&self.delete_regions, p)
     }
 
     /// The current pair list (for tests and diagnostics).
@@ -837,14 +835,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             Some("the pcvv integrator")
         } else if !self.bodies.is_empty() || !self.kinematic.is_empty() {
             Some("bodies")
-        } else if !self.delete_regions.is_empty() {
-            Some("delete regions")
         } else {
             None
         };
         if let Some(what) = unsupported {
             return Err(format!(
-                "the decomposed step does not support {what} yet (supported: velocity Verlet, planar walls, gravity, insertion); run without --grid"
+                "the decomposed step does not support {what} yet (supported: velocity Verlet, planar walls, gravity, insertion, delete regions); run without --grid"
             ));
         }
         let p = &self.particles;
@@ -995,7 +991,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     fn step_decomposed(&mut self) {
         let dt = self.dt;
         let d = self.decomposition.as_mut().expect("decomposed");
-        if d.drift_kick(dt) {
+        if d.drift_kick(dt, &self.delete_regions) {
             self.rebuild_decomposed();
         } else {
             d.forward();
@@ -1025,18 +1021,22 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
     }
 
-    /// `rebuild` for the subdomains: the same removal of particles that left the box (and
-    /// its accounting), then exchange, borders and lists; `particles` is laid out again.
+    /// `rebuild` for the subdomains: the same removal of particles that left the box or
+    /// entered a delete region (and its accounting), then exchange, borders and lists;
+    /// `particles` is laid out again.
     fn rebuild_decomposed(&mut self) {
         let stop_on_lost = self.guard.settings.stop_on_lost;
         let domain = self.domain.clone();
-        let keep = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
+        let stays = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
+        let regions = &self.delete_regions;
+        let keep = |x: Vec3| stays(x) && !in_delete_region(regions, x);
         let origin = self.potential_origin();
         let gravity = self.gravity;
         let tripped = self.guard.trip.is_some();
         let d = self.decomposition.as_mut().expect("decomposed");
         // Per subdomain, in order, the particles that left the box or are removed: (id,
-        // position, velocity, energy, left the box, removed), gathered from every rank.
+        // position, velocity, energy, left the box, removed, deleted, mass), gathered from
+        // every rank, so the counts and sums are the same on any number of threads or ranks.
         let events = d.comm.gather_by_subdomain(d.subdomains.len(), |s, out| {
             let sub = &d.subdomains[s];
             let p = &sub.particles;
@@ -1047,16 +1047,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 if !left && !removed {
                     continue;
                 }
+                // In a delete region and not otherwise removed: deleted, not lost.
+                let deleted = removed && stays(x);
                 let e = 0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
                     - p.mass[k] * gravity.dot(x - origin);
                 out.push(p.id[k] as Real);
                 out.extend_from_slice(&x.to_array());
                 out.extend_from_slice(&p.velocity[k].to_array());
                 out.extend_from_slice(&[e, left as u8 as Real, removed as u8 as Real]);
+                out.extend_from_slice(&[deleted as u8 as Real, p.mass[k]]);
             }
         });
         for words in &events {
-            for w in words.chunks_exact(10) {
+            for w in words.chunks_exact(12) {
                 let id = w[0] as u32;
                 if w[8] != 0.0 {
                     let (x, v) = (Vec3::new(w[1], w[2], w[3]), Vec3::new(w[4], w[5], w[6]));
@@ -1065,7 +1068,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 if w[9] == 0.0 {
                     continue;
                 }
-                self.lost += 1;
+                if w[10] != 0.0 {
+                    self.deleted += 1;
+                    self.deleted_mass += w[11];
+                } else {
+                    self.lost += 1;
+                }
                 if w[7].is_finite() {
                     self.guard.removed_energy += w[7];
                 } else {
@@ -2001,6 +2009,13 @@ fn body_force_and_torque<W: WallLaw>(
         torque: (contact_point - body.center()).cross(-force),
     };
     (force, torque, load, overlap)
+}
+
+/// Whether `p` lies in one of the delete regions (bounds included).
+pub(crate) fn in_delete_region(regions: &[Aabb], p: Vec3) -> bool {
+    regions
+        .iter()
+        .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
 }
 
 /// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN

@@ -14,10 +14,11 @@ use super::{Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
+use crate::geometry::Aabb;
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::{AngularState, Particles};
-use crate::simulation::{larger, pair_force, ForceView, Owner, ParticleState};
+use crate::simulation::{in_delete_region, larger, pair_force, ForceView, Owner, ParticleState};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -233,15 +234,23 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         rows
     }
 
-    /// Half kick and drift of the owned particles; whether one moved past half the skin.
-    pub fn drift_kick(&mut self, dt: Real) -> bool {
+    /// Half kick and drift of the owned particles; whether a rebuild is due: a particle
+    /// moved past half the skin, or entered one of `delete_regions` (the rebuild removes
+    /// it, at the step the undecomposed run does).
+    pub fn drift_kick(&mut self, dt: Real, delete_regions: &[Aabb]) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
-        let moved = self
+        let due = self
             .owned_mut()
-            .map(|sub| drift_kick(sub, dt, limit_sq))
+            .map(|sub| {
+                let moved = drift_kick(sub, dt, limit_sq);
+                let p = &sub.particles.position[..sub.n_owned];
+                moved
+                    || (!delete_regions.is_empty()
+                        && p.iter().any(|&x| in_delete_region(delete_regions, x)))
+            })
             .reduce(|| false, |a, b| a || b);
         // The exchange is collective: every rank rebuilds when one must.
-        self.comm.any(moved)
+        self.comm.any(due)
     }
 
     /// Ghosts take their owners' state.
