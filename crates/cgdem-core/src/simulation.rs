@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw, PairResult};
-use crate::decomposition::step::{Decomposition, Physics};
+use crate::decomposition::step::{Decomposition, Drive, Physics};
 use crate::decomposition::{choose_counts, Comm, Grid, GridSpec, HistoryRows};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
@@ -378,6 +378,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// force `F - m g` on each, torque about the body's axis point) to the bodies' loads,
     /// after the force evaluation.
     fn record_kinematic_loads(&mut self) {
+        if let Some(d) = &self.decomposition {
+            // Summed by the subdomains in the last force pass.
+            for (group, load) in self.kinematic.iter().zip(&d.kinematic_loads) {
+                self.bodies[group.body].load += *load;
+            }
+            return;
+        }
         let p = &self.particles;
         for group in &self.kinematic {
             let body = &mut self.bodies[group.body];
@@ -414,15 +421,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         match (decomposed, rows) {
             (Some(d), Some(mut rows)) => {
-                // Dealt out again over the same cut planes (still thick enough).
+                // Dealt out again over the same cut planes (still thick enough); that
+                // evaluates the forces, once: a second evaluation would advance the
+                // tangential springs twice.
                 for _ in 0..positions.len() {
                     rows.push(&[]);
                 }
                 self.decompose(d.grid, rows, d.comm);
             }
-            _ => self.rebuild(),
+            _ => {
+                self.rebuild();
+                self.compute_forces();
+            }
         }
-        self.compute_forces();
         self.record_kinematic_loads();
         self.reset_energy_reference();
     }
@@ -828,20 +839,14 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     /// Splits the world into the subdomains of `spec` (`--grid`): from now on each steps
-    /// its own particles and ghosts. Velocity Verlet with planar walls only so far.
+    /// its own particles and ghosts. Velocity Verlet only so far (PCVV is refused).
     /// Under MPI (`comm` of several ranks) each rank steps the subdomains it owns.
     pub fn set_grid(&mut self, spec: GridSpec, comm: Comm) -> Result<(), String> {
-        let unsupported = if self.integrator != Integrator::VelocityVerlet {
-            Some("the pcvv integrator")
-        } else if !self.bodies.is_empty() || !self.kinematic.is_empty() {
-            Some("bodies")
-        } else {
-            None
-        };
-        if let Some(what) = unsupported {
-            return Err(format!(
-                "the decomposed step does not support {what} yet (supported: velocity Verlet, planar walls, gravity, insertion, delete regions); run without --grid"
-            ));
+        if self.integrator != Integrator::VelocityVerlet {
+            return Err(
+                "the decomposed step does not support the pcvv integrator yet (supported: velocity Verlet, planar walls, gravity, insertion, delete regions, SDF bodies and bodies built of particles); run without --grid"
+                    .into(),
+            );
         }
         let p = &self.particles;
         let counts = match spec {
@@ -990,8 +995,15 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// particle moved past half the skin or forward otherwise, then forces and the kick.
     fn step_decomposed(&mut self) {
         let dt = self.dt;
+        // The bodies at the step's end: they move their particles after the drift.
+        self.pose_bodies_at(self.time + dt);
         let d = self.decomposition.as_mut().expect("decomposed");
-        if d.drift_kick(dt, &self.delete_regions) {
+        let drive = Drive {
+            bodies: &self.bodies,
+            kinematic: &self.kinematic,
+            delete_regions: &self.delete_regions,
+        };
+        if d.drift_kick(dt, &drive) {
             self.rebuild_decomposed();
         } else {
             d.forward();
@@ -1007,18 +1019,25 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             law: &self.law,
             wall_law: &self.wall_law,
             walls: &self.walls,
+            bodies: &self.bodies,
+            kinematic: &self.kinematic,
             gravity: self.gravity,
             n_species: self.n_species,
             dt: self.dt,
             wall_slots: (self.walls.walls.len() + self.bodies.len()).max(1),
             rotates: Self::ROTATES,
         };
-        let (pairs, walls, finite) = d.forces(&physics, kick, &mut self.particles);
-        self.guard.pair_overlap = pairs;
-        self.guard.wall_overlap = walls;
+        let sums = d.forces(&physics, kick, &mut self.particles);
+        self.guard.pair_overlap = sums.deepest_pair;
+        self.guard.wall_overlap = sums.deepest_wall;
         if kick {
-            self.guard.finite = finite;
+            self.guard.finite = sums.finite;
         }
+        for (body, load) in self.bodies.iter_mut().zip(&sums.body_loads) {
+            body.load = *load;
+        }
+        // Added to the bodies by `record_kinematic_loads`, as the undecomposed step does.
+        d.kinematic_loads = sums.kinematic_loads;
     }
 
     /// `rebuild` for the subdomains: the same removal of particles that left the box or
@@ -1931,7 +1950,7 @@ pub(crate) fn pair_force<L: PairLaw>(
 /// velocity relative to the body's surface), the particle's load on the body and its overlap
 /// with the body as a fraction of the radius.
 #[inline(always)]
-fn body_force<W: WallLaw>(
+pub(crate) fn body_force<W: WallLaw>(
     body: &Body,
     law: &W,
     particle: &WallParticle,
@@ -1967,7 +1986,7 @@ fn body_force<W: WallLaw>(
 /// history (tangential and rolling springs kept per particle per body, as for planar walls,
 /// and reset when they part). The body's own motion enters through the surface velocity at
 /// the contact point.
-fn body_force_and_torque<W: WallLaw>(
+pub(crate) fn body_force_and_torque<W: WallLaw>(
     body: &Body,
     law: &W,
     particle: &WallParticle,

@@ -11,6 +11,7 @@ use super::list::LocalList;
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
+use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
@@ -18,7 +19,10 @@ use crate::geometry::Aabb;
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::{AngularState, Particles};
-use crate::simulation::{in_delete_region, larger, pair_force, ForceView, Owner, ParticleState};
+use crate::simulation::{
+    body_force, body_force_and_torque, in_delete_region, larger, pair_force, ForceView, Owner,
+    ParticleState,
+};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -26,11 +30,82 @@ pub struct Physics<'a, L, W> {
     pub law: &'a L,
     pub wall_law: &'a W,
     pub walls: &'a WallSet,
+    /// Posed at the step's end; their history slots follow the walls'.
+    pub bodies: &'a [Body],
+    /// The particles of bodies built of particles, whose load goes to their bodies.
+    pub kinematic: &'a [KinematicParticles],
     pub gravity: Vec3,
     pub n_species: usize,
     pub dt: Real,
     pub wall_slots: usize,
     pub rotates: bool,
+}
+
+/// What moves or removes particles in a step besides the integrator.
+pub struct Drive<'a> {
+    /// Posed at the step's end: they move their particles (`kinematic`) after the drift.
+    pub bodies: &'a [Body],
+    pub kinematic: &'a [KinematicParticles],
+    /// A particle entering one of these calls for a rebuild, which deletes it.
+    pub delete_regions: &'a [Aabb],
+}
+
+/// What a force pass leaves for the world, over all subdomains: the deepest overlaps,
+/// whether every value stayed finite, and the loads on the bodies, summed per subdomain
+/// and then over the subdomains in order (the same numbers on any number of threads or
+/// ranks).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForceSums {
+    pub deepest_pair: Real,
+    pub deepest_wall: Real,
+    pub finite: bool,
+    /// Per body, the load of the particles through its SDF contact.
+    pub body_loads: Vec<BodyLoad>,
+    /// Per group of particles of a body built of particles, their load on the body.
+    pub kinematic_loads: Vec<BodyLoad>,
+}
+
+impl ForceSums {
+    /// `self` (earlier subdomains) and then `later`.
+    fn then(mut self, later: ForceSums) -> ForceSums {
+        self.deepest_pair = larger(self.deepest_pair, later.deepest_pair);
+        self.deepest_wall = larger(self.deepest_wall, later.deepest_wall);
+        self.finite &= later.finite;
+        for (a, b) in self.body_loads.iter_mut().zip(later.body_loads) {
+            *a += b;
+        }
+        for (a, b) in self.kinematic_loads.iter_mut().zip(later.kinematic_loads) {
+            *a += b;
+        }
+        self
+    }
+
+    fn write(&self, out: &mut Vec<Real>) {
+        let finite = if self.finite { 1.0 } else { 0.0 };
+        out.extend_from_slice(&[self.deepest_pair, self.deepest_wall, finite]);
+        for load in self.body_loads.iter().chain(&self.kinematic_loads) {
+            out.extend_from_slice(&load.force.to_array());
+            out.extend_from_slice(&load.torque.to_array());
+        }
+    }
+
+    fn read(words: &[Real], bodies: usize) -> ForceSums {
+        let loads: Vec<BodyLoad> = words[3..]
+            .chunks_exact(6)
+            .map(|w| BodyLoad {
+                force: Vec3::new(w[0], w[1], w[2]),
+                torque: Vec3::new(w[3], w[4], w[5]),
+            })
+            .collect();
+        let (body_loads, kinematic_loads) = loads.split_at(bodies);
+        ForceSums {
+            deepest_pair: words[0],
+            deepest_wall: words[1],
+            finite: words[2] != 0.0,
+            body_loads: body_loads.to_vec(),
+            kinematic_loads: kinematic_loads.to_vec(),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -49,6 +124,8 @@ pub struct Decomposition<H, WH> {
     pub total: usize,
     /// Bytes this rank sent to other ranks (exchange, borders, forward) since the start.
     pub bytes_sent: u64,
+    /// Per group of body particles, their load at the last force pass (over all ranks).
+    pub kinematic_loads: Vec<BodyLoad>,
     buffers: Vec<Vec<States>>,
     /// Words each rank sends here in a forward, fixed between rebuilds.
     forward_counts: Option<Vec<usize>>,
@@ -100,6 +177,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             comm,
             total: particles.len(),
             bytes_sent: 0,
+            kinematic_loads: Vec::new(),
             buffers: Vec::new(),
             forward_counts: None,
         };
@@ -234,19 +312,28 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         rows
     }
 
-    /// Half kick and drift of the owned particles; whether a rebuild is due: a particle
-    /// moved past half the skin, or entered one of `delete_regions` (the rebuild removes
-    /// it, at the step the undecomposed run does).
-    pub fn drift_kick(&mut self, dt: Real, delete_regions: &[Aabb]) -> bool {
+    /// Half kick and drift of the owned particles, then the particles of bodies built of
+    /// particles moved to their bodies' pose; whether a rebuild is due: a particle moved
+    /// past half the skin, or entered one of the delete regions (the rebuild removes it, at
+    /// the step the undecomposed run does).
+    pub fn drift_kick(&mut self, dt: Real, drive: &Drive<'_>) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
+        let regions = drive.delete_regions;
         let due = self
             .owned_mut()
             .map(|sub| {
-                let moved = drift_kick(sub, dt, limit_sq);
+                let mut moved = drift_kick(sub, dt, limit_sq);
+                if !drive.kinematic.is_empty() {
+                    // The test runs again once the body particles have moved.
+                    drive_kinematic(sub, drive);
+                    let p = &sub.particles.position[..sub.n_owned];
+                    moved = p
+                        .iter()
+                        .zip(&sub.list.reference)
+                        .any(|(&x, &r)| (x - r).length_squared() > limit_sq);
+                }
                 let p = &sub.particles.position[..sub.n_owned];
-                moved
-                    || (!delete_regions.is_empty()
-                        && p.iter().any(|&x| in_delete_region(delete_regions, x)))
+                moved || (!regions.is_empty() && p.iter().any(|&x| in_delete_region(regions, x)))
             })
             .reduce(|| false, |a, b| a || b);
         // The exchange is collective: every rank rebuilds when one must.
@@ -265,42 +352,66 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
 
     /// Forces on the owned particles, then (if `kick`) the closing half kick, and the new
     /// state copied into `world`'s arrays (the subdomains' owned particles side by side; not
-    /// under MPI, where `gathered` brings them when they are read). Returns the deepest pair
-    /// and wall overlaps and whether every value is finite, over all ranks.
+    /// under MPI, where `gathered` brings them when they are read). Returns the deepest
+    /// overlaps, finiteness and body loads over all subdomains of all ranks.
     pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         kick: bool,
         world: &mut Particles,
-    ) -> (Real, Real, bool) {
+    ) -> ForceSums {
         let step = |sub: &mut Subdomain<H, WH>| {
-            let (pairs, walls) = forces(sub, physics);
-            let finite = !kick || closing_kick(sub, physics.dt);
-            (pairs, walls, finite)
+            let mut sums = forces(sub, physics);
+            sums.kinematic_loads = kinematic_loads(sub, physics);
+            sums.finite = !kick || closing_kick(sub, physics.dt);
+            sums
         };
-        let reduce = |a: (Real, Real, bool), b: (Real, Real, bool)| {
-            (larger(a.0, b.0), larger(a.1, b.1), a.2 && b.2)
+        let in_order = |all: Vec<ForceSums>| {
+            all.into_iter()
+                .reduce(ForceSums::then)
+                .expect("at least one subdomain")
         };
+        let count = self.subdomains.len();
         if self.comm.is_distributed() {
-            let (pairs, walls, finite) = self
-                .owned_mut()
-                .map(step)
-                .reduce(|| (0.0, 0.0, true), reduce);
-            // One reduction for the three (max is exact in any order).
-            let mut v = [pairs, walls, if finite { 0.0 } else { 1.0 }];
-            self.comm.max_each(&mut v);
-            return (v[0], v[1], v[2] == 0.0);
+            let comm = &self.comm;
+            let mine: Vec<Option<ForceSums>> = self
+                .subdomains
+                .par_iter_mut()
+                .map(|sub| comm.owns(sub.index, count).then(|| step(sub)))
+                .collect();
+            if physics.bodies.is_empty() && physics.kinematic.is_empty() {
+                let here = in_order(mine.into_iter().flatten().collect());
+                // One reduction for the three (max is exact in any order).
+                let finite = if here.finite { 0.0 } else { 1.0 };
+                let mut v = [here.deepest_pair, here.deepest_wall, finite];
+                self.comm.max_each(&mut v);
+                return ForceSums {
+                    deepest_pair: v[0],
+                    deepest_wall: v[1],
+                    finite: v[2] == 0.0,
+                    ..here
+                };
+            }
+            // Loads are sums: every rank adds all subdomains' in subdomain order, as one
+            // process does (one all-gather instead of the max reduction).
+            let per_sub = comm.gather_by_subdomain(count, |s, out| {
+                mine[s].as_ref().expect("owned here").write(out)
+            });
+            let bodies = physics.bodies.len();
+            return in_order(per_sub.iter().map(|w| ForceSums::read(w, bodies)).collect());
         }
         let mut views = world_views(world, self.subdomains.iter().map(|s| s.n_owned));
-        self.subdomains
-            .par_iter_mut()
-            .zip(views.par_iter_mut())
-            .map(|(sub, view)| {
-                let result = step(sub);
-                view.copy_from(&sub.particles);
-                result
-            })
-            .reduce(|| (0.0, 0.0, true), reduce)
+        in_order(
+            self.subdomains
+                .par_iter_mut()
+                .zip(views.par_iter_mut())
+                .map(|(sub, view)| {
+                    let result = step(sub);
+                    view.copy_from(&sub.particles);
+                    result
+                })
+                .collect(),
+        )
     }
 
     /// Kinetic plus gravitational energy (from `origin`) and mobile mass of the owned
@@ -470,6 +581,52 @@ fn drift_kick<H: PairHistory, WH: PairHistory>(
     moved
 }
 
+/// Moves the owned particles of bodies built of particles to their bodies' pose: position
+/// from the body frame, velocity of the body's material there and, where particles spin,
+/// the body's angular velocity (as `World::drive_kinematic_particles`).
+fn drive_kinematic<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, drive: &Drive<'_>) {
+    let p = &mut sub.particles;
+    for group in drive.kinematic {
+        let body = &drive.bodies[group.body];
+        for k in 0..sub.n_owned {
+            if let Some(q) = group.reference_of(p.id[k]) {
+                let x = body.to_world(q);
+                p.position[k] = x;
+                p.velocity[k] = body.surface_velocity(x);
+                if let Some(angular) = p.angular.as_mut() {
+                    angular.omega[k] = body.angular_velocity();
+                }
+            }
+        }
+    }
+}
+
+/// Per group of body particles, the load of the grains on its owned particles here:
+/// contact force `F - m g` on each and its torque about the body's axis point (as
+/// `World::record_kinematic_loads`).
+fn kinematic_loads<H: PairHistory, WH: PairHistory, L, W>(
+    sub: &Subdomain<H, WH>,
+    physics: &Physics<'_, L, W>,
+) -> Vec<BodyLoad> {
+    let p = &sub.particles;
+    physics
+        .kinematic
+        .iter()
+        .map(|group| {
+            let center = physics.bodies[group.body].center();
+            let mut load = BodyLoad::default();
+            for k in 0..sub.n_owned {
+                if group.reference_of(p.id[k]).is_some() {
+                    let f = p.force[k] - p.mass[k] * physics.gravity;
+                    load.force += f;
+                    load.torque += (p.position[k] - center).cross(f);
+                }
+            }
+            load
+        })
+        .collect()
+}
+
 /// `v += dt/2 F/m` (and spins) for the owned particles; whether all stay finite.
 fn closing_kick<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt: Real) -> bool {
     let half = 0.5 * dt;
@@ -490,12 +647,14 @@ fn closing_kick<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt:
 
 /// Forces (and torques) on `sub`'s owned particles: every listed pair evaluated with the
 /// lower id first and added to whichever of its particles are owned here (both for an owned
-/// pair: a half list without stored reactions), then gravity and the planar walls. Returns
-/// the deepest pair and wall overlaps.
+/// pair: a half list without stored reactions), then gravity, the planar walls and the
+/// bodies (with their histories, as the undecomposed owner pass). Returns the deepest pair
+/// and wall (or body) overlaps and the bodies' loads summed over the owned particles in
+/// order.
 fn forces<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
-) -> (Real, Real) {
+) -> ForceSums {
     let n = sub.n_owned;
     let ForceView {
         id,
@@ -558,6 +717,7 @@ fn forces<L: PairLaw, W: WallLaw>(
     }
     let mut deepest_wall: Real = 0.0;
     let walls = physics.walls;
+    let mut body_loads = vec![BodyLoad::default(); physics.bodies.len()];
     for i in 0..n {
         let particle = WallParticle {
             species: state.species[i] as usize,
@@ -567,27 +727,61 @@ fn forces<L: PairLaw, W: WallLaw>(
             mass: state.mass[i],
         };
         let mut f = force[i] + state.mass[i] * physics.gravity;
-        let overlap = if rotates && W::NEEDS_ROTATION {
+        let mut overlap;
+        if rotates {
             let slots = &mut sub.wall_history[i * physics.wall_slots..][..physics.wall_slots];
-            let (wall_history, _) = slots.split_at_mut(walls.walls.len());
+            let (wall_history, body_history) = slots.split_at_mut(walls.walls.len());
             let omega = state.omega.map_or(Vec3::ZERO, |w| w[i]);
-            let (wf, wt, o) = walls.force_and_torque_on(
-                physics.wall_law,
-                &particle,
-                omega,
-                wall_history,
-                physics.dt,
-            );
-            f += wf;
-            torque[i] += wt;
-            o
+            if W::NEEDS_ROTATION {
+                let (wf, wt, o) = walls.force_and_torque_on(
+                    physics.wall_law,
+                    &particle,
+                    omega,
+                    wall_history,
+                    physics.dt,
+                );
+                f += wf;
+                torque[i] += wt;
+                overlap = o;
+            } else {
+                let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
+                f += wf;
+                overlap = o;
+            }
+            let with_history = physics.bodies.iter().zip(body_history);
+            for ((body, history), load) in with_history.zip(&mut body_loads) {
+                let (bf, bt, l, o) = body_force_and_torque(
+                    body,
+                    physics.wall_law,
+                    &particle,
+                    omega,
+                    history,
+                    physics.dt,
+                );
+                f += bf;
+                torque[i] += bt;
+                *load += l;
+                overlap = larger(overlap, o);
+            }
         } else {
             let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
             f += wf;
-            o
-        };
+            overlap = o;
+            for (body, load) in physics.bodies.iter().zip(&mut body_loads) {
+                let (bf, l, o) = body_force(body, physics.wall_law, &particle, physics.dt);
+                f += bf;
+                *load += l;
+                overlap = larger(overlap, o);
+            }
+        }
         force[i] = f;
         deepest_wall = larger(deepest_wall, overlap);
     }
-    (deepest_pair, deepest_wall)
+    ForceSums {
+        deepest_pair,
+        deepest_wall,
+        finite: true,
+        body_loads,
+        kinematic_loads: Vec::new(),
+    }
 }
