@@ -176,18 +176,17 @@ fn a_grid_the_step_cannot_take_is_refused_with_the_reason() {
 }
 
 #[test]
-fn the_pcvv_integrator_is_refused_under_a_grid_with_the_reason() {
+fn a_decomposed_pcvv_run_follows_the_undecomposed_one() {
     let mut scene = scene();
     scene.integrator = cgdem_core::integrate::Integrator::Pcvv;
-    let options = RunOptions {
-        out_dir: std::env::temp_dir().join("cgdem-decomposition-pcvv-refused"),
-        grid: Some(GridSpec::Given([2, 1, 1])),
-        ..Default::default()
-    };
-    let e = run(&scene, &options).unwrap_err().to_string();
-    assert!(
-        e.contains("--grid 2x1x1") && e.contains("pcvv") && e.contains("run without --grid"),
-        "{e}"
+    let reference = run_scene(&scene, None, 1, "pcvv-none");
+    let grid = Some(GridSpec::Given([2, 1, 1]));
+    let two = run_scene(&scene, grid, 2, "pcvv-2x1x1");
+    assert_follows(&reference, &two, "pcvv 2x1x1");
+    let one = run_scene(&scene, grid, 1, "pcvv-2x1x1-t1");
+    assert_eq!(
+        by_id(one.final_state.as_ref().unwrap()),
+        by_id(two.final_state.as_ref().unwrap())
     );
 }
 

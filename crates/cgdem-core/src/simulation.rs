@@ -542,6 +542,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// One predictor-corrector velocity-Verlet step, paper B Eq. (11)-(15).
     fn step_pcvv(&mut self) {
+        if self.decomposition.is_some() {
+            self.step_decomposed();
+            return;
+        }
         let dt = self.dt;
         let p = &mut self.particles;
         pcvv::predict(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
@@ -731,7 +735,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Every particle's force and torque: the owner pass, then the reactions.
     pub fn compute_forces(&mut self) {
         if self.decomposition.is_some() {
-            self.decomposed_forces(false);
+            self.decomposed_forces(None);
             return;
         }
         self.owner_pass();
@@ -839,15 +843,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     /// Splits the world into the subdomains of `spec` (`--grid`): from now on each steps
-    /// its own particles and ghosts. Velocity Verlet only so far (PCVV is refused).
+    /// its own particles and ghosts (either integrator, walls, bodies, delete regions).
     /// Under MPI (`comm` of several ranks) each rank steps the subdomains it owns.
     pub fn set_grid(&mut self, spec: GridSpec, comm: Comm) -> Result<(), String> {
-        if self.integrator != Integrator::VelocityVerlet {
-            return Err(
-                "the decomposed step does not support the pcvv integrator yet (supported: velocity Verlet, planar walls, gravity, insertion, delete regions, SDF bodies and bodies built of particles); run without --grid"
-                    .into(),
-            );
-        }
         let p = &self.particles;
         let counts = match spec {
             GridSpec::Given(counts) => counts,
@@ -928,7 +926,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             (self.particles, self.wall_history) = decomposition.gathered();
         }
         self.decomposition = Some(Box::new(decomposition));
-        self.decomposed_forces(false);
+        self.decomposed_forces(None);
         // Under MPI the forces do not reach `particles`: gather them (every rank).
         self.sync_particles();
     }
@@ -991,8 +989,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .map(|d| (&d.grid, d.subdomains.iter().map(|s| s.n_owned).collect()))
     }
 
-    /// One velocity-Verlet step of the subdomains: drift, then exchange and borders if a
-    /// particle moved past half the skin or forward otherwise, then forces and the kick.
+    /// One step of the subdomains (velocity Verlet or PCVV): drift or predictor, then
+    /// exchange and borders if a particle moved past half the skin or forward otherwise,
+    /// then forces and the closing kick or corrector.
     fn step_decomposed(&mut self) {
         let dt = self.dt;
         // The bodies at the step's end: they move their particles after the drift.
@@ -1002,18 +1001,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             bodies: &self.bodies,
             kinematic: &self.kinematic,
             delete_regions: &self.delete_regions,
+            rotates: Self::ROTATES,
         };
-        if d.drift_kick(dt, &drive) {
+        if d.advance(dt, self.integrator, &drive) {
             self.rebuild_decomposed();
         } else {
             d.forward();
         }
-        self.decomposed_forces(true);
+        self.decomposed_forces(Some(self.integrator));
     }
 
-    /// Forces from the current ghosts (then the closing kick if `kick`), copied with the
-    /// state into `particles`; the guard's overlaps and finiteness.
-    fn decomposed_forces(&mut self, kick: bool) {
+    /// Forces from the current ghosts (then the second half of a step of `closing`, if
+    /// given), copied with the state into `particles`; the guard's overlaps and finiteness.
+    fn decomposed_forces(&mut self, closing: Option<Integrator>) {
         let d = self.decomposition.as_mut().expect("decomposed");
         let physics = Physics {
             law: &self.law,
@@ -1027,10 +1027,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             wall_slots: (self.walls.walls.len() + self.bodies.len()).max(1),
             rotates: Self::ROTATES,
         };
-        let sums = d.forces(&physics, kick, &mut self.particles);
+        let sums = d.forces(&physics, closing, &mut self.particles);
         self.guard.pair_overlap = sums.deepest_pair;
         self.guard.wall_overlap = sums.deepest_wall;
-        if kick {
+        if closing.is_some() {
             self.guard.finite = sums.finite;
         }
         for (body, load) in self.bodies.iter_mut().zip(&sums.body_loads) {

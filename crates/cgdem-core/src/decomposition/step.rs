@@ -16,6 +16,7 @@ use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
 use crate::geometry::Aabb;
+use crate::integrate::{pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::{AngularState, Particles};
@@ -48,6 +49,8 @@ pub struct Drive<'a> {
     pub kinematic: &'a [KinematicParticles],
     /// A particle entering one of these calls for a rebuild, which deletes it.
     pub delete_regions: &'a [Aabb],
+    /// Whether spins are integrated (the world's laws need them).
+    pub rotates: bool,
 }
 
 /// What a force pass leaves for the world, over all subdomains: the deepest overlaps,
@@ -312,18 +315,26 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         rows
     }
 
-    /// Half kick and drift of the owned particles, then the particles of bodies built of
-    /// particles moved to their bodies' pose; whether a rebuild is due: a particle moved
-    /// past half the skin, or entered one of the delete regions (the rebuild removes it, at
-    /// the step the undecomposed run does).
-    pub fn drift_kick(&mut self, dt: Real, drive: &Drive<'_>) -> bool {
+    /// The first half of a step of `integrator` for the owned particles (velocity
+    /// Verlet's half kick and drift, or PCVV's predictor), then the particles of bodies
+    /// built of particles moved to their bodies' pose; whether a rebuild is due: a particle
+    /// moved past half the skin, or entered one of the delete regions (the rebuild removes
+    /// it, at the step the undecomposed run does).
+    pub fn advance(&mut self, dt: Real, integrator: Integrator, drive: &Drive<'_>) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
         let regions = drive.delete_regions;
         let due = self
             .owned_mut()
             .map(|sub| {
-                let mut moved = drift_kick(sub, dt, limit_sq);
-                if !drive.kinematic.is_empty() {
+                let pcvv = integrator == Integrator::Pcvv;
+                let mut moved = if pcvv {
+                    predict(sub, dt, drive.rotates);
+                    false
+                } else {
+                    drift_kick(sub, dt, limit_sq)
+                };
+                // PCVV's predictor has no displacement test of its own.
+                if pcvv || !drive.kinematic.is_empty() {
                     // The test runs again once the body particles have moved.
                     drive_kinematic(sub, drive);
                     let p = &sub.particles.position[..sub.n_owned];
@@ -350,20 +361,36 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         );
     }
 
-    /// Forces on the owned particles, then (if `kick`) the closing half kick, and the new
-    /// state copied into `world`'s arrays (the subdomains' owned particles side by side; not
-    /// under MPI, where `gathered` brings them when they are read). Returns the deepest
-    /// overlaps, finiteness and body loads over all subdomains of all ranks.
+    /// Forces on the owned particles, then the second half of a step of `closing` if
+    /// given (velocity Verlet's closing half kick, or PCVV's corrector), and the new state
+    /// copied into `world`'s arrays (the subdomains' owned particles side by side; not under
+    /// MPI, where `gathered` brings them when they are read). Returns the deepest overlaps,
+    /// finiteness and body loads over all subdomains of all ranks.
     pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
-        kick: bool,
+        closing: Option<Integrator>,
         world: &mut Particles,
     ) -> ForceSums {
         let step = |sub: &mut Subdomain<H, WH>| {
+            // PCVV's F0 and T0: the forces of the last step, which travel with their
+            // particles in an exchange.
+            let old = (closing == Some(Integrator::Pcvv)).then(|| {
+                let n = sub.n_owned;
+                let p = &sub.particles;
+                let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
+                (p.force[..n].to_vec(), torque)
+            });
             let mut sums = forces(sub, physics);
             sums.kinematic_loads = kinematic_loads(sub, physics);
-            sums.finite = !kick || closing_kick(sub, physics.dt);
+            sums.finite = match closing {
+                None => true,
+                Some(Integrator::VelocityVerlet) => closing_kick(sub, physics.dt),
+                Some(Integrator::Pcvv) => {
+                    let (force, torque) = old.expect("kept for PCVV");
+                    correct(sub, &force, torque.as_deref(), physics)
+                }
+            };
             sums
         };
         let in_order = |all: Vec<ForceSums>| {
@@ -625,6 +652,44 @@ fn kinematic_loads<H: PairHistory, WH: PairHistory, L, W>(
             load
         })
         .collect()
+}
+
+/// PCVV's predictor for the owned particles (`integrate::pcvv`, as the undecomposed step).
+fn predict<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt: Real, rotates: bool) {
+    let n = sub.n_owned;
+    let p = &mut sub.particles;
+    let (position, velocity) = (&mut p.position[..n], &mut p.velocity[..n]);
+    pcvv::predict(position, velocity, &p.force[..n], &p.inv_mass[..n], dt);
+    if let Some(a) = p.angular.as_mut().filter(|_| rotates) {
+        pcvv::predict_rate(&mut a.omega[..n], &a.torque[..n], &a.inv_inertia[..n], dt);
+    }
+}
+
+/// PCVV's corrector for the owned particles from the forces (and torques) before this
+/// step's; whether all stay finite.
+fn correct<H: PairHistory, WH: PairHistory, L, W>(
+    sub: &mut Subdomain<H, WH>,
+    old_force: &[Vec3],
+    old_torque: Option<&[Vec3]>,
+    physics: &Physics<'_, L, W>,
+) -> bool {
+    let n = sub.n_owned;
+    let dt = physics.dt;
+    let p = &mut sub.particles;
+    let mut finite = pcvv::correct(
+        &mut p.velocity[..n],
+        &p.force[..n],
+        old_force,
+        &p.inv_mass[..n],
+        dt,
+    );
+    if let (Some(a), Some(old_torque)) = (p.angular.as_mut(), old_torque) {
+        if physics.rotates {
+            let (omega, torque) = (&mut a.omega[..n], &a.torque[..n]);
+            finite &= pcvv::correct(omega, torque, old_torque, &a.inv_inertia[..n], dt);
+        }
+    }
+    finite
 }
 
 /// `v += dt/2 F/m` (and spins) for the owned particles; whether all stay finite.
