@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::borders::borders;
 use super::exchange::exchange;
-use super::forward::{forward, States};
+use super::forward::{pack, unpack, States};
 use super::list::LocalList;
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
@@ -19,10 +19,10 @@ use crate::geometry::Aabb;
 use crate::integrate::{pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
-use crate::particles::{AngularState, Particles};
+use crate::particles::Particles;
 use crate::simulation::{
-    body_force, body_force_and_torque, in_delete_region, larger, pair_force, ForceView, Owner,
-    ParticleState,
+    body_force, body_force_and_torque, in_delete_region, larger, pair_force, ForceView, MemoryUse,
+    Owner, ParticleState,
 };
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
@@ -317,15 +317,27 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
 
     /// The first half of a step of `integrator` for the owned particles (velocity
     /// Verlet's half kick and drift, or PCVV's predictor), then the particles of bodies
-    /// built of particles moved to their bodies' pose; whether a rebuild is due: a particle
+    /// built of particles moved to their bodies' pose, and the new states packed for the
+    /// ghosts, in one pass per subdomain. Whether a rebuild is due, on any rank: a particle
     /// moved past half the skin, or entered one of the delete regions (the rebuild removes
-    /// it, at the step the undecomposed run does).
-    pub fn advance(&mut self, dt: Real, integrator: Integrator, drive: &Drive<'_>) -> bool {
+    /// it, at the step the undecomposed run does); then the packed states are not used.
+    pub fn advance_and_pack(
+        &mut self,
+        dt: Real,
+        integrator: Integrator,
+        drive: &Drive<'_>,
+    ) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
         let regions = drive.delete_regions;
+        let count = self.subdomains.len();
+        self.buffers.resize_with(count, Vec::new);
+        let comm = &self.comm;
         let due = self
-            .owned_mut()
-            .map(|sub| {
+            .subdomains
+            .par_iter_mut()
+            .zip(self.buffers.par_iter_mut())
+            .filter(|(sub, _)| comm.owns(sub.index, count))
+            .map(|(sub, out)| {
                 let pcvv = integrator == Integrator::Pcvv;
                 let mut moved = if pcvv {
                     predict(sub, dt, drive.rotates);
@@ -343,6 +355,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                         .zip(&sub.list.reference)
                         .any(|(&x, &r)| (x - r).length_squared() > limit_sq);
                 }
+                pack(sub, out);
                 let p = &sub.particles.position[..sub.n_owned];
                 moved || (!regions.is_empty() && p.iter().any(|&x| in_delete_region(regions, x)))
             })
@@ -351,94 +364,86 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         self.comm.any(due)
     }
 
-    /// Ghosts take their owners' state.
-    pub fn forward(&mut self) {
-        self.bytes_sent += forward(
-            &mut self.subdomains,
+    /// The ghosts take the states `advance_and_pack` packed (`forward`), then forces and
+    /// the closing half kick: see `forces`.
+    pub fn forward_and_forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
+        &mut self,
+        physics: &Physics<'_, L, W>,
+        closing: Integrator,
+    ) -> ForceSums {
+        let subs = &self.subdomains;
+        self.bytes_sent += self.comm.route(
             &mut self.buffers,
-            &self.comm,
+            |from, list, _| subs[from].sends[list].to,
             &mut self.forward_counts,
         );
+        self.pass(physics, Some(closing), true)
     }
 
     /// Forces on the owned particles, then the second half of a step of `closing` if
-    /// given (velocity Verlet's closing half kick, or PCVV's corrector), and the new state
-    /// copied into `world`'s arrays (the subdomains' owned particles side by side; not under
-    /// MPI, where `gathered` brings them when they are read). Returns the deepest overlaps,
-    /// finiteness and body loads over all subdomains of all ranks.
+    /// given (velocity Verlet's closing half kick, or PCVV's corrector). The world's arrays
+    /// are not touched: `gathered` brings the owned particles when they are read. Returns
+    /// the deepest overlaps, finiteness and body loads over all subdomains of all ranks.
     pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         closing: Option<Integrator>,
-        world: &mut Particles,
     ) -> ForceSums {
-        let step = |sub: &mut Subdomain<H, WH>| {
-            // PCVV's F0 and T0: the forces of the last step, which travel with their
-            // particles in an exchange.
-            let old = (closing == Some(Integrator::Pcvv)).then(|| {
-                let n = sub.n_owned;
-                let p = &sub.particles;
-                let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
-                (p.force[..n].to_vec(), torque)
-            });
-            let mut sums = forces(sub, physics);
-            sums.kinematic_loads = kinematic_loads(sub, physics);
-            sums.finite = match closing {
-                None => true,
-                Some(Integrator::VelocityVerlet) => closing_kick(sub, physics.dt),
-                Some(Integrator::Pcvv) => {
-                    let (force, torque) = old.expect("kept for PCVV");
-                    correct(sub, &force, torque.as_deref(), physics)
+        self.pass(physics, closing, false)
+    }
+
+    /// One pass per owned subdomain: unpack the ghosts' states (if `unpack_ghosts`),
+    /// forces, the second half of the step (if `closing`); the guard's values and the body
+    /// loads over all ranks, summed in subdomain order.
+    fn pass<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
+        &mut self,
+        physics: &Physics<'_, L, W>,
+        closing: Option<Integrator>,
+        unpack_ghosts: bool,
+    ) -> ForceSums {
+        let count = self.subdomains.len();
+        let (comm, buffers) = (&self.comm, &self.buffers);
+        let mine: Vec<Option<ForceSums>> = self
+            .subdomains
+            .par_iter_mut()
+            .map(|sub| {
+                if !comm.owns(sub.index, count) {
+                    return None;
                 }
-            };
-            sums
-        };
+                if unpack_ghosts {
+                    unpack(sub, buffers);
+                }
+                Some(forces_and_closing(sub, physics, closing))
+            })
+            .collect();
         let in_order = |all: Vec<ForceSums>| {
             all.into_iter()
                 .reduce(ForceSums::then)
                 .expect("at least one subdomain")
         };
-        let count = self.subdomains.len();
-        if self.comm.is_distributed() {
-            let comm = &self.comm;
-            let mine: Vec<Option<ForceSums>> = self
-                .subdomains
-                .par_iter_mut()
-                .map(|sub| comm.owns(sub.index, count).then(|| step(sub)))
-                .collect();
-            if physics.bodies.is_empty() && physics.kinematic.is_empty() {
-                let here = in_order(mine.into_iter().flatten().collect());
-                // One reduction for the three (max is exact in any order).
-                let finite = if here.finite { 0.0 } else { 1.0 };
-                let mut v = [here.deepest_pair, here.deepest_wall, finite];
-                self.comm.max_each(&mut v);
-                return ForceSums {
-                    deepest_pair: v[0],
-                    deepest_wall: v[1],
-                    finite: v[2] == 0.0,
-                    ..here
-                };
-            }
-            // Loads are sums: every rank adds all subdomains' in subdomain order, as one
-            // process does (one all-gather instead of the max reduction).
-            let per_sub = comm.gather_by_subdomain(count, |s, out| {
-                mine[s].as_ref().expect("owned here").write(out)
-            });
-            let bodies = physics.bodies.len();
-            return in_order(per_sub.iter().map(|w| ForceSums::read(w, bodies)).collect());
+        if !comm.is_distributed() {
+            return in_order(mine.into_iter().flatten().collect());
         }
-        let mut views = world_views(world, self.subdomains.iter().map(|s| s.n_owned));
-        in_order(
-            self.subdomains
-                .par_iter_mut()
-                .zip(views.par_iter_mut())
-                .map(|(sub, view)| {
-                    let result = step(sub);
-                    view.copy_from(&sub.particles);
-                    result
-                })
-                .collect(),
-        )
+        if physics.bodies.is_empty() && physics.kinematic.is_empty() {
+            let here = in_order(mine.into_iter().flatten().collect());
+            // One reduction for the three (max is exact in any order).
+            let finite = if here.finite { 0.0 } else { 1.0 };
+            let mut v = [here.deepest_pair, here.deepest_wall, finite];
+            comm.max_each(&mut v);
+            return ForceSums {
+                deepest_pair: v[0],
+                deepest_wall: v[1],
+                finite: v[2] == 0.0,
+                ..here
+            };
+        }
+        // Loads are sums: every rank adds all subdomains' in subdomain order, as one
+        // process does (one all-gather instead of the max reduction).
+        let per_sub = comm.gather_by_subdomain(count, |s, out| {
+            mine[s].as_ref().expect("owned here").write(out)
+        });
+        let bodies = physics.bodies.len();
+        in_order(per_sub.iter().map(|w| ForceSums::read(w, bodies)).collect())
     }
 
     /// Kinetic plus gravitational energy (from `origin`) and mobile mass of the owned
@@ -493,6 +498,42 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         per_sub.iter().map(|w| w[0]).sum()
     }
 
+    /// The arrays of the subdomains this rank steps: particles (owned and ghosts), wall
+    /// histories, send lists, forward buffers and list references as per-particle bytes;
+    /// pairs and their histories as per-pair bytes (a pair across a boundary is listed, and
+    /// counted, on both sides).
+    pub fn memory_use(&self) -> MemoryUse {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let mut m = MemoryUse {
+            particles: 0,
+            particle_bytes: 0,
+            pairs: 0,
+            pair_bytes: 0,
+            history_entries: 0,
+        };
+        for sub in self.owned() {
+            m.particles += sub.n_owned;
+            m.particle_bytes += sub.particles.array_bytes()
+                + bytes(&sub.wall_history)
+                + bytes(&sub.list.out_start)
+                + bytes(&sub.list.reference)
+                + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
+                + bytes(&sub.receives);
+            m.pairs += sub.list.pairs.len();
+            m.pair_bytes += bytes(&sub.list.pairs) + bytes(&sub.list.history);
+            m.history_entries += sub.list.history.len();
+        }
+        m.particle_bytes += self
+            .buffers
+            .iter()
+            .flatten()
+            .map(|States(b)| bytes(b))
+            .sum::<usize>();
+        m
+    }
+
     /// Pairs listed over all subdomains (a pair across a boundary twice).
     pub fn listed_pairs(&self) -> usize {
         let here: usize = self.owned().map(|s| s.list.pairs.len()).sum();
@@ -527,61 +568,6 @@ fn resort_by_cell<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, c
     for &o in &order {
         sub.rows.push(old.of(o as usize));
     }
-}
-
-/// The world's per-particle arrays the step writes, cut at the subdomains' owned counts.
-struct WorldView<'a> {
-    position: &'a mut [Vec3],
-    velocity: &'a mut [Vec3],
-    force: &'a mut [Vec3],
-    omega: &'a mut [Vec3],
-    torque: &'a mut [Vec3],
-}
-
-impl WorldView<'_> {
-    fn copy_from(&mut self, p: &Particles) {
-        let n = self.position.len();
-        self.position.copy_from_slice(&p.position[..n]);
-        self.velocity.copy_from_slice(&p.velocity[..n]);
-        self.force.copy_from_slice(&p.force[..n]);
-        if let Some(a) = &p.angular {
-            self.omega.copy_from_slice(&a.omega[..n]);
-            self.torque.copy_from_slice(&a.torque[..n]);
-        }
-    }
-}
-
-fn world_views(world: &mut Particles, counts: impl Iterator<Item = usize>) -> Vec<WorldView<'_>> {
-    let Particles {
-        position,
-        velocity,
-        force,
-        angular,
-        ..
-    } = world;
-    let (mut omega, mut torque): (&mut [Vec3], &mut [Vec3]) = match angular {
-        Some(AngularState { omega, torque, .. }) => (omega, torque),
-        None => (&mut [], &mut []),
-    };
-    let (mut position, mut velocity, mut force) =
-        (&mut position[..], &mut velocity[..], &mut force[..]);
-    let mut views = Vec::new();
-    for n in counts {
-        let (p, rest_p) = position.split_at_mut(n);
-        let (v, rest_v) = velocity.split_at_mut(n);
-        let (f, rest_f) = force.split_at_mut(n);
-        let (w, rest_w) = omega.split_at_mut(if omega.is_empty() { 0 } else { n });
-        let (t, rest_t) = torque.split_at_mut(if torque.is_empty() { 0 } else { n });
-        views.push(WorldView {
-            position: p,
-            velocity: v,
-            force: f,
-            omega: w,
-            torque: t,
-        });
-        (position, velocity, force, omega, torque) = (rest_p, rest_v, rest_f, rest_w, rest_t);
-    }
-    views
 }
 
 /// `v += dt/2 F/m; x += dt v` (and the spin's half kick) for the owned particles; whether
@@ -652,6 +638,35 @@ fn kinematic_loads<H: PairHistory, WH: PairHistory, L, W>(
             load
         })
         .collect()
+}
+
+/// Forces on `sub`'s owned particles, the load on the particles of bodies built of
+/// particles, then the second half of a step of `closing` (velocity Verlet's closing half
+/// kick, or PCVV's corrector from the forces before this step's).
+fn forces_and_closing<L: PairLaw, W: WallLaw>(
+    sub: &mut Subdomain<L::History, W::History>,
+    physics: &Physics<'_, L, W>,
+    closing: Option<Integrator>,
+) -> ForceSums {
+    // PCVV's F0 and T0: the forces of the last step, which travel with their particles in
+    // an exchange.
+    let old = (closing == Some(Integrator::Pcvv)).then(|| {
+        let n = sub.n_owned;
+        let p = &sub.particles;
+        let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
+        (p.force[..n].to_vec(), torque)
+    });
+    let mut sums = forces(sub, physics);
+    sums.kinematic_loads = kinematic_loads(sub, physics);
+    sums.finite = match closing {
+        None => true,
+        Some(Integrator::VelocityVerlet) => closing_kick(sub, physics.dt),
+        Some(Integrator::Pcvv) => {
+            let (force, torque) = old.expect("kept for PCVV");
+            correct(sub, &force, torque.as_deref(), physics)
+        }
+    };
+    sums
 }
 
 /// PCVV's predictor for the owned particles (`integrate::pcvv`, as the undecomposed step).
