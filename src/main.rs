@@ -130,10 +130,10 @@ enum Command {
         strict: bool,
         /// Split the box into subdomains with ghost layers, each stepped on its own thread
         /// (domain decomposition): `2x1x1` subdomains along x, y, z, or a count (`2`) for the
-        /// grid with the least ghost surface. Off by default; velocity Verlet and planar walls
-        /// only so far. Results match the undecomposed run to rounding, not bitwise. Under
-        /// `mpirun -np N` (a build with `--features mpi`) each rank steps a block of the
-        /// subdomains; the outputs are bitwise those of the same grid on threads.
+        /// grid with the least ghost surface. Off by default. Results match the undecomposed
+        /// run to rounding, not bitwise. Under `mpirun -np N` (a build with `--features mpi`)
+        /// each rank steps a block of the subdomains; the outputs are bitwise those of the same
+        /// grid on threads.
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
         /// With --grid: at each list rebuild, when the imbalance (most particles in one

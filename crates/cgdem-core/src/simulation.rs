@@ -13,9 +13,9 @@ use rayon::prelude::*;
 use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw, PairResult};
-use crate::decomposition::step::{Decomposition, Physics};
-use crate::decomposition::HistoryRows;
+use crate::decomposition::step::{Decomposition, Drive, Physics};
 use crate::decomposition::{balance, choose_counts, BalanceSpec, Comm, Grid, GridSpec};
+use crate::decomposition::HistoryRows;
 use crate::domain::Domain;
 use crate::geometry::Aabb;
 use crate::guard::{
@@ -379,6 +379,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// force `F - m g` on each, torque about the body's axis point) to the bodies' loads,
     /// after the force evaluation.
     fn record_kinematic_loads(&mut self) {
+        if let Some(d) = &self.decomposition {
+            // Summed by the subdomains in the last force pass.
+            for (group, load) in self.kinematic.iter().zip(&d.kinematic_loads) {
+                self.bodies[group.body].load += *load;
+            }
+            return;
+        }
         let p = &self.particles;
         for group in &self.kinematic {
             let body = &mut self.bodies[group.body];
@@ -415,7 +422,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         match (decomposed, rows) {
             (Some(d), Some(mut rows)) => {
-                // Dealt out again over the same cut planes (still thick enough).
+                // Dealt out again over the same cut planes (still thick enough); that
+                // evaluates the forces, once: a second evaluation would advance the
+                // tangential springs twice.
                 for _ in 0..positions.len() {
                     rows.push(&[]);
                 }
@@ -425,9 +434,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     d.balance = balance;
                 }
             }
-            _ => self.rebuild(),
+            _ => {
+                self.rebuild();
+                self.compute_forces();
+            }
         }
-        self.compute_forces();
         self.record_kinematic_loads();
         self.reset_energy_reference();
     }
@@ -458,9 +469,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     fn in_delete_region(&self, p: Vec3) -> bool {
-        self.delete_regions
-            .iter()
-            .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
+        in_delete_region(&self.delete_regions, p)
     }
 
     /// The current pair list (for tests and diagnostics).
@@ -543,6 +552,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// One predictor-corrector velocity-Verlet step, paper B Eq. (11)-(15).
     fn step_pcvv(&mut self) {
+        if self.decomposition.is_some() {
+            self.step_decomposed();
+            return;
+        }
         let dt = self.dt;
         let p = &mut self.particles;
         pcvv::predict(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
@@ -732,7 +745,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// Every particle's force and torque: the owner pass, then the reactions.
     pub fn compute_forces(&mut self) {
         if self.decomposition.is_some() {
-            self.decomposed_forces(false);
+            self.decomposed_forces(None);
             return;
         }
         self.owner_pass();
@@ -840,23 +853,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     /// Splits the world into the subdomains of `spec` (`--grid`): from now on each steps
-    /// its own particles and ghosts. Velocity Verlet with planar walls only so far.
+    /// its own particles and ghosts (either integrator, walls, bodies, delete regions).
     /// Under MPI (`comm` of several ranks) each rank steps the subdomains it owns.
     pub fn set_grid(&mut self, spec: GridSpec, comm: Comm) -> Result<(), String> {
-        let unsupported = if self.integrator != Integrator::VelocityVerlet {
-            Some("the pcvv integrator")
-        } else if !self.bodies.is_empty() || !self.kinematic.is_empty() {
-            Some("bodies")
-        } else if !self.delete_regions.is_empty() {
-            Some("delete regions")
-        } else {
-            None
-        };
-        if let Some(what) = unsupported {
-            return Err(format!(
-                "the decomposed step does not support {what} yet (supported: velocity Verlet, planar walls, gravity, insertion); run without --grid"
-            ));
-        }
         let p = &self.particles;
         let counts = match spec {
             GridSpec::Given(counts) => counts,
@@ -947,7 +946,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             comm,
         );
         self.decomposition = Some(Box::new(decomposition));
-        self.decomposed_forces(false);
+        self.decomposed_forces(None);
         // The forces live in the subdomains: gather them (every rank).
         self.sync_particles();
     }
@@ -1022,66 +1021,85 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .map(|d| (&d.grid, d.subdomains.iter().map(|s| s.n_owned).collect()))
     }
 
-    /// One velocity-Verlet step of the subdomains: drift, then exchange and borders if a
-    /// particle moved past half the skin or forward otherwise, then forces and the kick.
+    /// One step of the subdomains (velocity Verlet or PCVV): drift or predictor, then
+    /// exchange and borders if a particle moved past half the skin or forward otherwise,
+    /// then forces and the closing kick or corrector.
     fn step_decomposed(&mut self) {
         let dt = self.dt;
+        // The bodies at the step's end: they move their particles after the drift.
+        self.pose_bodies_at(self.time + dt);
         let d = self.decomposition.as_mut().expect("decomposed");
-        if d.drift_and_pack(dt) {
+        let drive = Drive {
+            bodies: &self.bodies,
+            kinematic: &self.kinematic,
+            delete_regions: &self.delete_regions,
+            rotates: Self::ROTATES,
+        };
+        if d.advance_and_pack(dt, self.integrator, &drive) {
             self.rebuild_decomposed();
-            self.decomposed_forces(true);
+            self.decomposed_forces(Some(self.integrator));
         } else {
             self.decomposed_forces_forwarded();
         }
     }
 
-    /// Forces from the current ghosts (then the closing kick if `kick`); the guard's
-    /// overlaps and finiteness.
-    fn decomposed_forces(&mut self, kick: bool) {
-        self.decomposed_pass(kick, false);
+    /// Forces from the current ghosts (then the second half of a step of `closing`, if
+    /// given); the guard's overlaps and finiteness, the bodies' loads.
+    fn decomposed_forces(&mut self, closing: Option<Integrator>) {
+        self.decomposed_pass(closing, false);
     }
 
-    /// The ghosts take their owners' states packed by the drift, then forces and kick.
+    /// The ghosts take their owners' states packed by the drift, then forces and the
+    /// second half of the step.
     fn decomposed_forces_forwarded(&mut self) {
-        self.decomposed_pass(true, true);
+        self.decomposed_pass(Some(self.integrator), true);
     }
 
-    fn decomposed_pass(&mut self, kick: bool, forward: bool) {
+    fn decomposed_pass(&mut self, closing: Option<Integrator>, forward: bool) {
         let d = self.decomposition.as_mut().expect("decomposed");
         let physics = Physics {
             law: &self.law,
             wall_law: &self.wall_law,
             walls: &self.walls,
+            bodies: &self.bodies,
+            kinematic: &self.kinematic,
             gravity: self.gravity,
             n_species: self.n_species,
             dt: self.dt,
             wall_slots: (self.walls.walls.len() + self.bodies.len()).max(1),
             rotates: Self::ROTATES,
         };
-        let (pairs, walls, finite) = if forward {
-            d.forward_and_forces(&physics)
-        } else {
-            d.forces(&physics, kick)
+        let sums = match (forward, closing) {
+            (true, Some(integrator)) => d.forward_and_forces(&physics, integrator),
+            _ => d.forces(&physics, closing),
         };
-        self.guard.pair_overlap = pairs;
-        self.guard.wall_overlap = walls;
-        if kick {
-            self.guard.finite = finite;
+        self.guard.pair_overlap = sums.deepest_pair;
+        self.guard.wall_overlap = sums.deepest_wall;
+        if closing.is_some() {
+            self.guard.finite = sums.finite;
         }
+        for (body, load) in self.bodies.iter_mut().zip(&sums.body_loads) {
+            body.load = *load;
+        }
+        // Added to the bodies by `record_kinematic_loads`, as the undecomposed step does.
+        d.kinematic_loads = sums.kinematic_loads;
     }
 
-    /// `rebuild` for the subdomains: the same removal of particles that left the box (and
-    /// its accounting), then exchange, borders and lists.
+    /// `rebuild` for the subdomains: the same removal of particles that left the box or
+    /// entered a delete region (and its accounting), then exchange, borders and lists.
     fn rebuild_decomposed(&mut self) {
         let stop_on_lost = self.guard.settings.stop_on_lost;
         let domain = self.domain.clone();
-        let keep = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
+        let stays = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
+        let regions = &self.delete_regions;
+        let keep = |x: Vec3| stays(x) && !in_delete_region(regions, x);
         let origin = self.potential_origin();
         let gravity = self.gravity;
         let tripped = self.guard.trip.is_some();
         let d = self.decomposition.as_mut().expect("decomposed");
         // Per subdomain, in order, the particles that left the box or are removed: (id,
-        // position, velocity, energy, left the box, removed), gathered from every rank.
+        // position, velocity, energy, left the box, removed, deleted, mass), gathered from
+        // every rank, so the counts and sums are the same on any number of threads or ranks.
         let events = d.comm.gather_by_subdomain(d.subdomains.len(), |s, out| {
             let sub = &d.subdomains[s];
             let p = &sub.particles;
@@ -1092,16 +1110,19 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 if !left && !removed {
                     continue;
                 }
+                // In a delete region and not otherwise removed: deleted, not lost.
+                let deleted = removed && stays(x);
                 let e = 0.5 * p.mass[k] * p.velocity[k].length_squared() + p.spin_energy(k)
                     - p.mass[k] * gravity.dot(x - origin);
                 out.push(p.id[k] as Real);
                 out.extend_from_slice(&x.to_array());
                 out.extend_from_slice(&p.velocity[k].to_array());
                 out.extend_from_slice(&[e, left as u8 as Real, removed as u8 as Real]);
+                out.extend_from_slice(&[deleted as u8 as Real, p.mass[k]]);
             }
         });
         for words in &events {
-            for w in words.chunks_exact(10) {
+            for w in words.chunks_exact(12) {
                 let id = w[0] as u32;
                 if w[8] != 0.0 {
                     let (x, v) = (Vec3::new(w[1], w[2], w[3]), Vec3::new(w[4], w[5], w[6]));
@@ -1110,7 +1131,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 if w[9] == 0.0 {
                     continue;
                 }
-                self.lost += 1;
+                if w[10] != 0.0 {
+                    self.deleted += 1;
+                    self.deleted_mass += w[11];
+                } else {
+                    self.lost += 1;
+                }
                 if w[7].is_finite() {
                     self.guard.removed_energy += w[7];
                 } else {
@@ -1965,7 +1991,7 @@ pub(crate) fn pair_force<L: PairLaw>(
 /// velocity relative to the body's surface), the particle's load on the body and its overlap
 /// with the body as a fraction of the radius.
 #[inline(always)]
-fn body_force<W: WallLaw>(
+pub(crate) fn body_force<W: WallLaw>(
     body: &Body,
     law: &W,
     particle: &WallParticle,
@@ -2001,7 +2027,7 @@ fn body_force<W: WallLaw>(
 /// history (tangential and rolling springs kept per particle per body, as for planar walls,
 /// and reset when they part). The body's own motion enters through the surface velocity at
 /// the contact point.
-fn body_force_and_torque<W: WallLaw>(
+pub(crate) fn body_force_and_torque<W: WallLaw>(
     body: &Body,
     law: &W,
     particle: &WallParticle,
@@ -2043,6 +2069,13 @@ fn body_force_and_torque<W: WallLaw>(
         torque: (contact_point - body.center()).cross(-force),
     };
     (force, torque, load, overlap)
+}
+
+/// Whether `p` lies in one of the delete regions (bounds included).
+pub(crate) fn in_delete_region(regions: &[Aabb], p: Vec3) -> bool {
+    regions
+        .iter()
+        .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
 }
 
 /// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN

@@ -12,13 +12,19 @@ use super::list::LocalList;
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
+use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
+use crate::geometry::Aabb;
+use crate::integrate::{pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::Particles;
-use crate::simulation::{larger, pair_force, ForceView, MemoryUse, Owner, ParticleState};
+use crate::simulation::{
+    body_force, body_force_and_torque, in_delete_region, larger, pair_force, ForceView, MemoryUse,
+    Owner, ParticleState,
+};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -26,11 +32,84 @@ pub struct Physics<'a, L, W> {
     pub law: &'a L,
     pub wall_law: &'a W,
     pub walls: &'a WallSet,
+    /// Posed at the step's end; their history slots follow the walls'.
+    pub bodies: &'a [Body],
+    /// The particles of bodies built of particles, whose load goes to their bodies.
+    pub kinematic: &'a [KinematicParticles],
     pub gravity: Vec3,
     pub n_species: usize,
     pub dt: Real,
     pub wall_slots: usize,
     pub rotates: bool,
+}
+
+/// What moves or removes particles in a step besides the integrator.
+pub struct Drive<'a> {
+    /// Posed at the step's end: they move their particles (`kinematic`) after the drift.
+    pub bodies: &'a [Body],
+    pub kinematic: &'a [KinematicParticles],
+    /// A particle entering one of these calls for a rebuild, which deletes it.
+    pub delete_regions: &'a [Aabb],
+    /// Whether spins are integrated (the world's laws need them).
+    pub rotates: bool,
+}
+
+/// What a force pass leaves for the world, over all subdomains: the deepest overlaps,
+/// whether every value stayed finite, and the loads on the bodies, summed per subdomain
+/// and then over the subdomains in order (the same numbers on any number of threads or
+/// ranks).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForceSums {
+    pub deepest_pair: Real,
+    pub deepest_wall: Real,
+    pub finite: bool,
+    /// Per body, the load of the particles through its SDF contact.
+    pub body_loads: Vec<BodyLoad>,
+    /// Per group of particles of a body built of particles, their load on the body.
+    pub kinematic_loads: Vec<BodyLoad>,
+}
+
+impl ForceSums {
+    /// `self` (earlier subdomains) and then `later`.
+    fn then(mut self, later: ForceSums) -> ForceSums {
+        self.deepest_pair = larger(self.deepest_pair, later.deepest_pair);
+        self.deepest_wall = larger(self.deepest_wall, later.deepest_wall);
+        self.finite &= later.finite;
+        for (a, b) in self.body_loads.iter_mut().zip(later.body_loads) {
+            *a += b;
+        }
+        for (a, b) in self.kinematic_loads.iter_mut().zip(later.kinematic_loads) {
+            *a += b;
+        }
+        self
+    }
+
+    fn write(&self, out: &mut Vec<Real>) {
+        let finite = if self.finite { 1.0 } else { 0.0 };
+        out.extend_from_slice(&[self.deepest_pair, self.deepest_wall, finite]);
+        for load in self.body_loads.iter().chain(&self.kinematic_loads) {
+            out.extend_from_slice(&load.force.to_array());
+            out.extend_from_slice(&load.torque.to_array());
+        }
+    }
+
+    fn read(words: &[Real], bodies: usize) -> ForceSums {
+        let loads: Vec<BodyLoad> = words[3..]
+            .chunks_exact(6)
+            .map(|w| BodyLoad {
+                force: Vec3::new(w[0], w[1], w[2]),
+                torque: Vec3::new(w[3], w[4], w[5]),
+            })
+            .collect();
+        let (body_loads, kinematic_loads) = loads.split_at(bodies);
+        ForceSums {
+            deepest_pair: words[0],
+            deepest_wall: words[1],
+            finite: words[2] != 0.0,
+            body_loads: body_loads.to_vec(),
+            kinematic_loads: kinematic_loads.to_vec(),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -51,6 +130,8 @@ pub struct Decomposition<H, WH> {
     pub bytes_sent: u64,
     /// Whether and how the cut planes follow the particles, and what it saw.
     pub balance: Balance,
+    /// Per group of body particles, their load at the last force pass (over all ranks).
+    pub kinematic_loads: Vec<BodyLoad>,
     buffers: Vec<Vec<States>>,
     /// Words each rank sends here in a forward, fixed between rebuilds.
     forward_counts: Option<Vec<usize>>,
@@ -103,6 +184,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             comm,
             total: particles.len(),
             bytes_sent: 0,
+            kinematic_loads: Vec::new(),
             buffers: Vec::new(),
             forward_counts: None,
         };
@@ -247,90 +329,135 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         rows
     }
 
-    /// Half kick and drift of the owned particles, and their new states packed for the
-    /// ghosts, in one pass per subdomain (a step is two fork-joins of the thread pool, not
-    /// four). Whether a particle moved past half the skin, on any rank: then a rebuild
-    /// follows and the packed states are not used.
-    pub fn drift_and_pack(&mut self, dt: Real) -> bool {
+    /// The first half of a step of `integrator` for the owned particles (velocity
+    /// Verlet's half kick and drift, or PCVV's predictor), then the particles of bodies
+    /// built of particles moved to their bodies' pose, and the new states packed for the
+    /// ghosts, in one pass per subdomain. Whether a rebuild is due, on any rank: a particle
+    /// moved past half the skin, or entered one of the delete regions (the rebuild removes
+    /// it, at the step the undecomposed run does); then the packed states are not used.
+    pub fn advance_and_pack(
+        &mut self,
+        dt: Real,
+        integrator: Integrator,
+        drive: &Drive<'_>,
+    ) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
+        let regions = drive.delete_regions;
         let count = self.subdomains.len();
         self.buffers.resize_with(count, Vec::new);
         let comm = &self.comm;
-        let moved = self
+        let due = self
             .subdomains
             .par_iter_mut()
             .zip(self.buffers.par_iter_mut())
             .filter(|(sub, _)| comm.owns(sub.index, count))
             .map(|(sub, out)| {
-                let moved = drift_kick(sub, dt, limit_sq);
+                let pcvv = integrator == Integrator::Pcvv;
+                let mut moved = if pcvv {
+                    predict(sub, dt, drive.rotates);
+                    false
+                } else {
+                    drift_kick(sub, dt, limit_sq)
+                };
+                // PCVV's predictor has no displacement test of its own.
+                if pcvv || !drive.kinematic.is_empty() {
+                    // The test runs again once the body particles have moved.
+                    drive_kinematic(sub, drive);
+                    let p = &sub.particles.position[..sub.n_owned];
+                    moved = p
+                        .iter()
+                        .zip(&sub.list.reference)
+                        .any(|(&x, &r)| (x - r).length_squared() > limit_sq);
+                }
                 pack(sub, out);
-                moved
+                let p = &sub.particles.position[..sub.n_owned];
+                moved || (!regions.is_empty() && p.iter().any(|&x| in_delete_region(regions, x)))
             })
             .reduce(|| false, |a, b| a || b);
         // The exchange is collective: every rank rebuilds when one must.
-        self.comm.any(moved)
+        self.comm.any(due)
     }
 
-    /// The ghosts take the states `drift_and_pack` packed (`forward`), then forces and
+    /// The ghosts take the states `advance_and_pack` packed (`forward`), then forces and
     /// the closing half kick: see `forces`.
     pub fn forward_and_forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
-    ) -> (Real, Real, bool) {
+        closing: Integrator,
+    ) -> ForceSums {
         let subs = &self.subdomains;
         self.bytes_sent += self.comm.route(
             &mut self.buffers,
             |from, list, _| subs[from].sends[list].to,
             &mut self.forward_counts,
         );
-        self.pass(physics, true, true)
+        self.pass(physics, Some(closing), true)
     }
 
-    /// Forces on the owned particles, then (if `kick`) the closing half kick. The world's
-    /// arrays are not touched: `gathered` brings the owned particles when they are read
-    /// (copying them every step cost about 120 bytes per particle per step). Returns the
-    /// deepest pair and wall overlaps and whether every value is finite, over all ranks.
+    /// Forces on the owned particles, then the second half of a step of `closing` if
+    /// given (velocity Verlet's closing half kick, or PCVV's corrector). The world's arrays
+    /// are not touched: `gathered` brings the owned particles when they are read. Returns
+    /// the deepest overlaps, finiteness and body loads over all subdomains of all ranks.
     pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
-        kick: bool,
-    ) -> (Real, Real, bool) {
-        self.pass(physics, kick, false)
+        closing: Option<Integrator>,
+    ) -> ForceSums {
+        self.pass(physics, closing, false)
     }
 
     /// One pass per owned subdomain: unpack the ghosts' states (if `unpack_ghosts`),
-    /// forces, closing kick (if `kick`); the guard's values reduced over all ranks.
+    /// forces, the second half of the step (if `closing`); the guard's values and the body
+    /// loads over all ranks, summed in subdomain order.
     fn pass<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
-        kick: bool,
+        closing: Option<Integrator>,
         unpack_ghosts: bool,
-    ) -> (Real, Real, bool) {
+    ) -> ForceSums {
         let count = self.subdomains.len();
         let (comm, buffers) = (&self.comm, &self.buffers);
-        let (pairs, walls, finite) = self
+        let mine: Vec<Option<ForceSums>> = self
             .subdomains
             .par_iter_mut()
-            .filter(|sub| comm.owns(sub.index, count))
             .map(|sub| {
+                if !comm.owns(sub.index, count) {
+                    return None;
+                }
                 if unpack_ghosts {
                     unpack(sub, buffers);
                 }
-                let (pairs, walls) = forces(sub, physics);
-                let finite = !kick || closing_kick(sub, physics.dt);
-                (pairs, walls, finite)
+                Some(forces_and_closing(sub, physics, closing))
             })
-            .reduce(
-                || (0.0, 0.0, true),
-                |a, b| (larger(a.0, b.0), larger(a.1, b.1), a.2 && b.2),
-            );
-        if !self.comm.is_distributed() {
-            return (pairs, walls, finite);
+            .collect();
+        let in_order = |all: Vec<ForceSums>| {
+            all.into_iter()
+                .reduce(ForceSums::then)
+                .expect("at least one subdomain")
+        };
+        if !comm.is_distributed() {
+            return in_order(mine.into_iter().flatten().collect());
         }
-        // One reduction for the three (max is exact in any order).
-        let mut v = [pairs, walls, if finite { 0.0 } else { 1.0 }];
-        self.comm.max_each(&mut v);
-        (v[0], v[1], v[2] == 0.0)
+        if physics.bodies.is_empty() && physics.kinematic.is_empty() {
+            let here = in_order(mine.into_iter().flatten().collect());
+            // One reduction for the three (max is exact in any order).
+            let finite = if here.finite { 0.0 } else { 1.0 };
+            let mut v = [here.deepest_pair, here.deepest_wall, finite];
+            comm.max_each(&mut v);
+            return ForceSums {
+                deepest_pair: v[0],
+                deepest_wall: v[1],
+                finite: v[2] == 0.0,
+                ..here
+            };
+        }
+        // Loads are sums: every rank adds all subdomains' in subdomain order, as one
+        // process does (one all-gather instead of the max reduction).
+        let per_sub = comm.gather_by_subdomain(count, |s, out| {
+            mine[s].as_ref().expect("owned here").write(out)
+        });
+        let bodies = physics.bodies.len();
+        in_order(per_sub.iter().map(|w| ForceSums::read(w, bodies)).collect())
     }
 
     /// Kinetic plus gravitational energy (from `origin`) and mobile mass of the owned
@@ -481,6 +608,119 @@ fn drift_kick<H: PairHistory, WH: PairHistory>(
     moved
 }
 
+/// Moves the owned particles of bodies built of particles to their bodies' pose: position
+/// from the body frame, velocity of the body's material there and, where particles spin,
+/// the body's angular velocity (as `World::drive_kinematic_particles`).
+fn drive_kinematic<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, drive: &Drive<'_>) {
+    let p = &mut sub.particles;
+    for group in drive.kinematic {
+        let body = &drive.bodies[group.body];
+        for k in 0..sub.n_owned {
+            if let Some(q) = group.reference_of(p.id[k]) {
+                let x = body.to_world(q);
+                p.position[k] = x;
+                p.velocity[k] = body.surface_velocity(x);
+                if let Some(angular) = p.angular.as_mut() {
+                    angular.omega[k] = body.angular_velocity();
+                }
+            }
+        }
+    }
+}
+
+/// Per group of body particles, the load of the grains on its owned particles here:
+/// contact force `F - m g` on each and its torque about the body's axis point (as
+/// `World::record_kinematic_loads`).
+fn kinematic_loads<H: PairHistory, WH: PairHistory, L, W>(
+    sub: &Subdomain<H, WH>,
+    physics: &Physics<'_, L, W>,
+) -> Vec<BodyLoad> {
+    let p = &sub.particles;
+    physics
+        .kinematic
+        .iter()
+        .map(|group| {
+            let center = physics.bodies[group.body].center();
+            let mut load = BodyLoad::default();
+            for k in 0..sub.n_owned {
+                if group.reference_of(p.id[k]).is_some() {
+                    let f = p.force[k] - p.mass[k] * physics.gravity;
+                    load.force += f;
+                    load.torque += (p.position[k] - center).cross(f);
+                }
+            }
+            load
+        })
+        .collect()
+}
+
+/// Forces on `sub`'s owned particles, the load on the particles of bodies built of
+/// particles, then the second half of a step of `closing` (velocity Verlet's closing half
+/// kick, or PCVV's corrector from the forces before this step's).
+fn forces_and_closing<L: PairLaw, W: WallLaw>(
+    sub: &mut Subdomain<L::History, W::History>,
+    physics: &Physics<'_, L, W>,
+    closing: Option<Integrator>,
+) -> ForceSums {
+    // PCVV's F0 and T0: the forces of the last step, which travel with their particles in
+    // an exchange.
+    let old = (closing == Some(Integrator::Pcvv)).then(|| {
+        let n = sub.n_owned;
+        let p = &sub.particles;
+        let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
+        (p.force[..n].to_vec(), torque)
+    });
+    let mut sums = forces(sub, physics);
+    sums.kinematic_loads = kinematic_loads(sub, physics);
+    sums.finite = match closing {
+        None => true,
+        Some(Integrator::VelocityVerlet) => closing_kick(sub, physics.dt),
+        Some(Integrator::Pcvv) => {
+            let (force, torque) = old.expect("kept for PCVV");
+            correct(sub, &force, torque.as_deref(), physics)
+        }
+    };
+    sums
+}
+
+/// PCVV's predictor for the owned particles (`integrate::pcvv`, as the undecomposed step).
+fn predict<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt: Real, rotates: bool) {
+    let n = sub.n_owned;
+    let p = &mut sub.particles;
+    let (position, velocity) = (&mut p.position[..n], &mut p.velocity[..n]);
+    pcvv::predict(position, velocity, &p.force[..n], &p.inv_mass[..n], dt);
+    if let Some(a) = p.angular.as_mut().filter(|_| rotates) {
+        pcvv::predict_rate(&mut a.omega[..n], &a.torque[..n], &a.inv_inertia[..n], dt);
+    }
+}
+
+/// PCVV's corrector for the owned particles from the forces (and torques) before this
+/// step's; whether all stay finite.
+fn correct<H: PairHistory, WH: PairHistory, L, W>(
+    sub: &mut Subdomain<H, WH>,
+    old_force: &[Vec3],
+    old_torque: Option<&[Vec3]>,
+    physics: &Physics<'_, L, W>,
+) -> bool {
+    let n = sub.n_owned;
+    let dt = physics.dt;
+    let p = &mut sub.particles;
+    let mut finite = pcvv::correct(
+        &mut p.velocity[..n],
+        &p.force[..n],
+        old_force,
+        &p.inv_mass[..n],
+        dt,
+    );
+    if let (Some(a), Some(old_torque)) = (p.angular.as_mut(), old_torque) {
+        if physics.rotates {
+            let (omega, torque) = (&mut a.omega[..n], &a.torque[..n]);
+            finite &= pcvv::correct(omega, torque, old_torque, &a.inv_inertia[..n], dt);
+        }
+    }
+    finite
+}
+
 /// `v += dt/2 F/m` (and spins) for the owned particles; whether all stay finite.
 fn closing_kick<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt: Real) -> bool {
     let half = 0.5 * dt;
@@ -501,12 +741,14 @@ fn closing_kick<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt:
 
 /// Forces (and torques) on `sub`'s owned particles: every listed pair evaluated with the
 /// lower id first and added to whichever of its particles are owned here (both for an owned
-/// pair: a half list without stored reactions), then gravity and the planar walls. Returns
-/// the deepest pair and wall overlaps.
+/// pair: a half list without stored reactions), then gravity, the planar walls and the
+/// bodies (with their histories, as the undecomposed owner pass). Returns the deepest pair
+/// and wall (or body) overlaps and the bodies' loads summed over the owned particles in
+/// order.
 fn forces<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
-) -> (Real, Real) {
+) -> ForceSums {
     let n = sub.n_owned;
     let ForceView {
         id,
@@ -569,6 +811,7 @@ fn forces<L: PairLaw, W: WallLaw>(
     }
     let mut deepest_wall: Real = 0.0;
     let walls = physics.walls;
+    let mut body_loads = vec![BodyLoad::default(); physics.bodies.len()];
     for i in 0..n {
         let particle = WallParticle {
             species: state.species[i] as usize,
@@ -578,27 +821,61 @@ fn forces<L: PairLaw, W: WallLaw>(
             mass: state.mass[i],
         };
         let mut f = force[i] + state.mass[i] * physics.gravity;
-        let overlap = if rotates && W::NEEDS_ROTATION {
+        let mut overlap;
+        if rotates {
             let slots = &mut sub.wall_history[i * physics.wall_slots..][..physics.wall_slots];
-            let (wall_history, _) = slots.split_at_mut(walls.walls.len());
+            let (wall_history, body_history) = slots.split_at_mut(walls.walls.len());
             let omega = state.omega.map_or(Vec3::ZERO, |w| w[i]);
-            let (wf, wt, o) = walls.force_and_torque_on(
-                physics.wall_law,
-                &particle,
-                omega,
-                wall_history,
-                physics.dt,
-            );
-            f += wf;
-            torque[i] += wt;
-            o
+            if W::NEEDS_ROTATION {
+                let (wf, wt, o) = walls.force_and_torque_on(
+                    physics.wall_law,
+                    &particle,
+                    omega,
+                    wall_history,
+                    physics.dt,
+                );
+                f += wf;
+                torque[i] += wt;
+                overlap = o;
+            } else {
+                let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
+                f += wf;
+                overlap = o;
+            }
+            let with_history = physics.bodies.iter().zip(body_history);
+            for ((body, history), load) in with_history.zip(&mut body_loads) {
+                let (bf, bt, l, o) = body_force_and_torque(
+                    body,
+                    physics.wall_law,
+                    &particle,
+                    omega,
+                    history,
+                    physics.dt,
+                );
+                f += bf;
+                torque[i] += bt;
+                *load += l;
+                overlap = larger(overlap, o);
+            }
         } else {
             let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
             f += wf;
-            o
-        };
+            overlap = o;
+            for (body, load) in physics.bodies.iter().zip(&mut body_loads) {
+                let (bf, l, o) = body_force(body, physics.wall_law, &particle, physics.dt);
+                f += bf;
+                *load += l;
+                overlap = larger(overlap, o);
+            }
+        }
         force[i] = f;
         deepest_wall = larger(deepest_wall, overlap);
     }
-    (deepest_pair, deepest_wall)
+    ForceSums {
+        deepest_pair,
+        deepest_wall,
+        finite: true,
+        body_loads,
+        kinematic_loads: Vec::new(),
+    }
 }
