@@ -40,6 +40,25 @@ impl Particles {
         self.position.len()
     }
 
+    /// Bytes the per-particle arrays hold (at their capacity).
+    pub fn array_bytes(&self) -> usize {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let mut total = bytes(&self.id)
+            + bytes(&self.species)
+            + bytes(&self.position)
+            + bytes(&self.velocity)
+            + bytes(&self.force)
+            + bytes(&self.radius)
+            + bytes(&self.mass)
+            + bytes(&self.inv_mass);
+        if let Some(a) = &self.angular {
+            total += bytes(&a.omega) + bytes(&a.torque) + bytes(&a.inv_inertia);
+        }
+        total
+    }
+
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
     }

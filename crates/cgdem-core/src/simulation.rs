@@ -479,23 +479,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             v.capacity() * std::mem::size_of::<T>()
         }
         let p = &self.particles;
-        let mut particle_bytes = bytes(&p.id)
-            + bytes(&p.species)
-            + bytes(&p.position)
-            + bytes(&p.velocity)
-            + bytes(&p.force)
-            + bytes(&p.radius)
-            + bytes(&p.mass)
-            + bytes(&p.inv_mass)
+        let particle_bytes = p.array_bytes()
             + bytes(&self.wall_history)
             + bytes(&self.body_loads)
             + bytes(&self.old_force)
             + bytes(&self.old_torque)
             + self.list.particle_bytes();
-        if let Some(a) = &p.angular {
-            particle_bytes += bytes(&a.omega) + bytes(&a.torque) + bytes(&a.inv_inertia);
-        }
-        MemoryUse {
+        let global = MemoryUse {
             particles: p.len(),
             particle_bytes,
             pairs: self.list.pairs.len(),
@@ -504,6 +494,21 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 + bytes(&self.reaction_force)
                 + bytes(&self.reaction_spin),
             history_entries: self.history.len(),
+        };
+        match &self.decomposition {
+            // This rank's subdomains (ghosts included) and their lists, per particle it
+            // owns, plus the world's arrays the outputs read (gathered when read, on every
+            // rank: all particles; the global list stays empty).
+            Some(d) => {
+                let local = d.memory_use();
+                MemoryUse {
+                    particle_bytes: global.particle_bytes
+                        + global.pair_bytes
+                        + local.particle_bytes,
+                    ..local
+                }
+            }
+            None => global,
         }
     }
 
@@ -941,28 +946,25 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.neighbor.skin,
             comm,
         );
-        if !decomposition.comm.is_distributed() {
-            (self.particles, self.wall_history) = decomposition.gathered();
-        }
         self.decomposition = Some(Box::new(decomposition));
         self.decomposed_forces(false);
-        // Under MPI the forces do not reach `particles`: gather them (every rank).
+        // The forces live in the subdomains: gather them (every rank).
         self.sync_particles();
     }
 
-    /// Under MPI, brings every rank's owned particles into `particles` (subdomain order, as
-    /// one process lays them out): call before reading `particles` while decomposed.
-    /// Collective: every rank must call it at the same step. Nothing to do otherwise.
+    /// While decomposed, brings the subdomains' owned particles (every rank's under MPI)
+    /// into `particles`, in subdomain order: call before reading `particles`. The step
+    /// itself never writes `particles` (threads and ranks alike), so that no step pays for
+    /// a copy that only outputs read. Collective: every rank must call it at the same step.
+    /// Nothing to do when not decomposed.
     pub fn sync_particles(&mut self) {
         if let Some(d) = &self.decomposition {
-            if d.comm.is_distributed() {
-                (self.particles, self.wall_history) = d.gathered();
-            }
+            (self.particles, self.wall_history) = d.gathered();
         }
     }
 
-    /// Particles in the world (over all ranks under MPI, where `particles` is refreshed only
-    /// by `sync_particles`).
+    /// Particles in the world (while decomposed, over all subdomains and ranks: `particles`
+    /// is refreshed only by `sync_particles`).
     pub fn particle_count(&self) -> usize {
         match &self.decomposition {
             Some(d) => d.total,
@@ -1025,17 +1027,26 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     fn step_decomposed(&mut self) {
         let dt = self.dt;
         let d = self.decomposition.as_mut().expect("decomposed");
-        if d.drift_kick(dt) {
+        if d.drift_and_pack(dt) {
             self.rebuild_decomposed();
+            self.decomposed_forces(true);
         } else {
-            d.forward();
+            self.decomposed_forces_forwarded();
         }
-        self.decomposed_forces(true);
     }
 
-    /// Forces from the current ghosts (then the closing kick if `kick`), copied with the
-    /// state into `particles`; the guard's overlaps and finiteness.
+    /// Forces from the current ghosts (then the closing kick if `kick`); the guard's
+    /// overlaps and finiteness.
     fn decomposed_forces(&mut self, kick: bool) {
+        self.decomposed_pass(kick, false);
+    }
+
+    /// The ghosts take their owners' states packed by the drift, then forces and kick.
+    fn decomposed_forces_forwarded(&mut self) {
+        self.decomposed_pass(true, true);
+    }
+
+    fn decomposed_pass(&mut self, kick: bool, forward: bool) {
         let d = self.decomposition.as_mut().expect("decomposed");
         let physics = Physics {
             law: &self.law,
@@ -1047,7 +1058,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             wall_slots: (self.walls.walls.len() + self.bodies.len()).max(1),
             rotates: Self::ROTATES,
         };
-        let (pairs, walls, finite) = d.forces(&physics, kick, &mut self.particles);
+        let (pairs, walls, finite) = if forward {
+            d.forward_and_forces(&physics)
+        } else {
+            d.forces(&physics, kick)
+        };
         self.guard.pair_overlap = pairs;
         self.guard.wall_overlap = walls;
         if kick {
@@ -1056,7 +1071,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 
     /// `rebuild` for the subdomains: the same removal of particles that left the box (and
-    /// its accounting), then exchange, borders and lists; `particles` is laid out again.
+    /// its accounting), then exchange, borders and lists.
     fn rebuild_decomposed(&mut self) {
         let stop_on_lost = self.guard.settings.stop_on_lost;
         let domain = self.domain.clone();
@@ -1107,9 +1122,6 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             && d.builds.is_multiple_of(self.neighbor.resort_every as u64);
         let slots = (self.walls.walls.len() + self.bodies.len()).max(1);
         d.rebuild(&domain, slots, &keep, resort);
-        if !d.comm.is_distributed() {
-            (self.particles, self.wall_history) = d.gathered();
-        }
     }
 
     pub fn kinetic_energy(&self) -> Real {

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::balance::{imbalance, Balance};
 use super::borders::borders;
 use super::exchange::exchange;
-use super::forward::{forward, States};
+use super::forward::{pack, unpack, States};
 use super::list::LocalList;
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
@@ -17,8 +17,8 @@ use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
 use crate::math::{Real, Vec3};
 use crate::neighbor::{CellGrid, Pair};
-use crate::particles::{AngularState, Particles};
-use crate::simulation::{larger, pair_force, ForceView, Owner, ParticleState};
+use crate::particles::Particles;
+use crate::simulation::{larger, pair_force, ForceView, MemoryUse, Owner, ParticleState};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -247,65 +247,90 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         rows
     }
 
-    /// Half kick and drift of the owned particles; whether one moved past half the skin.
-    pub fn drift_kick(&mut self, dt: Real) -> bool {
+    /// Half kick and drift of the owned particles, and their new states packed for the
+    /// ghosts, in one pass per subdomain (a step is two fork-joins of the thread pool, not
+    /// four). Whether a particle moved past half the skin, on any rank: then a rebuild
+    /// follows and the packed states are not used.
+    pub fn drift_and_pack(&mut self, dt: Real) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
+        let count = self.subdomains.len();
+        self.buffers.resize_with(count, Vec::new);
+        let comm = &self.comm;
         let moved = self
-            .owned_mut()
-            .map(|sub| drift_kick(sub, dt, limit_sq))
+            .subdomains
+            .par_iter_mut()
+            .zip(self.buffers.par_iter_mut())
+            .filter(|(sub, _)| comm.owns(sub.index, count))
+            .map(|(sub, out)| {
+                let moved = drift_kick(sub, dt, limit_sq);
+                pack(sub, out);
+                moved
+            })
             .reduce(|| false, |a, b| a || b);
         // The exchange is collective: every rank rebuilds when one must.
         self.comm.any(moved)
     }
 
-    /// Ghosts take their owners' state.
-    pub fn forward(&mut self) {
-        self.bytes_sent += forward(
-            &mut self.subdomains,
+    /// The ghosts take the states `drift_and_pack` packed (`forward`), then forces and
+    /// the closing half kick: see `forces`.
+    pub fn forward_and_forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
+        &mut self,
+        physics: &Physics<'_, L, W>,
+    ) -> (Real, Real, bool) {
+        let subs = &self.subdomains;
+        self.bytes_sent += self.comm.route(
             &mut self.buffers,
-            &self.comm,
+            |from, list, _| subs[from].sends[list].to,
             &mut self.forward_counts,
         );
+        self.pass(physics, true, true)
     }
 
-    /// Forces on the owned particles, then (if `kick`) the closing half kick, and the new
-    /// state copied into `world`'s arrays (the subdomains' owned particles side by side; not
-    /// under MPI, where `gathered` brings them when they are read). Returns the deepest pair
-    /// and wall overlaps and whether every value is finite, over all ranks.
+    /// Forces on the owned particles, then (if `kick`) the closing half kick. The world's
+    /// arrays are not touched: `gathered` brings the owned particles when they are read
+    /// (copying them every step cost about 120 bytes per particle per step). Returns the
+    /// deepest pair and wall overlaps and whether every value is finite, over all ranks.
     pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         kick: bool,
-        world: &mut Particles,
     ) -> (Real, Real, bool) {
-        let step = |sub: &mut Subdomain<H, WH>| {
-            let (pairs, walls) = forces(sub, physics);
-            let finite = !kick || closing_kick(sub, physics.dt);
-            (pairs, walls, finite)
-        };
-        let reduce = |a: (Real, Real, bool), b: (Real, Real, bool)| {
-            (larger(a.0, b.0), larger(a.1, b.1), a.2 && b.2)
-        };
-        if self.comm.is_distributed() {
-            let (pairs, walls, finite) = self
-                .owned_mut()
-                .map(step)
-                .reduce(|| (0.0, 0.0, true), reduce);
-            // One reduction for the three (max is exact in any order).
-            let mut v = [pairs, walls, if finite { 0.0 } else { 1.0 }];
-            self.comm.max_each(&mut v);
-            return (v[0], v[1], v[2] == 0.0);
-        }
-        let mut views = world_views(world, self.subdomains.iter().map(|s| s.n_owned));
-        self.subdomains
+        self.pass(physics, kick, false)
+    }
+
+    /// One pass per owned subdomain: unpack the ghosts' states (if `unpack_ghosts`),
+    /// forces, closing kick (if `kick`); the guard's values reduced over all ranks.
+    fn pass<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
+        &mut self,
+        physics: &Physics<'_, L, W>,
+        kick: bool,
+        unpack_ghosts: bool,
+    ) -> (Real, Real, bool) {
+        let count = self.subdomains.len();
+        let (comm, buffers) = (&self.comm, &self.buffers);
+        let (pairs, walls, finite) = self
+            .subdomains
             .par_iter_mut()
-            .zip(views.par_iter_mut())
-            .map(|(sub, view)| {
-                let result = step(sub);
-                view.copy_from(&sub.particles);
-                result
+            .filter(|sub| comm.owns(sub.index, count))
+            .map(|sub| {
+                if unpack_ghosts {
+                    unpack(sub, buffers);
+                }
+                let (pairs, walls) = forces(sub, physics);
+                let finite = !kick || closing_kick(sub, physics.dt);
+                (pairs, walls, finite)
             })
-            .reduce(|| (0.0, 0.0, true), reduce)
+            .reduce(
+                || (0.0, 0.0, true),
+                |a, b| (larger(a.0, b.0), larger(a.1, b.1), a.2 && b.2),
+            );
+        if !self.comm.is_distributed() {
+            return (pairs, walls, finite);
+        }
+        // One reduction for the three (max is exact in any order).
+        let mut v = [pairs, walls, if finite { 0.0 } else { 1.0 }];
+        self.comm.max_each(&mut v);
+        (v[0], v[1], v[2] == 0.0)
     }
 
     /// Kinetic plus gravitational energy (from `origin`) and mobile mass of the owned
@@ -360,6 +385,42 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         per_sub.iter().map(|w| w[0]).sum()
     }
 
+    /// The arrays of the subdomains this rank steps: particles (owned and ghosts), wall
+    /// histories, send lists, forward buffers and list references as per-particle bytes;
+    /// pairs and their histories as per-pair bytes (a pair across a boundary is listed, and
+    /// counted, on both sides).
+    pub fn memory_use(&self) -> MemoryUse {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let mut m = MemoryUse {
+            particles: 0,
+            particle_bytes: 0,
+            pairs: 0,
+            pair_bytes: 0,
+            history_entries: 0,
+        };
+        for sub in self.owned() {
+            m.particles += sub.n_owned;
+            m.particle_bytes += sub.particles.array_bytes()
+                + bytes(&sub.wall_history)
+                + bytes(&sub.list.out_start)
+                + bytes(&sub.list.reference)
+                + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
+                + bytes(&sub.receives);
+            m.pairs += sub.list.pairs.len();
+            m.pair_bytes += bytes(&sub.list.pairs) + bytes(&sub.list.history);
+            m.history_entries += sub.list.history.len();
+        }
+        m.particle_bytes += self
+            .buffers
+            .iter()
+            .flatten()
+            .map(|States(b)| bytes(b))
+            .sum::<usize>();
+        m
+    }
+
     /// Pairs listed over all subdomains (a pair across a boundary twice).
     pub fn listed_pairs(&self) -> usize {
         let here: usize = self.owned().map(|s| s.list.pairs.len()).sum();
@@ -394,61 +455,6 @@ fn resort_by_cell<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, c
     for &o in &order {
         sub.rows.push(old.of(o as usize));
     }
-}
-
-/// The world's per-particle arrays the step writes, cut at the subdomains' owned counts.
-struct WorldView<'a> {
-    position: &'a mut [Vec3],
-    velocity: &'a mut [Vec3],
-    force: &'a mut [Vec3],
-    omega: &'a mut [Vec3],
-    torque: &'a mut [Vec3],
-}
-
-impl WorldView<'_> {
-    fn copy_from(&mut self, p: &Particles) {
-        let n = self.position.len();
-        self.position.copy_from_slice(&p.position[..n]);
-        self.velocity.copy_from_slice(&p.velocity[..n]);
-        self.force.copy_from_slice(&p.force[..n]);
-        if let Some(a) = &p.angular {
-            self.omega.copy_from_slice(&a.omega[..n]);
-            self.torque.copy_from_slice(&a.torque[..n]);
-        }
-    }
-}
-
-fn world_views(world: &mut Particles, counts: impl Iterator<Item = usize>) -> Vec<WorldView<'_>> {
-    let Particles {
-        position,
-        velocity,
-        force,
-        angular,
-        ..
-    } = world;
-    let (mut omega, mut torque): (&mut [Vec3], &mut [Vec3]) = match angular {
-        Some(AngularState { omega, torque, .. }) => (omega, torque),
-        None => (&mut [], &mut []),
-    };
-    let (mut position, mut velocity, mut force) =
-        (&mut position[..], &mut velocity[..], &mut force[..]);
-    let mut views = Vec::new();
-    for n in counts {
-        let (p, rest_p) = position.split_at_mut(n);
-        let (v, rest_v) = velocity.split_at_mut(n);
-        let (f, rest_f) = force.split_at_mut(n);
-        let (w, rest_w) = omega.split_at_mut(if omega.is_empty() { 0 } else { n });
-        let (t, rest_t) = torque.split_at_mut(if torque.is_empty() { 0 } else { n });
-        views.push(WorldView {
-            position: p,
-            velocity: v,
-            force: f,
-            omega: w,
-            torque: t,
-        });
-        (position, velocity, force, omega, torque) = (rest_p, rest_v, rest_f, rest_w, rest_t);
-    }
-    views
 }
 
 /// `v += dt/2 F/m; x += dt v` (and the spin's half kick) for the owned particles; whether

@@ -106,7 +106,8 @@ impl Comm {
     /// grow to hold them, with `T::default()` in slots meant for other ranks). Returns the
     /// bytes this rank sent. Nothing moves in one process. `counts`: the words each rank
     /// sends here, when known (forward between two rebuilds sends the same amounts each
-    /// step), saving a collective; filled in when `None`.
+    /// step): then only the ranks that exchange anything meet, point to point; filled in
+    /// (by a collective over all ranks) when `None`.
     pub fn route<T: Wire + Default>(
         &self,
         packed: &mut [Vec<T>],
@@ -359,6 +360,7 @@ impl Wire for Particles {
 #[cfg(feature = "mpi")]
 mod mpi_comm {
     use mpi::datatype::{Partition, PartitionMut};
+    use mpi::request::WaitGuard;
     use mpi::topology::SimpleCommunicator;
     use mpi::traits::*;
     use mpi::Count;
@@ -419,16 +421,13 @@ mod mpi_comm {
             known: &mut Option<Vec<usize>>,
         ) -> Vec<Vec<Real>> {
             let send_counts: Vec<Count> = out.iter().map(|b| b.len() as Count).collect();
-            let recv_counts: Vec<Count> = match known {
-                Some(counts) => counts.iter().map(|&c| c as Count).collect(),
-                None => {
-                    let mut recv_counts = vec![0 as Count; self.size];
-                    self.world
-                        .all_to_all_into(&send_counts[..], &mut recv_counts[..]);
-                    *known = Some(recv_counts.iter().map(|&c| c as usize).collect());
-                    recv_counts
-                }
-            };
+            if let Some(counts) = known {
+                return self.exchange_with_peers(out, counts);
+            }
+            let mut recv_counts = vec![0 as Count; self.size];
+            self.world
+                .all_to_all_into(&send_counts[..], &mut recv_counts[..]);
+            *known = Some(recv_counts.iter().map(|&c| c as usize).collect());
             let send: Vec<Real> = out.concat();
             let send_displs = Self::displacements(&send_counts);
             let recv_displs = Self::displacements(&recv_counts);
@@ -444,6 +443,37 @@ mod mpi_comm {
                 .zip(&recv_displs)
                 .map(|(&c, &d)| recv[d as usize..(d + c) as usize].to_vec())
                 .collect()
+        }
+
+        /// `all_to_all` once every rank knows what each other rank sends it (the forward
+        /// between two rebuilds): one message to and from each rank that sends or receives
+        /// anything, the neighbours' ranks, instead of a collective over all ranks (whose
+        /// cost grows with their number: see the scale-out estimate in PERFORMANCE.md).
+        fn exchange_with_peers(
+            &self,
+            out: Vec<Vec<Real>>,
+            recv_counts: &[usize],
+        ) -> Vec<Vec<Real>> {
+            let mut received: Vec<Vec<Real>> = recv_counts.iter().map(|&c| vec![0.0; c]).collect();
+            mpi::request::scope(|scope| {
+                let mut pending = Vec::new();
+                for (rank, buffer) in received.iter_mut().enumerate() {
+                    if !buffer.is_empty() {
+                        let process = self.world.process_at_rank(rank as i32);
+                        pending.push(WaitGuard::from(
+                            process.immediate_receive_into(scope, &mut buffer[..]),
+                        ));
+                    }
+                }
+                for (rank, buffer) in out.iter().enumerate() {
+                    if !buffer.is_empty() {
+                        let process = self.world.process_at_rank(rank as i32);
+                        pending.push(WaitGuard::from(process.immediate_send(scope, &buffer[..])));
+                    }
+                }
+                // Dropping the guards waits for every request.
+            });
+            received
         }
 
         pub(super) fn all_gather(&self, mine: Vec<Real>) -> Vec<Vec<Real>> {
