@@ -14,8 +14,8 @@ use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::decomposition::step::{Decomposition, Drive, Physics};
-use crate::decomposition::{balance, choose_counts, BalanceSpec, Comm, Grid, GridSpec};
 use crate::decomposition::HistoryRows;
+use crate::decomposition::{balance, choose_counts, BalanceSpec, Comm, Grid, GridSpec};
 use crate::domain::Domain;
 use crate::geometry::Aabb;
 use crate::guard::{
