@@ -348,30 +348,17 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.kinematic = kinematic;
     }
 
-    /// Moves the particles of bodies built of particles to the bodies' pose at time `t`:
-    /// position `c + R (q - point)`, velocity `omega x r + v` and, where particles spin, the
-    /// body's angular velocity (the material of a rigid body turns with it, so a contact point
-    /// on a body particle moves as the body's surface does; LAMMPS's `fix move rotate` does
-    /// the same); all zero before the motion starts. They are frozen (zero inverse mass), so
-    /// the integrator never changes them.
+    /// Moves the particles of bodies built of particles to the bodies' pose at time `t`
+    /// (`KinematicParticles::drive`); all zero before the motion starts. They are frozen
+    /// (zero inverse mass), so the integrator never changes them.
     fn drive_kinematic_particles(&mut self, t: Real) {
         if self.kinematic.is_empty() {
             return;
         }
         self.pose_bodies_at(t);
-        let p = &mut self.particles;
+        let n = self.particles.len();
         for group in &self.kinematic {
-            let body = &self.bodies[group.body];
-            for k in 0..p.id.len() {
-                if let Some(q) = group.reference_of(p.id[k]) {
-                    let x = body.to_world(q);
-                    p.position[k] = x;
-                    p.velocity[k] = body.surface_velocity(x);
-                    if let Some(angular) = p.angular.as_mut() {
-                        angular.omega[k] = body.angular_velocity();
-                    }
-                }
-            }
+            group.drive(&self.bodies[group.body], &mut self.particles, n);
         }
     }
 

@@ -5,8 +5,10 @@
 
 use rayon::prelude::*;
 
+use super::Body;
 use crate::geometry::{Bvh, FastWindingNumber, TriMesh};
 use crate::math::{Real, Vec3};
+use crate::particles::Particles;
 
 /// The sites of an fcc lattice with nearest-neighbour distance `spacing` (cube edge
 /// `sqrt(2) spacing`), one site at `origin`, axes along x, y, z, whose points lie inside
@@ -61,6 +63,24 @@ impl KinematicParticles {
         id.checked_sub(self.first_id)
             .and_then(|k| self.reference.get(k as usize))
             .copied()
+    }
+
+    /// Moves this body's particles among the first `n` of `p` to `body`'s pose: position
+    /// `c + R (q - point)`, velocity `omega x r + v` and, where particles spin, the body's
+    /// angular velocity (the material of a rigid body turns with it, so a contact point on a
+    /// body particle moves as the body's surface does; LAMMPS's `fix move rotate` does the
+    /// same).
+    pub fn drive(&self, body: &Body, p: &mut Particles, n: usize) {
+        for k in 0..n {
+            if let Some(q) = self.reference_of(p.id[k]) {
+                let x = body.to_world(q);
+                p.position[k] = x;
+                p.velocity[k] = body.surface_velocity(x);
+                if let Some(angular) = p.angular.as_mut() {
+                    angular.omega[k] = body.angular_velocity();
+                }
+            }
+        }
     }
 }
 

@@ -608,23 +608,10 @@ fn drift_kick<H: PairHistory, WH: PairHistory>(
     moved
 }
 
-/// Moves the owned particles of bodies built of particles to their bodies' pose: position
-/// from the body frame, velocity of the body's material there and, where particles spin,
-/// the body's angular velocity (as `World::drive_kinematic_particles`).
+/// Moves the owned particles of bodies built of particles to their bodies' pose.
 fn drive_kinematic<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, drive: &Drive<'_>) {
-    let p = &mut sub.particles;
     for group in drive.kinematic {
-        let body = &drive.bodies[group.body];
-        for k in 0..sub.n_owned {
-            if let Some(q) = group.reference_of(p.id[k]) {
-                let x = body.to_world(q);
-                p.position[k] = x;
-                p.velocity[k] = body.surface_velocity(x);
-                if let Some(angular) = p.angular.as_mut() {
-                    angular.omega[k] = body.angular_velocity();
-                }
-            }
-        }
+        group.drive(&drive.bodies[group.body], &mut sub.particles, sub.n_owned);
     }
 }
 
