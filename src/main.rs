@@ -133,8 +133,8 @@ enum Command {
         /// grid with the least ghost surface. Off by default. Results match the undecomposed
         /// run to rounding, not bitwise. Under `mpirun -np N` (a build with `--features mpi`)
         /// each rank steps a block of the subdomains; the outputs are bitwise those of the same
-        /// grid on threads.
-        #[arg(long)]
+        /// grid on threads. Not with --sweep (its runs are not decomposed).
+        #[arg(long, conflicts_with = "sweep")]
         grid: Option<cgdem_core::decomposition::GridSpec>,
         /// With --grid: at each list rebuild, when the imbalance (most particles in one
         /// subdomain over the mean) passes this threshold, move the cut planes so that each
@@ -215,6 +215,14 @@ enum Command {
         /// what moved since the last night recorded there.
         #[arg(long)]
         history: Option<PathBuf>,
+        /// Decompose cgdem's runs as `cgdem run --grid` does (`2x1x1`, or a count for the grid
+        /// with the least ghost surface per scene), stepped on --threads, to compare the
+        /// verdicts with the undecomposed suite's. The reference codes run as without it.
+        #[arg(long)]
+        grid: Option<cgdem_core::decomposition::GridSpec>,
+        /// With --grid: as `cgdem run --balance`.
+        #[arg(long, value_name = "THRESH|off", default_value_t, requires = "grid")]
+        balance: cgdem_core::decomposition::BalanceSpec,
     },
     /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
     /// starts from one state that cgdem prepares, runs the same steps, alternating (A B C,
@@ -595,6 +603,8 @@ fn main() -> ExitCode {
             jobs,
             fault,
             history,
+            grid,
+            balance,
         } => {
             let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
                 PathBuf::from(&suite)
@@ -618,6 +628,7 @@ fn main() -> ExitCode {
                 stop: interrupt.as_ref().map(|i| i.flag()),
                 cgdem_faults: fault,
                 history,
+                decomposition: cgdem_harness::runs::CgdemDecomposition { grid, balance },
             };
             let result = pool.install(|| cgdem_harness::validate::validate(&options));
             if let Some(code) = interrupted(&interrupt, &out) {

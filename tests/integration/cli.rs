@@ -24,6 +24,31 @@ fn a_missing_scene_file_is_an_error_naming_it() {
     assert!(!stderr.contains("panicked"));
 }
 
+/// A sweep's runs are not decomposed: `--grid` with `--sweep` is refused rather than ignored.
+#[test]
+fn grid_with_a_sweep_is_refused_not_ignored() {
+    let out = cgdem()
+        .args([
+            "run",
+            "tests/data/tiny_drop.toml",
+            "--sweep",
+            "rpm=140",
+            "--grid",
+            "2x1x1",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--grid")
+            && stderr.contains("--sweep")
+            && stderr.contains("cannot be used with"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn lambda_must_be_a_power_of_two() {
     let out = cgdem()

@@ -60,3 +60,63 @@ fn stability_suite_classifies_a_stable_and_a_detected_case() {
     assert!(html.contains("Stability") && html.contains("stab_impact_50ms_wca"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `validate --grid`: every cgdem run of the suite (a case and a stability entry) is
+/// decomposed as `cgdem run --grid` decomposes it, and `--reuse` without `--grid` does not
+/// take the decomposed run for an undecomposed one.
+#[test]
+fn validate_grid_decomposes_cgdem_runs_and_reuse_tells_them_apart() {
+    let dir = std::env::temp_dir().join(format!("cgdem-validate-grid-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let suite = dir.join("suite.toml");
+    std::fs::write(
+        &suite,
+        "name = \"grid-test\"\n\
+         [[case]]\nfile = \"tests/data/tiny_drop.toml\"\ncodes = [\"cgdem\"]\nlambdas = [1]\nseeds = [1]\n\
+         [[stability]]\nfile = \"validation/stability/impact_50ms_wca.toml\"\ncodes = [\"cgdem\"]\n",
+    )
+    .unwrap();
+    let report = dir.join("report");
+    let validate = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_cgdem"))
+            .args(["validate", "--quiet", "--threads", "2", "--suite"])
+            .arg(&suite)
+            .arg("--out")
+            .arg(&report)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let summary_of = |run: &str| -> serde_json::Value {
+        let path = report.join(run).join("summary.json");
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+    };
+    let case_run = "runs/tiny_drop/cgdem-lambda1-seed1";
+    let stability_run = "runs/stability/stab_impact_50ms_wca/cgdem";
+
+    validate(&["--grid", "2x1x1", "--balance", "off"]);
+    for run in [case_run, stability_run] {
+        let d = &summary_of(run)["decomposition"];
+        assert_eq!(d["grid"], serde_json::json!([2, 1, 1]), "{run}: {d}");
+        assert!(d["balance_threshold"].is_null(), "{run}: {d}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["stability"][0]["verdict"], "stable", "{summary}");
+    assert!(
+        summary.to_string().contains("2x1x1, balance off"),
+        "{summary}"
+    );
+
+    validate(&["--reuse"]);
+    assert!(summary_of(case_run)["decomposition"].is_null());
+    assert!(summary_of(stability_run)["decomposition"].is_null());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::code::Code;
 use crate::suite_entry::SuiteError;
 use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
+use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_core::run::{run, Progress, RunOptions};
 use cgdem_core::scene::Scene;
 
@@ -166,6 +167,39 @@ pub struct ValidateOptions {
     /// A nightly history directory (`history.json`, `cgdem history`): the report's first
     /// screen says what moved since the last night recorded there.
     pub history: Option<PathBuf>,
+    /// `--grid`/`--balance`: cgdem's runs decomposed as `cgdem run --grid` decomposes them.
+    pub decomposition: CgdemDecomposition,
+}
+
+/// `validate --grid` and `--balance`: every cgdem run of the suite (cases, accuracy sweeps,
+/// stability) split into subdomains on the suite's threads, so that its verdicts can be
+/// compared with the undecomposed suite's. The reference codes run as without it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CgdemDecomposition {
+    /// None: undecomposed (the default).
+    pub grid: Option<GridSpec>,
+    pub balance: BalanceSpec,
+}
+
+impl CgdemDecomposition {
+    /// Whether the run that wrote `summary` (its summary.json) was decomposed this way, so
+    /// that `--reuse` never takes a decomposed run for an undecomposed one or the reverse.
+    /// A count (`--grid 4`) matches any grid of that many subdomains.
+    pub fn made(&self, summary: &serde_json::Value) -> bool {
+        let done = &summary["decomposition"];
+        let Some(spec) = self.grid else {
+            return done.is_null();
+        };
+        let Some(grid) = done["grid"].as_array() else {
+            return false;
+        };
+        let grid: Vec<u64> = grid.iter().map(|n| n.as_u64().unwrap_or(0)).collect();
+        let same_grid = match spec {
+            GridSpec::Given(counts) => grid.iter().zip(counts).all(|(&a, b)| a == b as u64),
+            GridSpec::Auto(n) => grid.iter().product::<u64>() == n as u64,
+        };
+        same_grid && done["balance_threshold"].as_f64() == self.balance.threshold()
+    }
 }
 
 /// `run` applied to every item, `jobs` at a time, results in the items' order. With more
@@ -270,7 +304,12 @@ fn run_cgdem(
 ) -> Result<bool, RunOutcome> {
     let coarse = coarse_grain_by(&scene.with_insertion_seed(seed), lambda, rule)
         .map_err(|e| RunOutcome::Failed(e.to_string()))?;
-    if options.reuse && finished_digest(dir).as_deref() == Some(coarse.digest().as_str()) {
+    if options.reuse
+        && finished_summary(dir).is_some_and(|s| {
+            s["scene_digest"].as_str() == Some(coarse.digest().as_str())
+                && options.decomposition.made(&s)
+        })
+    {
         return Ok(true);
     }
     let run_options = RunOptions {
@@ -279,6 +318,8 @@ fn run_cgdem(
         force_dt: false,
         keep_going: options.keep_going,
         stop: options.stop.clone(),
+        grid: options.decomposition.grid,
+        balance: options.decomposition.balance,
         ..Default::default()
     };
     run(&coarse, &run_options)
@@ -286,11 +327,18 @@ fn run_cgdem(
         .map_err(|e| RunOutcome::Failed(e.to_string()))
 }
 
+/// `dir/summary.json`, if a finished run left one.
+fn finished_summary(dir: &Path) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
 /// The scene digest in `dir/summary.json`, if a finished run left one.
 fn finished_digest(dir: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
-    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
-    value.get("scene_digest")?.as_str().map(str::to_string)
+    finished_summary(dir)?
+        .get("scene_digest")?
+        .as_str()
+        .map(str::to_string)
 }
 
 /// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
@@ -428,5 +476,27 @@ mod tests {
             assert_eq!(outcome.to_string(), word);
         }
         assert!(serde_json::from_str::<Outcome>("\"completed\"").is_err());
+    }
+
+    #[test]
+    fn reuse_takes_only_a_run_decomposed_as_asked() {
+        let plain = serde_json::json!({ "scene_digest": "x" });
+        let split = |grid: [u64; 3], threshold: Option<f64>| serde_json::json!({ "decomposition": { "grid": grid, "balance_threshold": threshold } });
+        let asked =
+            |grid: Option<GridSpec>, balance: BalanceSpec| CgdemDecomposition { grid, balance };
+        let none = CgdemDecomposition::default();
+        assert!(none.made(&plain));
+        assert!(!none.made(&split([2, 1, 1], Some(1.1))));
+        let given = asked(Some(GridSpec::Given([2, 1, 1])), BalanceSpec::Shift(1.1));
+        assert!(given.made(&split([2, 1, 1], Some(1.1))));
+        assert!(!given.made(&plain));
+        assert!(!given.made(&split([1, 2, 1], Some(1.1))));
+        assert!(!given.made(&split([2, 1, 1], None)));
+        assert!(!given.made(&split([2, 1, 1], Some(1.2))));
+        let off = asked(Some(GridSpec::Given([2, 1, 1])), BalanceSpec::Off);
+        assert!(off.made(&split([2, 1, 1], None)));
+        let count = asked(Some(GridSpec::Auto(4)), BalanceSpec::Shift(1.1));
+        assert!(count.made(&split([1, 2, 2], Some(1.1))));
+        assert!(!count.made(&split([2, 1, 1], Some(1.1))));
     }
 }

@@ -25,6 +25,7 @@ use super::lammps::runner::{log_tail_of, RunStatus, RunnerOptions};
 use crate::code::Code;
 use crate::csv_table::CsvTable;
 use crate::report::{Cell, Report, Table};
+use crate::runs::CgdemDecomposition;
 use crate::suite_entry::{load_variant, parse_codes, parse_variant, SuiteError};
 use cgdem_core::coarse_graining::coarse_grain;
 use cgdem_core::guard::overlap_fraction;
@@ -221,6 +222,7 @@ pub fn run_stability(
     quiet: bool,
     keep_going: bool,
     reference_timeout_s: u64,
+    decomposition: CgdemDecomposition,
     report: &mut Report,
 ) -> Result<Vec<StabilityRecord>, String> {
     if cases.is_empty() {
@@ -278,7 +280,7 @@ pub fn run_stability(
                 .join(code.name());
             let _ = std::fs::remove_dir_all(&dir);
             let record = match code {
-                Code::Cgdem => run_cgdem(&scene, case, &dir, keep_going),
+                Code::Cgdem => run_cgdem(&scene, case, &dir, keep_going, decomposition),
                 Code::Lammps | Code::Liggghts => {
                     run_reference(code, &scene, case, &dir, reference_timeout_s)
                 }
@@ -317,18 +319,22 @@ fn record(scene: &Scene, code: Code, case: &StabilityCase, dir: &Path) -> Stabil
     }
 }
 
-/// cgdem with its guards (`--force-dt` where the case forces the step).
+/// cgdem with its guards (`--force-dt` where the case forces the step), decomposed when
+/// `validate --grid` asks.
 pub(crate) fn run_cgdem(
     scene: &Scene,
     case: &StabilityCase,
     dir: &Path,
     keep_going: bool,
+    decomposition: CgdemDecomposition,
 ) -> StabilityRecord {
     let mut rec = record(scene, Code::Cgdem, case, dir);
     let options = RunOptions {
         out_dir: dir.to_path_buf(),
         force_dt: case.force_dt,
         keep_going,
+        grid: decomposition.grid,
+        balance: decomposition.balance,
         ..Default::default()
     };
     let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| run(scene, &options)));
@@ -999,7 +1005,16 @@ mod tests {
     fn a_suite_without_stability_cases_adds_no_section_and_no_csv() {
         let dir = std::env::temp_dir().join(format!("cgdem-stability-none-{}", std::process::id()));
         let mut report = Report::new("t");
-        let records = run_stability(&[], &dir, true, false, 1, &mut report).unwrap();
+        let records = run_stability(
+            &[],
+            &dir,
+            true,
+            false,
+            1,
+            CgdemDecomposition::default(),
+            &mut report,
+        )
+        .unwrap();
         assert!(records.is_empty());
         assert!(!dir.join("stability.csv").exists());
         assert!(!report.render(&dir).contains("Stability"));

@@ -162,6 +162,7 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         options.quiet,
         options.keep_going,
         options.reference_timeout_s,
+        options.decomposition,
         &mut report,
     )
     .map_err(|message| ValidateError::Case {
@@ -455,6 +456,12 @@ fn provenance(suite: &Suite, options: &ValidateOptions) -> BTreeMap<String, Stri
     p.insert("suite file".into(), suite.source.display().to_string());
     p.insert("output".into(), options.out.display().to_string());
     p.insert("concurrent runs (jobs)".into(), options.jobs.to_string());
+    if let Some(grid) = options.decomposition.grid {
+        p.insert(
+            "cgdem decomposed (--grid, --balance)".into(),
+            format!("{grid}, balance {}", options.decomposition.balance),
+        );
+    }
     p
 }
 
