@@ -13,6 +13,7 @@ mod progress;
 mod refill;
 pub mod restart;
 mod setup;
+pub mod state_file;
 
 pub use hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
 pub use laws::{seed_laws, with_laws, LawVisitor};
