@@ -33,6 +33,11 @@ struct RunInvocation {
     variant: Option<String>,
     force_dt: bool,
     keep_going: bool,
+    /// `--grid` and `--balance` as given (absent in files of runs without them).
+    #[serde(default)]
+    grid: Option<String>,
+    #[serde(default)]
+    balance: Option<String>,
 }
 
 impl RunInvocation {
@@ -873,10 +878,41 @@ fn main() -> ExitCode {
                         variant: variant.clone(),
                         force_dt,
                         keep_going,
+                        grid: grid.map(|g| g.to_string()),
+                        balance: grid.map(|_| balance.to_string()),
                     },
                     None,
                 ),
             };
+            // A resumed run keeps its grid and balance unless given another grid.
+            let (grid, balance) = match (grid, &invocation.grid) {
+                (None, Some(stored)) => {
+                    use cgdem_core::decomposition::{BalanceSpec, GridSpec};
+                    let balance: Result<BalanceSpec, String> = invocation
+                        .balance
+                        .as_deref()
+                        .map_or(Ok(BalanceSpec::default()), str::parse);
+                    let parsed = stored
+                        .parse::<GridSpec>()
+                        .and_then(|g| Ok((Some(g), balance?)));
+                    match parsed {
+                        Ok(p) => p,
+                        Err(e) => {
+                            eprintln!("error: the stored --grid/--balance: {e}");
+                            return ExitCode::from(2);
+                        }
+                    }
+                }
+                _ => (grid, balance),
+            };
+            // The restart files the run writes from now on name the grid it runs on.
+            let invocation = RunInvocation {
+                grid: grid.map(|g| g.to_string()),
+                balance: grid.map(|_| balance.to_string()),
+                ..invocation
+            };
+            let checkpoint_every =
+                checkpoint_every.or_else(|| resumed.as_ref().map(|l| l.restart.checkpoint_every));
             let RunInvocation {
                 case,
                 lambda,

@@ -73,6 +73,9 @@ pub struct WorldState<H: PairHistory, WH: PairHistory> {
     /// The arrays' capacities, given back on restore so that `MemoryUse` (in summary.json)
     /// and later growth are those of the run the state was taken from.
     capacities: Vec<usize>,
+    /// The subdomains, when decomposed (`--grid`): then they hold the particles' state and
+    /// the list, and `particles` is the world's copy as last gathered.
+    decomposed: Option<crate::decomposition::DecomposedState>,
 }
 
 /// Applies `$m!` to each array of a world whose capacity `MemoryUse` counts, in a fixed
@@ -160,6 +163,8 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// Subdomains with ghosts (`--grid`); when set they hold the state, and `particles` is
     /// their owned particles side by side, refreshed every step.
     decomposition: Option<Box<Decomposition<L::History, W::History>>>,
+    /// Subdomains from a restart file, taken up by the next `set_grid`.
+    restored_grid: Option<Box<crate::decomposition::DecomposedState>>,
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
@@ -214,6 +219,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 ..Default::default()
             },
             decomposition: None,
+            restored_grid: None,
         };
         world.rebuild();
         world.compute_forces();
@@ -222,12 +228,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         world
     }
 
-    /// The world's changing state, for a restart file; None when decomposed (`--grid`), whose
-    /// state lives in the subdomains.
-    pub fn state(&self) -> Option<WorldState<L::History, W::History>> {
-        if self.decomposition.is_some() {
-            return None;
-        }
+    /// The world's changing state, for a restart file. When decomposed (`--grid`) the
+    /// subdomains' state is gathered from every rank (collective).
+    pub fn state(&self) -> WorldState<L::History, W::History> {
         let mut state = WorldState {
             particles: self.particles.clone(),
             time: self.time,
@@ -247,6 +250,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             old_torque: self.old_torque.clone(),
             guard: self.guard.clone(),
             capacities: Vec::new(),
+            decomposed: self.decomposition.as_ref().map(|d| d.state()),
         };
         // The clones have their lengths as capacities; keep this world's.
         let mut capacities = Vec::new();
@@ -257,11 +261,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         world_arrays!(self, record, as_ref);
         state.capacities = capacities;
-        Some(state)
+        state
     }
 
     /// Puts back a state taken by [`World::state`] from a world built from the same scene
-    /// (the guard settings stay this world's); an error when the walls or bodies differ.
+    /// (the guard settings stay this world's); an error when the walls or bodies differ. A
+    /// decomposed state's subdomains wait for [`World::set_grid`].
     pub fn set_state(&mut self, state: WorldState<L::History, W::History>) -> Result<(), String> {
         if state.wall_active.len() != self.walls.walls.len()
             || state.bodies.len() != self.bodies.len()
@@ -311,7 +316,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             };
         }
         world_arrays!(self, reserve, as_mut);
+        self.restored_grid = state.decomposed.map(Box::new);
         Ok(())
+    }
+
+    /// The grid of the subdomains a restored state holds (taken up by `set_grid`).
+    pub fn restored_grid(&self) -> Option<[usize; 3]> {
+        self.restored_grid.as_ref().map(|d| d.grid.counts)
     }
 
     /// Replaces the bodies (posed at the current time) and re-evaluates the forces.
@@ -843,6 +854,88 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// its own particles and ghosts (either integrator, walls, bodies, delete regions).
     /// Under MPI (`comm` of several ranks) each rank steps the subdomains it owns.
     pub fn set_grid(&mut self, spec: GridSpec, comm: Comm) -> Result<(), String> {
+        if let Some(stored) = self.restored_grid.take() {
+            return self.resume_grid(spec, comm, *stored);
+        }
+        let grid = self.grid_for(spec, self.ghost_width(), comm.size())?;
+        // Histories by partner id, in the pair's canonical orientation (lower id first).
+        let p = &self.particles;
+        let mut entries = Vec::new();
+        for (pair, &h) in self.list.pairs.iter().zip(&self.history) {
+            if h == L::History::default() {
+                continue;
+            }
+            let (i, j) = (pair.i, pair.j);
+            let (id_i, id_j) = (p.id[i as usize], p.id[j as usize]);
+            let h = if id_i < id_j { h } else { h.mirrored() };
+            entries.push((i, id_j, h));
+            entries.push((j, id_i, h));
+        }
+        let rows = HistoryRows::from_entries(p.len(), entries);
+        self.decompose(grid, rows, comm);
+        self.list = VerletList::new(self.neighbor.skin);
+        self.history = Vec::new();
+        self.reaction_force = Vec::new();
+        self.reaction_spin = Vec::new();
+        Ok(())
+    }
+
+    /// Takes up the subdomains of a restart file: on the grid they were (the same counts)
+    /// each as it was, so the run steps on bit for bit on any number of threads or ranks; on
+    /// another grid the owned particles dealt out again with their histories, on planes by
+    /// count (as a rebuild with a rebalance), the stored forces kept.
+    fn resume_grid(
+        &mut self,
+        spec: GridSpec,
+        comm: Comm,
+        stored: crate::decomposition::DecomposedState,
+    ) -> Result<(), String> {
+        let slots = self.wall_slots();
+        let same = match spec {
+            GridSpec::Given(counts) => counts == stored.grid.counts,
+            GridSpec::Auto(n) => n == stored.grid.len(),
+        };
+        let decomposition = if same && comm.size() <= stored.grid.len() {
+            let threshold = None;
+            Decomposition::from_state(stored, comm, threshold, Self::ROTATES, slots)?
+        } else {
+            let (particles, wall_history, rows) =
+                Decomposition::<L::History, W::History>::gathered_from_state(
+                    &stored,
+                    Self::ROTATES,
+                    slots,
+                )?;
+            self.particles = particles;
+            self.wall_history = wall_history;
+            let grid = self.grid_for(spec, stored.width, comm.size())?;
+            let mut d = Decomposition::new(
+                grid,
+                &self.particles,
+                &self.wall_history,
+                &rows,
+                &self.domain,
+                slots,
+                stored.width,
+                stored.extra,
+                stored.skin,
+                comm,
+            );
+            d.builds = stored.builds + 1;
+            d
+        };
+        self.decomposition = Some(Box::new(decomposition));
+        self.list = VerletList::new(self.neighbor.skin);
+        self.history = Vec::new();
+        self.reaction_force = Vec::new();
+        self.reaction_spin = Vec::new();
+        self.sync_particles();
+        Ok(())
+    }
+
+    /// The grid of `spec` over the particles, its planes by count and at least `width`
+    /// apart; an error when no placement is thick enough or `ranks` outnumber its
+    /// subdomains.
+    fn grid_for(&self, spec: GridSpec, width: Real, ranks: usize) -> Result<Grid, String> {
         let p = &self.particles;
         let counts = match spec {
             GridSpec::Given(counts) => counts,
@@ -863,42 +956,22 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             }
         };
         let mut grid = Grid::balanced(counts, &self.domain, &p.position);
-        if grid.check_width(self.ghost_width()).is_err() {
+        if grid.check_width(width).is_err() {
             // By count the planes crowd where the particles do: moved apart to a ghost layer
             // (as a balance shift would be); refused only if no placement is thick enough.
-            balance::clamp_to_width(&mut grid, self.ghost_width());
+            balance::clamp_to_width(&mut grid, width);
         }
-        grid.check_width(self.ghost_width())?;
-        if comm.size() > grid.len() {
+        grid.check_width(width)?;
+        if ranks > grid.len() {
             return Err(format!(
-                "{} MPI ranks need at least as many subdomains, and the grid {}x{}x{} has {}; give a grid of at least {} subdomains",
-                comm.size(),
+                "{ranks} MPI ranks need at least as many subdomains, and the grid {}x{}x{} has {}; give a grid of at least {ranks} subdomains",
                 counts[0],
                 counts[1],
                 counts[2],
                 grid.len(),
-                comm.size()
             ));
         }
-        // Histories by partner id, in the pair's canonical orientation (lower id first).
-        let mut entries = Vec::new();
-        for (pair, &h) in self.list.pairs.iter().zip(&self.history) {
-            if h == L::History::default() {
-                continue;
-            }
-            let (i, j) = (pair.i, pair.j);
-            let (id_i, id_j) = (p.id[i as usize], p.id[j as usize]);
-            let h = if id_i < id_j { h } else { h.mirrored() };
-            entries.push((i, id_j, h));
-            entries.push((j, id_i, h));
-        }
-        let rows = HistoryRows::from_entries(p.len(), entries);
-        self.decompose(grid, rows, comm);
-        self.list = VerletList::new(self.neighbor.skin);
-        self.history = Vec::new();
-        self.reaction_force = Vec::new();
-        self.reaction_spin = Vec::new();
-        Ok(())
+        Ok(grid)
     }
 
     /// `--balance`: whether the cut planes move by count at a rebuild when the imbalance
@@ -946,6 +1019,17 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     pub fn sync_particles(&mut self) {
         if let Some(d) = &self.decomposition {
             (self.particles, self.wall_history) = d.gathered();
+        }
+    }
+
+    /// `sync_particles` for what only rank 0 writes: under MPI only rank 0 receives the
+    /// particles, the other ranks' `particles` stay as they were (call `sync_particles`
+    /// where every rank takes a decision from them). Collective.
+    pub fn sync_particles_for_output(&mut self) {
+        if let Some(d) = &self.decomposition {
+            if let Some(gathered) = d.gathered_to(true) {
+                (self.particles, self.wall_history) = gathered;
+            }
         }
     }
 

@@ -25,11 +25,13 @@ pub mod exchange;
 pub mod forward;
 pub mod grid;
 pub mod list;
+pub mod state;
 pub mod step;
 pub mod transport;
 
 pub use balance::BalanceSpec;
 pub use grid::{choose_counts, Grid, GridSpec};
+pub use state::DecomposedState;
 pub use transport::Comm;
 
 use crate::contact::PairHistory;

@@ -132,9 +132,9 @@ pub struct Decomposition<H, WH> {
     pub balance: Balance,
     /// Per group of body particles, their load at the last force pass (over all ranks).
     pub kinematic_loads: Vec<BodyLoad>,
-    buffers: Vec<Vec<States>>,
+    pub(super) buffers: Vec<Vec<States>>,
     /// Words each rank sends here in a forward, fixed between rebuilds.
-    forward_counts: Option<Vec<usize>>,
+    pub(super) forward_counts: Option<Vec<usize>>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
@@ -263,6 +263,12 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     /// rebuild), with their wall histories; under MPI gathered from every rank (to every
     /// rank, so each takes the same decisions from them).
     pub fn gathered(&self) -> (Particles, Vec<WH>) {
+        self.gathered_to(false).expect("gathered to every rank")
+    }
+
+    /// `gathered`, and with `to_root` under MPI at rank 0 only (None on the others): for
+    /// what only rank 0 writes. Collective.
+    pub fn gathered_to(&self, to_root: bool) -> Option<(Particles, Vec<WH>)> {
         let rotation = self.subdomains[0].particles.angular.is_some();
         let mut all = Particles::new(rotation);
         let mut wall = Vec::new();
@@ -273,17 +279,31 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 }
                 wall.extend_from_slice(&sub.wall_history);
             }
-            return (all, wall);
+            return Some((all, wall));
         }
-        let per_sub = self
-            .comm
-            .gather_by_subdomain(self.subdomains.len(), |s, out| {
-                let sub = &self.subdomains[s];
-                let mut owned = sub.particles.clone();
-                owned.truncate(sub.n_owned);
-                owned.write(out);
-                write_histories(&sub.wall_history, out);
-            });
+        let encode = |s: usize, out: &mut Vec<Real>| {
+            let sub = &self.subdomains[s];
+            let mut owned = sub.particles.clone();
+            owned.truncate(sub.n_owned);
+            owned.write(out);
+            write_histories(&sub.wall_history, out);
+        };
+        let count = self.subdomains.len();
+        if to_root {
+            let per_sub = self.comm.gather_by_subdomain_to_root(count, encode);
+            if !self.comm.is_root() {
+                return None;
+            }
+            return Some(Self::concatenated(per_sub, rotation));
+        }
+        let per_sub = self.comm.gather_by_subdomain(count, encode);
+        Some(Self::concatenated(per_sub, rotation))
+    }
+
+    /// The particles and wall histories each subdomain's words hold, side by side.
+    fn concatenated(per_sub: Vec<Vec<Real>>, rotation: bool) -> (Particles, Vec<WH>) {
+        let mut all = Particles::new(rotation);
+        let mut wall = Vec::new();
         for words in per_sub {
             let mut input = &words[..];
             let p = Particles::read(&mut input);

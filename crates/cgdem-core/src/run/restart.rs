@@ -23,8 +23,9 @@ use super::StageRecord;
 pub const RESTART_FILE: &str = "restart.cgr";
 pub const PREVIOUS_RESTART_FILE: &str = "restart.prev.cgr";
 const MAGIC: &[u8; 8] = b"CGDEMRST";
-/// Bumped whenever the payload's layout changes; an older file is refused by name.
-pub const FORMAT_VERSION: u32 = 1;
+/// Bumped whenever the payload's layout changes; an older file is refused by name (2: the
+/// world state holds the subdomains of a `--grid` run).
+pub const FORMAT_VERSION: u32 = 2;
 const HEADER_LEN: usize = 32;
 
 /// Where in the stage list a checkpoint was taken.
