@@ -15,6 +15,7 @@ pub mod guard;
 pub mod insertion;
 pub mod integrate;
 pub mod io;
+pub mod lammps_data;
 pub mod math;
 pub mod neighbor;
 pub mod particles;
