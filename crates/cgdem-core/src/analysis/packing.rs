@@ -10,7 +10,8 @@
 use serde::Serialize;
 
 use super::pore_size::{pore_size_field_of_spheres, Boundary, PoreSizeDistribution, VoxelGrid};
-use super::porosity::{bed_measurement_region, porosity_z_slab, BedRegionRule};
+use super::porosity::{bed_measurement_region, porosity_z_slab};
+use crate::scene::BedRegionRule;
 use crate::math::{Real, Vec3};
 
 /// What was measured, for `summary.json`.
