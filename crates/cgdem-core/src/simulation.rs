@@ -538,10 +538,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         let dt = self.dt;
         let p = &mut self.particles;
-        pcvv::predict(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
+        pcvv::par_predict(&mut p.position, &mut p.velocity, &p.force, &p.inv_mass, dt);
         if Self::ROTATES {
             if let Some(a) = &mut p.angular {
-                pcvv::predict_rate(&mut a.omega, &a.torque, &a.inv_inertia, dt);
+                pcvv::par_predict_rate(&mut a.omega, &a.torque, &a.inv_inertia, dt);
             }
         }
         self.drive_kinematic_particles(self.time + dt);
@@ -558,10 +558,11 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         self.compute_forces();
         let p = &mut self.particles;
-        let mut finite = pcvv::correct(&mut p.velocity, &p.force, &self.old_force, &p.inv_mass, dt);
+        let mut finite =
+            pcvv::par_correct(&mut p.velocity, &p.force, &self.old_force, &p.inv_mass, dt);
         if Self::ROTATES {
             if let Some(a) = &mut p.angular {
-                finite &= pcvv::correct(
+                finite &= pcvv::par_correct(
                     &mut a.omega,
                     &a.torque,
                     &self.old_torque,

@@ -13,8 +13,6 @@
 
 use std::str::FromStr;
 
-use rayon::prelude::*;
-
 use super::step::Decomposition;
 use super::Grid;
 use crate::contact::PairHistory;
@@ -167,26 +165,20 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         domain: &Domain,
         keep: &(impl Fn(Vec3) -> bool + Sync),
     ) -> Vec<u64> {
-        let here = self
-            .owned()
-            .collect::<Vec<_>>()
-            .par_iter()
-            .map(|sub| {
-                let mut counts = vec![0u64; len];
-                for &x in &sub.particles.position[..sub.n_owned] {
-                    if keep(x) {
-                        count(domain.wrap(x), &mut counts);
-                    }
+        let mut subs: Vec<_> = self.subdomains.iter().collect();
+        let mut here = vec![0u64; len];
+        let per_sub = self.comm.each_owned(&mut subs, |sub| {
+            let mut counts = vec![0u64; len];
+            for &x in &sub.particles.position[..sub.n_owned] {
+                if keep(x) {
+                    count(domain.wrap(x), &mut counts);
                 }
-                counts
-            })
-            .reduce(
-                || vec![0u64; len],
-                |mut a, b| {
-                    a.iter_mut().zip(&b).for_each(|(a, b)| *a += b);
-                    a
-                },
-            );
+            }
+            counts
+        });
+        for counts in per_sub.into_iter().flatten() {
+            here.iter_mut().zip(&counts).for_each(|(a, b)| *a += b);
+        }
         // Counts below 2^53 are exact as f64, summed in any order.
         let mut words: Vec<Real> = here.iter().map(|&c| c as Real).collect();
         self.comm.sum_each(&mut words);

@@ -4,8 +4,6 @@
 //! subdomain appends its ghosts: full copies of the particles, positions shifted by the
 //! image. The lists stay until the next rebuild; `forward` refreshes the ghosts' state.
 
-use rayon::prelude::*;
-
 use super::transport::{Comm, Wire};
 use super::{Grid, Subdomain};
 use crate::contact::PairHistory;
@@ -104,24 +102,18 @@ pub fn borders<H: PairHistory, WH: PairHistory>(
     width: Real,
     comm: &Comm,
 ) -> u64 {
-    let count = subs.len();
-    let mut packed: Vec<Vec<Ghosts>> = subs
-        .par_iter_mut()
-        .map(|sub| {
-            if comm.owns(sub.index, count) {
-                pack(sub, grid, width)
-                    .into_iter()
-                    .map(|(to, p)| Ghosts(to, p))
-                    .collect()
-            } else {
-                Vec::new()
-            }
+    let mut packed: Vec<Vec<Ghosts>> = comm
+        .each_owned(subs, |sub| {
+            pack(sub, grid, width)
+                .into_iter()
+                .map(|(to, p)| Ghosts(to, p))
+                .collect()
         })
+        .into_iter()
+        .map(Option::unwrap_or_default)
         .collect();
     let sent = comm.route(&mut packed, |_, _, g| g.0, &mut None);
-    subs.par_iter_mut()
-        .filter(|sub| comm.owns(sub.index, count))
-        .for_each(|sub| unpack(sub, &packed));
+    comm.each_owned(subs, |sub| unpack(sub, &packed));
     sent
 }
 

@@ -3,8 +3,6 @@
 //! contact-history rows. Particles the world removes (left the box through a bounded face,
 //! non-finite) are dropped here.
 
-use rayon::prelude::*;
-
 use super::transport::{read_histories, write_histories, Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
@@ -141,21 +139,13 @@ pub fn exchange<H: PairHistory, WH: PairHistory>(
     keep: &(impl Fn(Vec3) -> bool + Sync),
     comm: &Comm,
 ) -> u64 {
-    let count = subs.len();
-    let mut packed: Vec<Vec<Migrants<H, WH>>> = subs
-        .par_iter_mut()
-        .map(|sub| {
-            if comm.owns(sub.index, count) {
-                pack(sub, grid, domain, wall_slots, keep)
-            } else {
-                Vec::new()
-            }
-        })
+    let mut packed: Vec<Vec<Migrants<H, WH>>> = comm
+        .each_owned(subs, |sub| pack(sub, grid, domain, wall_slots, keep))
+        .into_iter()
+        .map(Option::unwrap_or_default)
         .collect();
     let sent = comm.route(&mut packed, |_, to, _| to, &mut None);
-    subs.par_iter_mut()
-        .filter(|sub| comm.owns(sub.index, count))
-        .for_each(|sub| unpack(sub, &packed));
+    comm.each_owned(subs, |sub| unpack(sub, &packed));
     sent
 }
 

@@ -1,8 +1,6 @@
 //! `forward_comm` (LAMMPS `Comm::forward_comm`): every step between list rebuilds, the
 //! ghosts take their owners' new positions (shifted by the image), velocities and spins.
 
-use rayon::prelude::*;
-
 use super::transport::{read_vec3s, write_vec3s, Comm, Wire};
 use super::Subdomain;
 use crate::contact::PairHistory;
@@ -89,16 +87,11 @@ pub fn forward<H: PairHistory, WH: PairHistory>(
     comm: &Comm,
     counts: &mut Option<Vec<usize>>,
 ) -> u64 {
-    let count = subs.len();
-    buffers.resize_with(count, Vec::new);
-    subs.par_iter()
-        .zip(buffers.par_iter_mut())
-        .filter(|(sub, _)| comm.owns(sub.index, count))
-        .for_each(|(sub, out)| pack(sub, out));
+    buffers.resize_with(subs.len(), Vec::new);
+    let mut with_buffers: Vec<_> = subs.iter().zip(buffers.iter_mut()).collect();
+    comm.each_owned(&mut with_buffers, |(sub, out)| pack(sub, out));
     let sent = comm.route(buffers, |from, list, _| subs[from].sends[list].to, counts);
-    subs.par_iter_mut()
-        .filter(|sub| comm.owns(sub.index, count))
-        .for_each(|sub| unpack(sub, buffers));
+    comm.each_owned(subs, |sub| unpack(sub, buffers));
     sent
 }
 

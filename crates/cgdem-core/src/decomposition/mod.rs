@@ -17,7 +17,8 @@
 //! granular pair styles), so no forces travel back; each pair is evaluated with the particle
 //! of lower id first, so both sides compute the same numbers and keep the same history.
 //! Each phase packs what travels into buffers and unpacks them on the other side: threads in
-//! one process read them in place, MPI ranks send the same buffers ([`transport`]).
+//! one process read them in place, MPI ranks send the same buffers ([`transport`]). The
+//! threads of a process form a [`team`] that keeps each subdomain on one thread.
 
 pub mod balance;
 pub mod borders;
@@ -26,6 +27,7 @@ pub mod forward;
 pub mod grid;
 pub mod list;
 pub mod step;
+pub mod team;
 pub mod transport;
 
 pub use balance::BalanceSpec;

@@ -2,8 +2,6 @@
 //! the four phases of communication between them, and the global arrays the outputs read
 //! kept as the subdomains' owned particles side by side.
 
-use rayon::prelude::*;
-
 use super::balance::{imbalance, Balance};
 use super::borders::borders;
 use super::exchange::exchange;
@@ -197,24 +195,17 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     fn borders_and_lists(&mut self, resort: bool) {
         let width = self.width;
         if resort {
-            self.owned_mut().for_each(|sub| resort_by_cell(sub, width));
+            self.comm
+                .each_owned(&mut self.subdomains, |sub| resort_by_cell(sub, width));
         }
         self.bytes_sent += borders(&mut self.subdomains, &self.grid, width, &self.comm);
         self.forward_counts = None;
         let extra = self.extra;
-        self.owned_mut().for_each(|sub| {
+        self.comm.each_owned(&mut self.subdomains, |sub| {
             sub.list = LocalList::build(sub, extra, width);
             sub.rows = HistoryRows::default();
         });
         self.builds += 1;
-    }
-
-    /// The subdomains this rank steps, each on its own task.
-    fn owned_mut(&mut self) -> impl ParallelIterator<Item = &mut Subdomain<H, WH>> {
-        let (comm, count) = (&self.comm, self.subdomains.len());
-        self.subdomains
-            .par_iter_mut()
-            .filter(move |sub| comm.owns(sub.index, count))
     }
 
     /// The subdomains this rank steps.
@@ -234,7 +225,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         keep: &(impl Fn(Vec3) -> bool + Sync),
         resort: bool,
     ) {
-        self.owned_mut().for_each(|sub| {
+        self.comm.each_owned(&mut self.subdomains, |sub| {
             sub.rows = sub.list.rows(&sub.particles.id, sub.n_owned);
         });
         self.rebalance(domain, keep);
@@ -344,15 +335,11 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     ) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
         let regions = drive.delete_regions;
-        let count = self.subdomains.len();
-        self.buffers.resize_with(count, Vec::new);
-        let comm = &self.comm;
+        self.buffers.resize_with(self.subdomains.len(), Vec::new);
+        let mut with_buffers: Vec<_> = self.subdomains.iter_mut().zip(&mut self.buffers).collect();
         let due = self
-            .subdomains
-            .par_iter_mut()
-            .zip(self.buffers.par_iter_mut())
-            .filter(|(sub, _)| comm.owns(sub.index, count))
-            .map(|(sub, out)| {
+            .comm
+            .each_owned(&mut with_buffers, |(sub, out)| {
                 let pcvv = integrator == Integrator::Pcvv;
                 let mut moved = if pcvv {
                     predict(sub, dt, drive.rotates);
@@ -374,7 +361,8 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 let p = &sub.particles.position[..sub.n_owned];
                 moved || (!regions.is_empty() && p.iter().any(|&x| in_delete_region(regions, x)))
             })
-            .reduce(|| false, |a, b| a || b);
+            .into_iter()
+            .any(|due| due == Some(true));
         // The exchange is collective: every rank rebuilds when one must.
         self.comm.any(due)
     }
@@ -418,19 +406,12 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     ) -> ForceSums {
         let count = self.subdomains.len();
         let (comm, buffers) = (&self.comm, &self.buffers);
-        let mine: Vec<Option<ForceSums>> = self
-            .subdomains
-            .par_iter_mut()
-            .map(|sub| {
-                if !comm.owns(sub.index, count) {
-                    return None;
-                }
-                if unpack_ghosts {
-                    unpack(sub, buffers);
-                }
-                Some(forces_and_closing(sub, physics, closing))
-            })
-            .collect();
+        let mine: Vec<Option<ForceSums>> = comm.each_owned(&mut self.subdomains, |sub| {
+            if unpack_ghosts {
+                unpack(sub, buffers);
+            }
+            forces_and_closing(sub, physics, closing)
+        });
         let in_order = |all: Vec<ForceSums>| {
             all.into_iter()
                 .reduce(ForceSums::then)

@@ -8,15 +8,20 @@
 //! overlap, finiteness, whether any particle moved past half the skin) and the all-gathers
 //! in subdomain order give each rank the values one process computes, bit for bit.
 
+use super::team::Team;
 use crate::contact::PairHistory;
 use crate::math::{Real, Vec3};
 use crate::particles::{AngularState, Particles};
 
-/// The processes a decomposed run spans: one (threads only) or the ranks of `MPI_COMM_WORLD`.
+/// The processes a decomposed run spans: one (threads only) or the ranks of `MPI_COMM_WORLD`,
+/// and the threads of this process that step its subdomains.
 #[derive(Clone, Default)]
 pub struct Comm {
     #[cfg(feature = "mpi")]
     mpi: Option<std::sync::Arc<mpi_comm::MpiComm>>,
+    /// Started at the first phase, with the threads of the rayon pool the run is in
+    /// (`--threads`); shared by clones.
+    team: std::sync::Arc<std::sync::OnceLock<Team>>,
 }
 
 impl std::fmt::Debug for Comm {
@@ -46,6 +51,7 @@ impl Comm {
         {
             mpi_comm::MpiComm::initialize().map(|c| Comm {
                 mpi: Some(std::sync::Arc::new(c)),
+                team: Default::default(),
             })
         }
         #[cfg(not(feature = "mpi"))]
@@ -98,6 +104,22 @@ impl Comm {
 
     pub fn owns(&self, sub: usize, count: usize) -> bool {
         self.owner(sub, count) == self.rank()
+    }
+
+    /// `task` on each subdomain this rank owns (`items[s]` stands for subdomain `s`), each
+    /// on the thread of this process that always steps it; results by subdomain, `None`
+    /// where owned elsewhere.
+    pub fn each_owned<T: Send, R: Send>(
+        &self,
+        items: &mut [T],
+        task: impl Fn(&mut T) -> R + Sync,
+    ) -> Vec<Option<R>> {
+        let count = items.len();
+        let owned: Vec<usize> = (0..count).filter(|&s| self.owns(s, count)).collect();
+        let team = self
+            .team
+            .get_or_init(|| Team::new(rayon::current_num_threads()));
+        team.each_of(items, &owned, task)
     }
 
     /// Sends every item `packed[from][slot]` of an owned `from` whose destination subdomain

@@ -11,6 +11,8 @@ use rayon::prelude::*;
 
 use crate::math::{Real, Vec3};
 
+/// Particles per task of the parallel forms (the world's arrays); a subdomain of a
+/// decomposed run calls the serial forms on its own thread.
 const CHUNK: usize = 1024;
 
 /// The predictor for positions and velocities.
@@ -21,24 +23,22 @@ pub fn predict(
     inv_mass: &[Real],
     dt: Real,
 ) {
-    position
-        .par_iter_mut()
-        .zip(velocity.par_iter_mut())
-        .zip(force.par_iter().zip(inv_mass.par_iter()))
-        .with_min_len(CHUNK)
-        .for_each(|((x, v), (f, inv_m))| {
-            let a = *inv_m * *f;
-            *x += dt * *v + 0.5 * dt * dt * a;
-            *v += dt * a;
-        });
+    for ((x, v), (f, inv_m)) in position
+        .iter_mut()
+        .zip(velocity)
+        .zip(force.iter().zip(inv_mass))
+    {
+        let a = *inv_m * *f;
+        *x += dt * *v + 0.5 * dt * dt * a;
+        *v += dt * a;
+    }
 }
 
 /// The predictor for spins (or any rate): `w += dt T/I`.
 pub fn predict_rate(rate: &mut [Vec3], torque: &[Vec3], inv_inertia: &[Real], dt: Real) {
-    rate.par_iter_mut()
-        .zip(torque.par_iter().zip(inv_inertia.par_iter()))
-        .with_min_len(CHUNK)
-        .for_each(|(w, (t, inv_i))| *w += dt * *inv_i * *t);
+    for (w, (t, inv_i)) in rate.iter_mut().zip(torque.iter().zip(inv_inertia)) {
+        *w += dt * *inv_i * *t;
+    }
 }
 
 /// The corrector: `v += dt/(2m) (F1 - F0)`. Returns whether every updated value is finite.
@@ -50,14 +50,52 @@ pub fn correct(
     dt: Real,
 ) -> bool {
     let half = 0.5 * dt;
+    let mut finite = true;
+    for ((v, (f1, f0)), inv_m) in velocity
+        .iter_mut()
+        .zip(force.iter().zip(old_force))
+        .zip(inv_mass)
+    {
+        *v += half * *inv_m * (*f1 - *f0);
+        finite &= v.is_finite();
+    }
+    finite
+}
+
+/// [`predict`] in chunks on the rayon pool.
+pub fn par_predict(
+    position: &mut [Vec3],
+    velocity: &mut [Vec3],
+    force: &[Vec3],
+    inv_mass: &[Real],
+    dt: Real,
+) {
+    position
+        .par_chunks_mut(CHUNK)
+        .zip(velocity.par_chunks_mut(CHUNK))
+        .zip(force.par_chunks(CHUNK).zip(inv_mass.par_chunks(CHUNK)))
+        .for_each(|((x, v), (f, inv_m))| predict(x, v, f, inv_m, dt));
+}
+
+/// [`predict_rate`] in chunks on the rayon pool.
+pub fn par_predict_rate(rate: &mut [Vec3], torque: &[Vec3], inv_inertia: &[Real], dt: Real) {
+    rate.par_chunks_mut(CHUNK)
+        .zip(torque.par_chunks(CHUNK).zip(inv_inertia.par_chunks(CHUNK)))
+        .for_each(|(w, (t, inv_i))| predict_rate(w, t, inv_i, dt));
+}
+
+/// [`correct`] in chunks on the rayon pool.
+pub fn par_correct(
+    velocity: &mut [Vec3],
+    force: &[Vec3],
+    old_force: &[Vec3],
+    inv_mass: &[Real],
+    dt: Real,
+) -> bool {
     velocity
-        .par_iter_mut()
-        .zip(force.par_iter().zip(old_force.par_iter()))
-        .zip(inv_mass.par_iter())
-        .with_min_len(CHUNK)
-        .map(|((v, (f1, f0)), inv_m)| {
-            *v += half * *inv_m * (*f1 - *f0);
-            v.is_finite()
-        })
+        .par_chunks_mut(CHUNK)
+        .zip(force.par_chunks(CHUNK).zip(old_force.par_chunks(CHUNK)))
+        .zip(inv_mass.par_chunks(CHUNK))
+        .map(|((v, (f1, f0)), inv_m)| correct(v, f1, f0, inv_m, dt))
         .reduce(|| true, |a, b| a && b)
 }
