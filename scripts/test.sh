@@ -50,7 +50,14 @@ await_beside() {
         return 1
     fi
 }
-trap '((${#beside_pids[@]} == 0)) || kill "${beside_pids[@]}" 2>/dev/null || true' EXIT
+# At the end, also on a failure: stop what still runs beside, print the stage times.
+finish() {
+    ((${#beside_pids[@]} == 0)) || kill "${beside_pids[@]}" 2>/dev/null || true
+    echo "CI stages (wall time; 'beside': in the background of the stages after it):"
+    ((${#stages[@]} == 0)) || printf '%s\n' "${stages[@]}"
+    echo "total: $SECONDS s"
+}
+trap finish EXIT
 
 # Reference codes: the golden tests against LAMMPS run whenever it is present. Installing
 # needs root and apt; without them those tests and runs report themselves skipped.
@@ -110,7 +117,3 @@ fi
 # planted in cgdem alone turn their comparisons red (cgdem's runs only).
 stage planted-faults bash scripts/planted-faults.sh "$report" "$bin"
 stage await-beside await_beside
-
-echo "CI stages (wall time; 'beside' ran in the background of the stage after it):"
-printf '%s\n' "${stages[@]}"
-echo "total: $SECONDS s"
