@@ -466,7 +466,7 @@ struct RunResult {
     steps: u64,
     loop_s: Option<Real>,
     particle_steps: Option<u64>,
-    memory: Option<cgdem_core::simulation::MemoryUse>,
+    memory: Option<cgdem_core::memory_use::MemoryUse>,
     memory_mb: Option<Real>,
 }
 

@@ -14,15 +14,16 @@ use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
+use crate::force::{
+    body_force, body_force_and_torque, larger, pair_force, ForceView, Owner, ParticleState,
+};
+use crate::geometry::aabb::in_delete_region;
 use crate::geometry::Aabb;
 use crate::integrate::{pcvv, Integrator};
 use crate::math::{Real, Vec3};
+use crate::memory_use::MemoryUse;
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::Particles;
-use crate::simulation::{
-    body_force, body_force_and_torque, in_delete_region, larger, pair_force, ForceView, MemoryUse,
-    Owner, ParticleState,
-};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
