@@ -4,7 +4,8 @@
 # `cgdem run --resume`; every output file must equal the uninterrupted run's byte for byte
 # (cmp), summary.json after removing its wall-clock fields (wall_s, particle_steps_per_s),
 # which differ between any two runs. The killed runs use 2 threads, the others 1: the
-# restart file does not depend on the thread count.
+# restart file does not depend on the thread count. The *_grid cases (run them by name)
+# do the same on subdomains (--grid).
 # Usage: bash scripts/kill-resume.sh [BIN] [OUT] [N] [CASE...]
 set -u
 cd "$(dirname "$0")/.."
@@ -16,6 +17,9 @@ declare -A ARGS=(
   [aor_hertz_smoke]="validation/cases/aor_hertz_smoke.toml --lambda 2 --checkpoint-every 0.05"
   [packing]="validation/cases/packing_vdw.toml --set stage[0].max_duration=0.05 --set stage[0].min_duration=0.01 --checkpoint-every 0.005"
   [screw_mesh]="validation/cases/screw_feeder_hertz.toml $S --checkpoint-every 0.02"
+  # Decomposed (--grid): the restart file holds the subdomains; named on the command line.
+  [tiny_grid]="tests/data/tiny_hertz_collapse.toml --checkpoint-every 0.03 --grid 2x1x1"
+  [screw_grid]="validation/cases/screw_feeder_hertz.toml $S --checkpoint-every 0.02 --grid 2x1x1"
 )
 CASES=("$@"); [ ${#CASES[@]} -gt 0 ] || CASES=(aor_smoke aor_hertz_smoke packing screw_mesh)
 mkdir -p "$OUT"

@@ -2,10 +2,14 @@
 # The MPI transport of the decomposed step (issue 23): installs OpenMPI (as root with apt),
 # builds cgdem with `--features mpi` in the workspace's target directory, and checks that
 # the tiny Hertz collapse on 2 MPI ranks (and on 4 oversubscribed ranks) writes bitwise the
-# CSVs the same --grid writes on threads in one process. A few seconds beyond the build.
-# Usage: bash scripts/mpi-check.sh
+# CSVs the same --grid writes on threads in one process. A few seconds beyond the build
+# (none when scripts/test.sh has built the workspace with --features mpi already).
+# Usage: bash scripts/mpi-check.sh [--prepare]
+#   --prepare: only install what the MPI build needs; exit 0 when it is there, 1 when not
+#   (scripts/test.sh then builds everything once with --features mpi, or without).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+prepare=${1:-}
 
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES=(libopenmpi-dev openmpi-bin libclang-dev pkg-config)
@@ -18,12 +22,14 @@ done
 if ((${#missing[@]} > 0)); then
     if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
         echo "note: ${missing[*]} missing and cannot be installed without root and apt; MPI check skipped"
+        [ "$prepare" = --prepare ] && exit 1
         exit 0
     fi
     echo "installing: ${missing[*]}"
     apt-get update -qq
     apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+[ "$prepare" = --prepare ] && exit 0
 
 cargo build --release --features mpi
 bin=target/release/cgdem

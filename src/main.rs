@@ -33,6 +33,11 @@ struct RunInvocation {
     variant: Option<String>,
     force_dt: bool,
     keep_going: bool,
+    /// `--grid` and `--balance` as given (absent in files of runs without them).
+    #[serde(default)]
+    grid: Option<String>,
+    #[serde(default)]
+    balance: Option<String>,
 }
 
 impl RunInvocation {
@@ -73,10 +78,20 @@ impl From<CgRule> for CoarseGrainRule {
     }
 }
 
+/// `cgdem --version`; a build with MPI says so (`cgdem bench --np` looks for
+/// `cgdem_harness::bench::MPI_MARK` in it).
+#[cfg(feature = "mpi")]
+const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (built with MPI: --features mpi)"
+);
+#[cfg(not(feature = "mpi"))]
+const VERSION: &str = env!("CARGO_PKG_VERSION");
+
 #[derive(Parser)]
 #[command(
     name = "cgdem",
-    version,
+    version = VERSION,
     about = "Discrete-element solver for powders and granular flow, with coarse-graining"
 )]
 struct Cli {
@@ -166,14 +181,22 @@ enum Command {
         sweep: Option<String>,
         /// Write a restart file (OUT/restart.cgr, the one before kept as restart.prev.cgr)
         /// every this many simulated seconds, at the start, at every stage end and when
-        /// SIGINT/SIGTERM stops the run. Not with --grid or --sweep.
+        /// SIGINT/SIGTERM stops the run. Not with --sweep. With --grid it holds the
+        /// subdomains (gathered from every rank; rank 0 writes it).
         #[arg(long, value_name = "SECONDS")]
         checkpoint_every: Option<f64>,
         /// Continue the run in DIR from its newest usable restart file: the case file and
-        /// options (--lambda, --set, ...) are the ones the run stored, and the scene's digest
-        /// must match the stored one. Outputs come out as those of an uninterrupted run.
-        #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "sweep", "set", "seed", "variant", "checkpoint_every", "grid", "strict"])]
+        /// options (--lambda, --set, --grid, ...) are the ones the run stored, and the
+        /// scene's digest must match the stored one. Outputs come out as those of an
+        /// uninterrupted run (with --grid: on the same grid, on any number of threads or MPI
+        /// ranks). `--grid` here continues a decomposed run on another grid, from the stored
+        /// particles (to rounding, not bitwise).
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "sweep", "set", "seed", "variant", "checkpoint_every", "strict"])]
         resume: Option<PathBuf>,
+        /// Start from the particles of this state file instead of the scene's insertions
+        /// (`cgdem bench --np` writes its prepared state into one for the ranks it starts).
+        #[arg(long, value_name = "FILE", hide = true, conflicts_with_all = ["resume", "sweep", "checkpoint_every"])]
+        initial_state: Option<PathBuf>,
     },
     /// Run a validation suite (validation/suites/*.toml) with cgdem and the reference codes,
     /// compare the runs and write DIR/index.html, DIR/summary.json, figures and their CSV.
@@ -259,10 +282,20 @@ enum Command {
         reference_timeout: u64,
         /// Also time cgdem decomposed into these subdomains (`2x1x1`, as `run --grid`), as a
         /// case `<case>-grid<G>` in the same alternation (ratio to the undecomposed run per
-        /// repetition). MPI ranks are not launched: `cgdem run` cannot start from the
-        /// bench's prepared state; time them with `mpirun ... cgdem run --grid`.
+        /// repetition).
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
+        /// MPI rank counts, comma-separated: cgdem also runs the `--grid` case as that many
+        /// ranks of one thread (`mpirun -np N cgdem run --grid G ...` from the prepared
+        /// state), in the same alternation as the runs at N threads, in rows of its own
+        /// ("cgdem (N ranks)"). Needs --grid with at least N subdomains, mpirun and a cgdem
+        /// built with `--features mpi` (this one, or --cgdem-bin).
+        #[arg(long, value_delimiter = ',', requires = "grid")]
+        np: Vec<usize>,
+        /// The cgdem binary the ranks of --np run (default: this one), e.g.
+        /// target/release/cgdem of a `cargo build --release --features mpi`.
+        #[arg(long, value_name = "PATH", requires = "np")]
+        cgdem_bin: Option<PathBuf>,
     },
     /// Add a nightly report (a `cgdem validate` output) to the history in DIR: appends its
     /// metrics to DIR/history.json, rewrites DIR/index.html with the history table, trend
@@ -709,6 +742,8 @@ fn main() -> ExitCode {
             no_outcome,
             reference_timeout,
             grid,
+            np,
+            cgdem_bin,
         } => {
             let mut parsed = Vec::new();
             for name in &codes {
@@ -722,13 +757,20 @@ fn main() -> ExitCode {
                     }
                 });
             }
-            if threads.contains(&0) || pairs == 0 || steps == 0 || prepare.is_nan() || prepare < 0.0
+            if threads.contains(&0)
+                || np.contains(&0)
+                || pairs == 0
+                || steps == 0
+                || prepare.is_nan()
+                || prepare < 0.0
             {
-                eprintln!("error: --threads, --pairs and --steps must be at least 1 and --prepare at least 0");
+                eprintln!("error: --threads, --np, --pairs and --steps must be at least 1 and --prepare at least 0");
                 return ExitCode::FAILURE;
             }
             let options = cgdem_harness::bench::BenchOptions {
                 grid,
+                np,
+                cgdem_bin,
                 cases,
                 out: out.clone(),
                 codes: parsed,
@@ -806,6 +848,7 @@ fn main() -> ExitCode {
             balance,
             checkpoint_every,
             resume,
+            initial_state,
         } => {
             let sweep = match sweep.as_deref().map(Sweep::parse).transpose() {
                 Ok(s) => s,
@@ -846,10 +889,41 @@ fn main() -> ExitCode {
                         variant: variant.clone(),
                         force_dt,
                         keep_going,
+                        grid: grid.map(|g| g.to_string()),
+                        balance: grid.map(|_| balance.to_string()),
                     },
                     None,
                 ),
             };
+            // A resumed run keeps its grid and balance unless given another grid.
+            let (grid, balance) = match (grid, &invocation.grid) {
+                (None, Some(stored)) => {
+                    use cgdem_core::decomposition::{BalanceSpec, GridSpec};
+                    let balance: Result<BalanceSpec, String> = invocation
+                        .balance
+                        .as_deref()
+                        .map_or(Ok(BalanceSpec::default()), str::parse);
+                    let parsed = stored
+                        .parse::<GridSpec>()
+                        .and_then(|g| Ok((Some(g), balance?)));
+                    match parsed {
+                        Ok(p) => p,
+                        Err(e) => {
+                            eprintln!("error: the stored --grid/--balance: {e}");
+                            return ExitCode::from(2);
+                        }
+                    }
+                }
+                _ => (grid, balance),
+            };
+            // The restart files the run writes from now on name the grid it runs on.
+            let invocation = RunInvocation {
+                grid: grid.map(|g| g.to_string()),
+                balance: grid.map(|_| balance.to_string()),
+                ..invocation
+            };
+            let checkpoint_every =
+                checkpoint_every.or_else(|| resumed.as_ref().map(|l| l.restart.checkpoint_every));
             let RunInvocation {
                 case,
                 lambda,
@@ -955,7 +1029,12 @@ fn main() -> ExitCode {
                             return Ok((last, out_dir));
                         }
                         out_used = Some(out_dir.clone());
+                        let initial_state = initial_state
+                            .as_deref()
+                            .map(|path| cgdem_core::run::state_file::read(path, &scene))
+                            .transpose()?;
                         let options = RunOptions {
+                            initial_state,
                             out_dir: scratch.clone().unwrap_or_else(|| out_dir.clone()),
                             progress: progress_bar::progress(quiet || !root),
                             force_dt,

@@ -165,23 +165,85 @@ fn resumed_runs_write_the_uninterrupted_outputs_and_refuse_damaged_restart_files
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
 
+/// A decomposed run (`--grid`) resumed from a checkpoint within a stage writes exactly the
+/// uninterrupted run's outputs on its grid (on another thread count); on another grid it
+/// goes on from the stored particles; the restart file and `--grid` must agree on whether
+/// the run is decomposed.
 #[test]
-fn checkpoints_are_refused_with_grid() {
-    let out = tmp("grid");
+fn grid_runs_resume_bit_for_bit_on_their_grid_and_go_on_on_another() {
+    let reference = tmp("grid-reference");
+    let args = [
+        "run",
+        "tests/data/tiny_hertz_collapse.toml",
+        "--quiet",
+        "--threads",
+        "2",
+        "--grid",
+        "2x1x1",
+        "--checkpoint-every",
+        "0.03",
+        "--out",
+    ];
+    let run = cgdem(&args, &reference);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    // The newest file torn: the last periodic checkpoint, within the collapse, is used.
+    let dir = killed_copy(&reference, "grid-torn", |b| b.truncate(b.len() / 2));
+    let out = resume(&dir, "1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("restart.prev.cgr"), "{stderr}");
+    assert_same_outputs(&reference, &dir);
+    // Another grid: dealt out again, on it to the end.
+    let dir = killed_copy(&reference, "grid-other", |b| b.truncate(b.len() / 2));
+    let out = cgdem(
+        &[
+            "run",
+            "--quiet",
+            "--threads",
+            "1",
+            "--grid",
+            "1x1x2",
+            "--resume",
+        ],
+        &dir,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(
+        summary(&dir)["decomposition"]["grid"],
+        serde_json::json!([1, 1, 2])
+    );
+    assert_eq!(summary(&dir)["steps"], summary(&reference)["steps"]);
+    // A checkpoint of a run without --grid is not resumed with one.
+    let plain = tmp("grid-plain");
     let run = cgdem(
         &[
             "run",
             "tests/data/tiny_hertz_collapse.toml",
             "--quiet",
-            "--grid",
-            "2",
+            "--set",
+            "stage[0].max_duration=0.01",
+            "--set",
+            "stage[0].min_duration=0.01",
+            "--set",
+            "stage[1].duration=0.01",
             "--checkpoint-every",
             "0.1",
             "--out",
         ],
-        &out,
+        &plain,
     );
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(!run.status.success());
-    assert!(stderr.contains("not supported with --grid"), "{stderr}");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let out = cgdem(&["run", "--quiet", "--grid", "2x1x1", "--resume"], &plain);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("written by a run without --grid") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
 }

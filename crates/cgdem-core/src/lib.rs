@@ -3,6 +3,18 @@
 //!
 //! The solver core (particles, neighbour search, contact slots, walls, integration,
 //! coarse-graining, scenes) never depends on the validation harness or on plotting.
+//!
+//! Layers, lowest first: a module imports only modules listed before it here, so there is
+//! no import circle (`scripts/module-graph.py crates/cgdem-core/src`, run by
+//! `scripts/test.sh`, checks that).
+//! - physics: `math`; `domain`, `geometry`, `particles`, `contact`, `guard`, `timestep`;
+//!   `lammps_data` (the data-file format); `neighbor`, `integrate`, `walls`, `bodies`.
+//! - input: `scene` (the scene file and its validation: never the world or its outputs);
+//!   `coarse_graining`, `insertion` (a scene transformed, particles placed from it).
+//! - world (physics only, no scene): `force`, `memory_use` (shared by the two below);
+//!   `decomposition`; `simulation` (the `World`).
+//! - outputs: `io` (files), then `analysis` (measurements written with it).
+//! - `run`: the stage driver, on top of everything.
 
 pub mod analysis;
 pub mod bodies;
@@ -10,12 +22,15 @@ pub mod coarse_graining;
 pub mod contact;
 pub mod decomposition;
 pub mod domain;
+pub(crate) mod force;
 pub mod geometry;
 pub mod guard;
 pub mod insertion;
 pub mod integrate;
 pub mod io;
+pub mod lammps_data;
 pub mod math;
+pub mod memory_use;
 pub mod neighbor;
 pub mod particles;
 pub mod run;

@@ -12,11 +12,17 @@ use rayon::prelude::*;
 
 use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
-use crate::contact::{Contact, PairLaw, PairResult};
+use crate::contact::{Contact, PairLaw};
 use crate::decomposition::step::{Decomposition, Drive, Physics};
 use crate::decomposition::HistoryRows;
-use crate::decomposition::{balance, choose_counts, BalanceSpec, Comm, Grid, GridSpec};
+use crate::decomposition::{
+    balance, choose_counts, BalanceSpec, Comm, DecompositionSummary, Grid, GridSpec,
+};
 use crate::domain::Domain;
+use crate::force::{
+    body_force, body_force_and_torque, larger, pair_force, ForceView, Owner, ParticleState,
+};
+use crate::geometry::aabb::in_delete_region;
 use crate::geometry::Aabb;
 use crate::guard::{
     forced_step_cause, overlap_fraction, undamped_limit, GuardKind, GuardPeaks, GuardSettings,
@@ -24,25 +30,12 @@ use crate::guard::{
 };
 use crate::integrate::{complete_and_kick, drift_kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
+use crate::memory_use::MemoryUse;
 use crate::neighbor::{Pair, VerletList};
 use crate::particles::Particles;
 use crate::walls::{WallContact, WallLaw, WallParticle, WallSet};
 
 const CHUNK: usize = 512;
-
-/// Bytes the world holds, from its arrays' capacities (what `cgdem bench` reports).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MemoryUse {
-    pub particles: usize,
-    /// Per-particle arrays: state, forces, wall history, body loads, list offsets.
-    pub particle_bytes: usize,
-    pub pairs: usize,
-    /// Per-pair arrays: the list, its reverse index, the contact history and the results.
-    pub pair_bytes: usize,
-    /// Contact-history entries (one per listed pair: the store is rebuilt with the list,
-    /// so it never outgrows it).
-    pub history_entries: usize,
-}
 
 /// Everything a world carries from one step to the next that its scene does not give: the
 /// particles (with the forces and torques the next step's first half-kick uses), the pair
@@ -73,6 +66,9 @@ pub struct WorldState<H: PairHistory, WH: PairHistory> {
     /// The arrays' capacities, given back on restore so that `MemoryUse` (in summary.json)
     /// and later growth are those of the run the state was taken from.
     capacities: Vec<usize>,
+    /// The subdomains, when decomposed (`--grid`): then they hold the particles' state and
+    /// the list, and `particles` is the world's copy as last gathered.
+    decomposed: Option<crate::decomposition::DecomposedState>,
 }
 
 /// Applies `$m!` to each array of a world whose capacity `MemoryUse` counts, in a fixed
@@ -160,6 +156,8 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// Subdomains with ghosts (`--grid`); when set they hold the state, and `particles` is
     /// their owned particles side by side, refreshed every step.
     decomposition: Option<Box<Decomposition<L::History, W::History>>>,
+    /// Subdomains from a restart file, taken up by the next `set_grid`.
+    restored_grid: Option<Box<crate::decomposition::DecomposedState>>,
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
@@ -214,6 +212,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 ..Default::default()
             },
             decomposition: None,
+            restored_grid: None,
         };
         world.rebuild();
         world.compute_forces();
@@ -222,12 +221,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         world
     }
 
-    /// The world's changing state, for a restart file; None when decomposed (`--grid`), whose
-    /// state lives in the subdomains.
-    pub fn state(&self) -> Option<WorldState<L::History, W::History>> {
-        if self.decomposition.is_some() {
-            return None;
-        }
+    /// The world's changing state, for a restart file. When decomposed (`--grid`) the
+    /// subdomains' state is gathered from every rank (collective).
+    pub fn state(&self) -> WorldState<L::History, W::History> {
         let mut state = WorldState {
             particles: self.particles.clone(),
             time: self.time,
@@ -247,6 +243,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             old_torque: self.old_torque.clone(),
             guard: self.guard.clone(),
             capacities: Vec::new(),
+            decomposed: self.decomposition.as_ref().map(|d| d.state()),
         };
         // The clones have their lengths as capacities; keep this world's.
         let mut capacities = Vec::new();
@@ -257,11 +254,12 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         world_arrays!(self, record, as_ref);
         state.capacities = capacities;
-        Some(state)
+        state
     }
 
     /// Puts back a state taken by [`World::state`] from a world built from the same scene
-    /// (the guard settings stay this world's); an error when the walls or bodies differ.
+    /// (the guard settings stay this world's); an error when the walls or bodies differ. A
+    /// decomposed state's subdomains wait for [`World::set_grid`].
     pub fn set_state(&mut self, state: WorldState<L::History, W::History>) -> Result<(), String> {
         if state.wall_active.len() != self.walls.walls.len()
             || state.bodies.len() != self.bodies.len()
@@ -311,7 +309,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             };
         }
         world_arrays!(self, reserve, as_mut);
+        self.restored_grid = state.decomposed.map(Box::new);
         Ok(())
+    }
+
+    /// The grid of the subdomains a restored state holds (taken up by `set_grid`).
+    pub fn restored_grid(&self) -> Option<[usize; 3]> {
+        self.restored_grid.as_ref().map(|d| d.grid.counts)
     }
 
     /// Replaces the bodies (posed at the current time) and re-evaluates the forces.
@@ -844,6 +848,88 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// its own particles and ghosts (either integrator, walls, bodies, delete regions).
     /// Under MPI (`comm` of several ranks) each rank steps the subdomains it owns.
     pub fn set_grid(&mut self, spec: GridSpec, comm: Comm) -> Result<(), String> {
+        if let Some(stored) = self.restored_grid.take() {
+            return self.resume_grid(spec, comm, *stored);
+        }
+        let grid = self.grid_for(spec, self.ghost_width(), comm.size())?;
+        // Histories by partner id, in the pair's canonical orientation (lower id first).
+        let p = &self.particles;
+        let mut entries = Vec::new();
+        for (pair, &h) in self.list.pairs.iter().zip(&self.history) {
+            if h == L::History::default() {
+                continue;
+            }
+            let (i, j) = (pair.i, pair.j);
+            let (id_i, id_j) = (p.id[i as usize], p.id[j as usize]);
+            let h = if id_i < id_j { h } else { h.mirrored() };
+            entries.push((i, id_j, h));
+            entries.push((j, id_i, h));
+        }
+        let rows = HistoryRows::from_entries(p.len(), entries);
+        self.decompose(grid, rows, comm);
+        self.list = VerletList::new(self.neighbor.skin);
+        self.history = Vec::new();
+        self.reaction_force = Vec::new();
+        self.reaction_spin = Vec::new();
+        Ok(())
+    }
+
+    /// Takes up the subdomains of a restart file: on the grid they were (the same counts)
+    /// each as it was, so the run steps on bit for bit on any number of threads or ranks; on
+    /// another grid the owned particles dealt out again with their histories, on planes by
+    /// count (as a rebuild with a rebalance), the stored forces kept.
+    fn resume_grid(
+        &mut self,
+        spec: GridSpec,
+        comm: Comm,
+        stored: crate::decomposition::DecomposedState,
+    ) -> Result<(), String> {
+        let slots = self.wall_slots();
+        let same = match spec {
+            GridSpec::Given(counts) => counts == stored.grid.counts,
+            GridSpec::Auto(n) => n == stored.grid.len(),
+        };
+        let decomposition = if same && comm.size() <= stored.grid.len() {
+            let threshold = None;
+            Decomposition::from_state(stored, comm, threshold, Self::ROTATES, slots)?
+        } else {
+            let (particles, wall_history, rows) =
+                Decomposition::<L::History, W::History>::gathered_from_state(
+                    &stored,
+                    Self::ROTATES,
+                    slots,
+                )?;
+            self.particles = particles;
+            self.wall_history = wall_history;
+            let grid = self.grid_for(spec, stored.width, comm.size())?;
+            let mut d = Decomposition::new(
+                grid,
+                &self.particles,
+                &self.wall_history,
+                &rows,
+                &self.domain,
+                slots,
+                stored.width,
+                stored.extra,
+                stored.skin,
+                comm,
+            );
+            d.builds = stored.builds + 1;
+            d
+        };
+        self.decomposition = Some(Box::new(decomposition));
+        self.list = VerletList::new(self.neighbor.skin);
+        self.history = Vec::new();
+        self.reaction_force = Vec::new();
+        self.reaction_spin = Vec::new();
+        self.sync_particles();
+        Ok(())
+    }
+
+    /// The grid of `spec` over the particles, its planes by count and at least `width`
+    /// apart; an error when no placement is thick enough or `ranks` outnumber its
+    /// subdomains.
+    fn grid_for(&self, spec: GridSpec, width: Real, ranks: usize) -> Result<Grid, String> {
         let p = &self.particles;
         let counts = match spec {
             GridSpec::Given(counts) => counts,
@@ -864,42 +950,22 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             }
         };
         let mut grid = Grid::balanced(counts, &self.domain, &p.position);
-        if grid.check_width(self.ghost_width()).is_err() {
+        if grid.check_width(width).is_err() {
             // By count the planes crowd where the particles do: moved apart to a ghost layer
             // (as a balance shift would be); refused only if no placement is thick enough.
-            balance::clamp_to_width(&mut grid, self.ghost_width());
+            balance::clamp_to_width(&mut grid, width);
         }
-        grid.check_width(self.ghost_width())?;
-        if comm.size() > grid.len() {
+        grid.check_width(width)?;
+        if ranks > grid.len() {
             return Err(format!(
-                "{} MPI ranks need at least as many subdomains, and the grid {}x{}x{} has {}; give a grid of at least {} subdomains",
-                comm.size(),
+                "{ranks} MPI ranks need at least as many subdomains, and the grid {}x{}x{} has {}; give a grid of at least {ranks} subdomains",
                 counts[0],
                 counts[1],
                 counts[2],
                 grid.len(),
-                comm.size()
             ));
         }
-        // Histories by partner id, in the pair's canonical orientation (lower id first).
-        let mut entries = Vec::new();
-        for (pair, &h) in self.list.pairs.iter().zip(&self.history) {
-            if h == L::History::default() {
-                continue;
-            }
-            let (i, j) = (pair.i, pair.j);
-            let (id_i, id_j) = (p.id[i as usize], p.id[j as usize]);
-            let h = if id_i < id_j { h } else { h.mirrored() };
-            entries.push((i, id_j, h));
-            entries.push((j, id_i, h));
-        }
-        let rows = HistoryRows::from_entries(p.len(), entries);
-        self.decompose(grid, rows, comm);
-        self.list = VerletList::new(self.neighbor.skin);
-        self.history = Vec::new();
-        self.reaction_force = Vec::new();
-        self.reaction_spin = Vec::new();
-        Ok(())
+        Ok(grid)
     }
 
     /// `--balance`: whether the cut planes move by count at a rebuild when the imbalance
@@ -950,6 +1016,17 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
     }
 
+    /// `sync_particles` for what only rank 0 writes: under MPI only rank 0 receives the
+    /// particles, the other ranks' `particles` stay as they were (call `sync_particles`
+    /// where every rank takes a decision from them). Collective.
+    pub fn sync_particles_for_output(&mut self) {
+        if let Some(d) = &self.decomposition {
+            if let Some(gathered) = d.gathered_to(true) {
+                (self.particles, self.wall_history) = gathered;
+            }
+        }
+    }
+
     /// Particles in the world (while decomposed, over all subdomains and ranks: `particles`
     /// is refreshed only by `sync_particles`).
     pub fn particle_count(&self) -> usize {
@@ -961,7 +1038,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 
     /// The grid, ranks, particles per subdomain, imbalance and bytes sent between ranks per
     /// step, when decomposed. Collective under MPI.
-    pub fn decomposition_summary(&self) -> Option<crate::run::DecompositionSummary> {
+    pub fn decomposition_summary(&self) -> Option<DecompositionSummary> {
         let d = self.decomposition.as_ref()?;
         let counts: Vec<usize> = d
             .comm
@@ -981,7 +1058,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let keep = |x: Vec3| x.is_finite() && (stop_on_lost || domain.contains_bounded(x));
         let b = &d.balance;
         let static_now = balance::imbalance(&d.counts_over(&[&b.start], domain, &keep)[0]);
-        Some(crate::run::DecompositionSummary {
+        Some(DecompositionSummary {
             grid: d.grid.counts,
             ranks: d.comm.size(),
             subdomain_particles: counts,
@@ -1569,75 +1646,6 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
 /// Particles per leaf of the owner pass's recursive split.
 const OWNER_LEAF: usize = 256;
 
-/// The particle arrays the owner pass reads.
-#[derive(Clone, Copy)]
-pub(crate) struct ParticleState<'a> {
-    pub(crate) position: &'a [Vec3],
-    pub(crate) velocity: &'a [Vec3],
-    pub(crate) omega: Option<&'a [Vec3]>,
-    pub(crate) radius: &'a [Real],
-    pub(crate) mass: &'a [Real],
-    pub(crate) inv_mass: &'a [Real],
-    pub(crate) species: &'a [u16],
-}
-
-/// What a force pass borrows from the particles at once: the state it reads, the force and
-/// torque arrays it writes (torque empty without rotation), and the ids.
-pub(crate) struct ForceView<'a> {
-    pub(crate) id: &'a [u32],
-    pub(crate) state: ParticleState<'a>,
-    pub(crate) force: &'a mut [Vec3],
-    pub(crate) torque: &'a mut [Vec3],
-}
-
-impl<'a> ParticleState<'a> {
-    /// The state of `p`, read only.
-    pub(crate) fn of(p: &'a Particles) -> Self {
-        ParticleState {
-            position: &p.position,
-            velocity: &p.velocity,
-            omega: p.angular.as_ref().map(|a| a.omega.as_slice()),
-            radius: &p.radius,
-            mass: &p.mass,
-            inv_mass: &p.inv_mass,
-            species: &p.species,
-        }
-    }
-
-    /// `p` split into the state a force pass reads and the arrays it writes.
-    pub(crate) fn split(p: &'a mut Particles) -> ForceView<'a> {
-        let Particles {
-            id,
-            position,
-            velocity,
-            force,
-            radius,
-            mass,
-            inv_mass,
-            species,
-            angular,
-        } = p;
-        let (omega, torque) = match angular.as_mut() {
-            Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
-            None => (None, &mut [][..]),
-        };
-        ForceView {
-            id,
-            state: ParticleState {
-                position,
-                velocity,
-                omega,
-                radius,
-                mass,
-                inv_mass,
-                species,
-            },
-            force,
-            torque,
-        }
-    }
-}
-
 /// What the owner pass reads: the laws, the particles, the list, and what acts on one
 /// particle alone (gravity, planar walls, bodies).
 struct OwnerPass<'a, L: PairLaw, W: WallLaw> {
@@ -1895,185 +1903,6 @@ impl Reactions<'_> {
                 *torque += t;
             }
         }
-    }
-}
-
-/// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
-#[derive(Clone, Copy)]
-pub(crate) struct Owner {
-    pub(crate) index: usize,
-    pub(crate) position: Vec3,
-    pub(crate) velocity: Vec3,
-    pub(crate) omega: Vec3,
-    pub(crate) radius: Real,
-    pub(crate) inv_mass: Real,
-    /// `species_i * n_species`: the row of the species-pair tables.
-    pub(crate) species_row: usize,
-}
-
-/// The force of one listed pair `(i, j)` seen from its owner `i`; zero (and history reset)
-/// when out of range. Also returns the overlap and the smaller radius, for the guard.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-pub(crate) fn pair_force<L: PairLaw>(
-    law: &L,
-    p: &ParticleState,
-    images: &[Vec3; 27],
-    owner: &Owner,
-    pair: Pair,
-    history: &mut L::History,
-    dt: Real,
-) -> (PairResult, Real, Real) {
-    let j = pair.j as usize;
-    let d = owner.position - (p.position[j] + images[pair.image as usize]);
-    let distance_sq = d.length_squared();
-    let (radius_i, radius_j) = (owner.radius, p.radius[j]);
-    let species_pair = owner.species_row + p.species[j] as usize;
-    let cutoff = law.cutoff(species_pair, radius_i, radius_j);
-    if distance_sq >= cutoff * cutoff {
-        *history = L::History::default();
-        return (PairResult::default(), 0.0, 1.0);
-    }
-    let distance = distance_sq.sqrt();
-    // One division, as LIGGGHTS's `rinv`.
-    let normal = d * (1.0 / distance);
-    let overlap = radius_i + radius_j - distance;
-    let mut relative_velocity = owner.velocity - p.velocity[j];
-    let mut spins = (Vec3::ZERO, Vec3::ZERO);
-    if L::NEEDS_ROTATION {
-        if let Some(omega) = p.omega {
-            spins = (owner.omega, omega[j]);
-            // Contact point on the line of centres, inside each sphere by half the overlap.
-            let arm_i = -normal * (radius_i - 0.5 * overlap);
-            let arm_j = normal * (radius_j - 0.5 * overlap);
-            relative_velocity += spins.0.cross(arm_i) - spins.1.cross(arm_j);
-        }
-    }
-    let normal_speed = relative_velocity.dot(normal);
-    let (inv_mass_i, inv_mass_j) = (owner.inv_mass, p.inv_mass[j]);
-    let contact = Contact {
-        species_pair,
-        normal,
-        distance,
-        overlap,
-        radius_i,
-        radius_j,
-        r_eff: radius_i * radius_j / (radius_i + radius_j),
-        inv_mass_i,
-        inv_mass_j,
-        // A frozen particle (inverse mass 0) acts with infinite mass, as in LIGGGHTS and
-        // LAMMPS with `fix freeze`; two frozen particles are never listed.
-        m_eff: 1.0 / (inv_mass_i + inv_mass_j),
-        relative_velocity,
-        normal_speed,
-        tangential_velocity: relative_velocity - normal_speed * normal,
-    };
-    (
-        law.evaluate(&contact, history, spins, dt),
-        overlap,
-        radius_i.min(radius_j),
-    )
-}
-
-/// Force of one body on one particle (the wall law with the SDF distance and normal and the
-/// velocity relative to the body's surface), the particle's load on the body and its overlap
-/// with the body as a fraction of the radius.
-#[inline(always)]
-pub(crate) fn body_force<W: WallLaw>(
-    body: &Body,
-    law: &W,
-    particle: &WallParticle,
-    dt: Real,
-) -> (Vec3, BodyLoad, Real) {
-    let reach = law.reach(particle.species, particle.radius);
-    let Some((distance, normal)) = body.query(particle.position, reach) else {
-        return (Vec3::ZERO, BodyLoad::default(), 0.0);
-    };
-    let overlap = overlap_fraction(distance, particle.radius);
-    // A centre inside the body has passed through it: no force (as for planar walls).
-    if distance <= 0.0 || distance >= reach {
-        return (Vec3::ZERO, BodyLoad::default(), overlap);
-    }
-    let contact_point = particle.position - distance * normal;
-    let contact = WallContact {
-        species: particle.species,
-        normal,
-        distance,
-        relative_velocity: particle.velocity - body.surface_velocity(contact_point),
-        radius: particle.radius,
-        mass: particle.mass,
-    };
-    let force = law.force(&contact, dt);
-    let load = BodyLoad {
-        force: -force,
-        torque: (contact_point - body.center()).cross(-force),
-    };
-    (force, load, overlap)
-}
-
-/// `body_force` for spinning particles: the wall law's force and torque with the contact's
-/// history (tangential and rolling springs kept per particle per body, as for planar walls,
-/// and reset when they part). The body's own motion enters through the surface velocity at
-/// the contact point.
-pub(crate) fn body_force_and_torque<W: WallLaw>(
-    body: &Body,
-    law: &W,
-    particle: &WallParticle,
-    omega: Vec3,
-    history: &mut W::History,
-    dt: Real,
-) -> (Vec3, Vec3, BodyLoad, Real) {
-    let reach = law.reach(particle.species, particle.radius);
-    let reset = |history: &mut W::History| {
-        if *history != W::History::default() {
-            *history = W::History::default();
-        }
-    };
-    let Some((distance, normal)) = body.query(particle.position, reach) else {
-        reset(history);
-        return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), 0.0);
-    };
-    let overlap = overlap_fraction(distance, particle.radius);
-    if distance <= 0.0 || distance >= reach {
-        reset(history);
-        return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), overlap);
-    }
-    let contact_point = particle.position - distance * normal;
-    let contact = WallContact {
-        species: particle.species,
-        normal,
-        distance,
-        relative_velocity: particle.velocity - body.surface_velocity(contact_point),
-        radius: particle.radius,
-        mass: particle.mass,
-    };
-    let (force, torque) = if W::NEEDS_ROTATION {
-        law.force_and_torque_with_history(&contact, omega, history, dt)
-    } else {
-        (law.force(&contact, dt), Vec3::ZERO)
-    };
-    let load = BodyLoad {
-        force: -force,
-        torque: (contact_point - body.center()).cross(-force),
-    };
-    (force, torque, load, overlap)
-}
-
-/// Whether `p` lies in one of the delete regions (bounds included).
-pub(crate) fn in_delete_region(regions: &[Aabb], p: Vec3) -> bool {
-    regions
-        .iter()
-        .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
-}
-
-/// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN
-/// handling, and a NaN state is the non-finite guard's business).
-#[inline(always)]
-pub(crate) fn larger(a: Real, b: Real) -> Real {
-    if b > a {
-        b
-    } else {
-        a
     }
 }
 

@@ -29,6 +29,10 @@ use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::scene::{Override, Scene};
 
+/// Spread = this many standard errors of the mean over seeds (the matrix's columns and
+/// `cgdem advise`).
+pub const SPREAD_STANDARD_ERRORS: f64 = 2.0;
+
 /// What a point varies: the coarse-graining level or a scene key.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Knob {
@@ -1191,7 +1195,6 @@ fn write_matrix(
     points: &[AccuracyPoint],
     dir: &Path,
 ) -> Result<(), ValidateError> {
-    use crate::advise::SPREAD_STANDARD_ERRORS;
     let code = Code::Cgdem;
     let all = settings(code, points);
     let Some(reference) = all.iter().find(|s| s.series == "reference") else {

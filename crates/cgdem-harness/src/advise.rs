@@ -13,11 +13,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::accuracy::{settings, AccuracyPoint, Cost, Measure};
+use super::accuracy::{settings, AccuracyPoint, Cost, Measure, SPREAD_STANDARD_ERRORS};
 use super::code::Code;
-
-/// Spread = this many standard errors of the mean over seeds.
-pub const SPREAD_STANDARD_ERRORS: f64 = 2.0;
 
 #[derive(Debug, thiserror::Error)]
 pub enum AdviseError {

@@ -13,6 +13,11 @@
 //! A separate, untimed run of each code from the same state to the scene's end measures the
 //! outcome (height and flank slope of the heap), so that the speed is compared on the same
 //! physics.
+//!
+//! cgdem's MPI ranks (`np`) run the decomposed case as the reference codes run: a process
+//! tree under `mpirun`, `cgdem run` on the case file with the timed scene's overrides, the
+//! prepared state from a state file and `--grid`, its figures from rank 0's summary.json.
+//! Their outcome is not run again: the ranks write bitwise the threaded grid's outputs.
 
 use cgdem_core::io::CsvBuffer;
 use std::collections::BTreeMap;
@@ -58,6 +63,12 @@ pub struct BenchOptions {
     /// ratio decomposed / undecomposed from adjacent runs. The reference codes run the
     /// undecomposed case only.
     pub grid: Option<GridSpec>,
+    /// Also time cgdem on the decomposed case as this many MPI ranks of one thread each
+    /// (`mpirun -np N cgdem run --grid G --initial-state ...`, started from the prepared
+    /// state), in the same alternation as the other runs at N workers.
+    pub np: Vec<usize>,
+    /// The cgdem the ranks run: a build with `--features mpi`.
+    pub cgdem_bin: Option<PathBuf>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -66,6 +77,8 @@ pub enum BenchError {
     Case(String),
     #[error("{path}: {message}")]
     Output { path: PathBuf, message: String },
+    #[error("--np: {0}")]
+    Ranks(String),
 }
 
 /// One timed run.
@@ -73,7 +86,11 @@ pub enum BenchError {
 pub struct BenchRun {
     pub case: String,
     pub code: Code,
+    /// Workers: cgdem's threads, or the MPI ranks of a reference code or of cgdem (`--np`).
     pub threads: usize,
+    /// MPI ranks when the run was started by `mpirun` (the reference codes beyond one
+    /// worker, cgdem under `--np`); none for one process.
+    pub ranks: Option<usize>,
     pub repetition: usize,
     /// `completed`, `skipped`, `failed` or `timed out`.
     pub status: String,
@@ -94,11 +111,13 @@ pub struct BenchMedian {
     pub case: String,
     pub code: Code,
     pub threads: usize,
+    pub ranks: Option<usize>,
     pub runs: usize,
     pub median_particle_steps_per_s: Real,
     pub min_particle_steps_per_s: Real,
     pub max_particle_steps_per_s: Real,
-    /// Median throughput at this thread count over `threads` times the median at one.
+    /// Median throughput at this worker count over `threads` times the median of the same
+    /// case and code at one worker (in one process for cgdem's ranks).
     pub parallel_efficiency: Option<Real>,
 }
 
@@ -147,6 +166,10 @@ pub struct BenchReport {
 #[derive(Clone)]
 struct PreparedCase {
     name: String,
+    /// The case file, absolute (the ranks' command line reads it).
+    source: PathBuf,
+    /// The undecomposed case this one was derived from (itself if it is).
+    base: String,
     timed: Scene,
     full: Option<Scene>,
     state: Particles,
@@ -154,10 +177,13 @@ struct PreparedCase {
     reference_codes: bool,
     /// cgdem runs decomposed into this grid (the reference codes skip the case).
     grid: Option<GridSpec>,
+    /// `state` written for the ranks (`--np`).
+    state_file: Option<PathBuf>,
 }
 
 pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
     let out = &options.out;
+    let ranks_bin = check_ranks(options)?;
     let mut cases = Vec::new();
     for path in &options.cases {
         let case = prepare(path, options)?;
@@ -165,6 +191,16 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
             let mut decomposed = case.clone();
             decomposed.name = format!("{}-grid{grid}", case.name);
             decomposed.grid = Some(grid);
+            if ranks_bin.is_some() {
+                let path = out.join(&decomposed.name).join("state.cgs");
+                std::fs::create_dir_all(out.join(&decomposed.name))
+                    .and_then(|_| cgdem_core::run::state_file::write(&path, &case.state))
+                    .map_err(|e| BenchError::Output {
+                        path: path.clone(),
+                        message: e.to_string(),
+                    })?;
+                decomposed.state_file = Some(path);
+            }
             cases.push(case);
             cases.push(decomposed);
         } else {
@@ -173,26 +209,33 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
     }
     let mut runs: Vec<BenchRun> = Vec::new();
     let mut memory = Vec::new();
-    for &threads in &options.threads {
+    // Worker counts: threads (and the reference codes' ranks), and cgdem's ranks.
+    let mut workers: Vec<usize> = options.threads.iter().chain(&options.np).copied().collect();
+    workers.sort_unstable();
+    workers.dedup();
+    for &threads in &workers {
         for repetition in 0..options.pairs {
             // Every (case, code) in turn, the whole sequence reversed on odd repetitions
             // (A B C, C B A), so adjacent runs make each ratio.
-            let mut order: Vec<(&PreparedCase, Code)> = cases
-                .iter()
-                .flat_map(|case| options.codes.iter().map(move |&code| (case, code)))
-                .collect();
+            let mut order = run_order(&cases, options, threads);
             if repetition % 2 == 1 {
                 order.reverse();
             }
-            for (case, code) in order {
-                let dir = out
-                    .join(&case.name)
-                    .join(format!("{}-t{threads}-r{repetition}", code.name()));
-                let (run, mem) = timed_run(case, code, threads, repetition, &dir, options);
+            for (case, code, ranks) in order {
+                let dir = out.join(&case.name).join(match ranks {
+                    Some(n) => format!("{}-np{n}-r{repetition}", code.name()),
+                    None => format!("{}-t{threads}-r{repetition}", code.name()),
+                });
+                let (run, mem) = match (ranks, &ranks_bin) {
+                    (Some(n), Some(bin)) => {
+                        (ranks_run(case, bin, n, repetition, &dir, options), None)
+                    }
+                    _ => timed_run(case, code, threads, repetition, &dir, options),
+                };
                 eprintln!(
                     "bench {} {} threads={threads} rep={repetition}: {}",
                     case.name,
-                    code.name(),
+                    label(code, run.ranks),
                     run.particle_steps_per_s
                         .map_or(run.status.clone(), |v| format!("{v:.3e} particle-steps/s"))
                 );
@@ -206,10 +249,18 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
         }
     }
     let medians = medians(&runs);
-    let ratios = ratios(
+    let mut ratios = ratios(
         &runs,
         &cases.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
     );
+    ratios.extend(rank_ratios(
+        &runs,
+        &cases
+            .iter()
+            .filter(|c| c.grid.is_some())
+            .map(|c| (c.name.clone(), c.base.clone()))
+            .collect::<Vec<_>>(),
+    ));
     let mut outcomes = Vec::new();
     if options.outcome {
         let threads = options.threads.iter().copied().max().unwrap_or(1);
@@ -300,6 +351,9 @@ fn prepare(path: &Path, options: &BenchOptions) -> Result<PreparedCase, BenchErr
     let remaining = duration - options.prepare_s;
     Ok(PreparedCase {
         name: scene.name.clone(),
+        source: std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf()),
+        base: scene.name.clone(),
+        state_file: None,
         timed: with_duration(&scene, window),
         full: (options.outcome && remaining > window).then(|| with_duration(&scene, remaining)),
         state,
@@ -412,7 +466,7 @@ struct RunResult {
     steps: u64,
     loop_s: Option<Real>,
     particle_steps: Option<u64>,
-    memory: Option<cgdem_core::simulation::MemoryUse>,
+    memory: Option<cgdem_core::memory_use::MemoryUse>,
     memory_mb: Option<Real>,
 }
 
@@ -465,6 +519,16 @@ fn finish_reference(
                 }
             }
         }
+        other => *result = not_completed(other),
+    }
+}
+
+/// The result of a run that did not complete: skipped (with how to install what is
+/// missing), failed (with the log's tail) or timed out.
+fn not_completed(status: RunStatus) -> RunResult {
+    let mut result = RunResult::default();
+    match status {
+        RunStatus::Completed { .. } => result.status = "completed".into(),
         RunStatus::Skipped {
             reason,
             install_hint,
@@ -476,7 +540,7 @@ fn finish_reference(
             exit_code,
             log_tail,
         } => {
-            *result = RunResult::failed(format!("exit code {exit_code:?}; log tail:\n{log_tail}"));
+            result = RunResult::failed(format!("exit code {exit_code:?}; log tail:\n{log_tail}"));
         }
         RunStatus::TimedOut { after_s, log_tail } => {
             result.status = "timed out".into();
@@ -485,6 +549,7 @@ fn finish_reference(
             ));
         }
     }
+    result
 }
 
 fn timed_run(
@@ -516,6 +581,8 @@ fn timed_run(
             case: case.name.clone(),
             code,
             threads,
+            // The reference runner starts them under mpirun beyond one worker.
+            ranks: (code != Code::Cgdem && threads > 1).then_some(threads),
             repetition,
             status: result.status,
             reason: result.reason,
@@ -528,6 +595,210 @@ fn timed_run(
         },
         memory,
     )
+}
+
+/// The runs at `threads` workers in alternation order: each case with each code on threads
+/// (when `threads` is one of `--threads`), and after cgdem's threaded run of a decomposed
+/// case, its run as that many MPI ranks (when `threads` is one of `--np`).
+fn run_order<'c>(
+    cases: &'c [PreparedCase],
+    options: &BenchOptions,
+    threads: usize,
+) -> Vec<(&'c PreparedCase, Code, Option<usize>)> {
+    let threaded = options.threads.contains(&threads);
+    let ranks = options.np.contains(&threads);
+    let mut order = Vec::new();
+    for case in cases {
+        for &code in &options.codes {
+            if threaded {
+                order.push((case, code, None));
+            }
+            if ranks && code == Code::Cgdem && case.grid.is_some() {
+                order.push((case, code, Some(threads)));
+            }
+        }
+    }
+    order
+}
+
+/// How a code is named in the tables and plots: cgdem's MPI runs with their rank count.
+pub fn label(code: Code, ranks: Option<usize>) -> String {
+    match (code, ranks) {
+        (Code::Cgdem, Some(1)) => "cgdem (1 rank)".into(),
+        (Code::Cgdem, Some(n)) => format!("cgdem ({n} ranks)"),
+        _ => code.name().into(),
+    }
+}
+
+/// With `--np`: the cgdem binary the ranks run, after checking what they need (a grid of at
+/// least as many subdomains, cgdem in the codes, `mpirun`, a binary built with MPI); None
+/// without `--np`.
+fn check_ranks(options: &BenchOptions) -> Result<Option<PathBuf>, BenchError> {
+    let Some(&most) = options.np.iter().max() else {
+        return Ok(None);
+    };
+    let bad = |m: String| Err(BenchError::Ranks(m));
+    if options.np.contains(&0) {
+        return bad("rank counts must be at least 1".into());
+    }
+    if !options.codes.contains(&Code::Cgdem) {
+        return bad("the ranks are cgdem's: add cgdem to --codes".into());
+    }
+    let subdomains = match options.grid {
+        None => return bad("cgdem's ranks step subdomains: give --grid (e.g. 2x1x1)".into()),
+        Some(GridSpec::Given(c)) => c.iter().product(),
+        Some(GridSpec::Auto(n)) => n,
+    };
+    if subdomains < most {
+        return bad(format!(
+            "{most} ranks need at least {most} subdomains; --grid {} has {subdomains}",
+            options.grid.expect("checked")
+        ));
+    }
+    let bin = match &options.cgdem_bin {
+        Some(bin) => bin.clone(),
+        None => std::env::current_exe()
+            .map_err(|e| BenchError::Ranks(format!("cannot find this cgdem's binary: {e}")))?,
+    };
+    // `cgdem --version` names the MPI feature when built with it.
+    let version = std::process::Command::new(&bin)
+        .arg("--version")
+        .output()
+        .map_err(|e| BenchError::Ranks(format!("cannot run {} --version: {e}", bin.display())))?;
+    let version = String::from_utf8_lossy(&version.stdout);
+    if !version.contains(MPI_MARK) {
+        return bad(format!(
+            "{} ({}) is built without MPI: build one with `cargo build --release --features mpi` and give it with --cgdem-bin PATH (or run that binary)",
+            bin.display(),
+            version.trim()
+        ));
+    }
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    if !std::env::split_paths(&path).any(|dir| dir.join("mpirun").is_file()) {
+        return bad(
+            "mpirun not found on PATH; install OpenMPI (apt-get install openmpi-bin libopenmpi-dev)"
+                .into(),
+        );
+    }
+    Ok(Some(bin))
+}
+
+/// What `cgdem --version` prints in a build with the `mpi` feature (src/main.rs).
+pub const MPI_MARK: &str = "with MPI";
+
+/// The scene overrides that make a case file's scene the bench's timed scene (as
+/// `with_duration` makes it): one stage of `duration`, one output row at its end, no VTK.
+fn timed_overrides(duration: Real) -> Vec<String> {
+    // `{:?}` keeps every digit (and a `.` or exponent, so TOML reads a float).
+    vec![
+        format!("stage[0].duration={duration:?}"),
+        format!("output.timeseries_interval={duration:?}"),
+        "output.vtk_interval=0.0".into(),
+    ]
+}
+
+/// `mpirun -np N BIN run CASE --set ... --initial-state STATE --grid G --threads 1 --out DIR`:
+/// the ranks run of a decomposed case from its prepared state (one thread per rank).
+fn ranks_command(
+    case: &PreparedCase,
+    bin: &Path,
+    np: usize,
+    cores: usize,
+    dir: &Path,
+) -> Vec<String> {
+    let duration = match case.timed.stages[0].end {
+        StageEnd::Duration(d) => d,
+        StageEnd::Settled { max_duration, .. } => max_duration,
+    };
+    let mut argv = lammps::runner::mpirun_argv(np as u32, cores);
+    argv.extend([
+        bin.display().to_string(),
+        "run".into(),
+        case.source.display().to_string(),
+    ]);
+    for o in timed_overrides(duration) {
+        argv.extend(["--set".into(), o]);
+    }
+    let state = case.state_file.as_deref().unwrap_or(Path::new(""));
+    argv.extend([
+        "--initial-state".into(),
+        state.display().to_string(),
+        "--grid".into(),
+        case.grid.map_or(String::new(), |g| g.to_string()),
+        "--threads".into(),
+        "1".into(),
+        "--out".into(),
+        dir.display().to_string(),
+        "--quiet".into(),
+    ]);
+    argv
+}
+
+/// One timed run of a decomposed case as `np` MPI ranks of `bin`; the figures are rank 0's
+/// summary.json (its step loop, as the threaded runs'). Memory is not reported: each rank
+/// counts only its own subdomains.
+fn ranks_run(
+    case: &PreparedCase,
+    bin: &Path,
+    np: usize,
+    repetition: usize,
+    dir: &Path,
+    options: &BenchOptions,
+) -> BenchRun {
+    let dir = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    let result = match std::fs::create_dir_all(&dir) {
+        Err(e) => RunResult::failed(format!("cannot create {}: {e}", dir.display())),
+        Ok(()) => {
+            let argv = ranks_command(case, bin, np, lammps::runner::cores(), &dir);
+            let runner = RunnerOptions {
+                np: None,
+                timeout: options.timeout,
+                stop: None,
+            };
+            match lammps::runner::run_command(&argv, &dir, "stdout.txt", &runner) {
+                RunStatus::Completed { .. } => read_cgdem_summary(&dir),
+                other => not_completed(other),
+            }
+        }
+    };
+    let per_s = match (result.particle_steps, result.loop_s) {
+        (Some(ps), Some(s)) if s > 0.0 => Some(ps as Real / s),
+        _ => None,
+    };
+    BenchRun {
+        case: case.name.clone(),
+        code: Code::Cgdem,
+        threads: np,
+        ranks: Some(np),
+        repetition,
+        status: result.status,
+        reason: result.reason,
+        n_particles: result.n_particles,
+        steps: result.steps,
+        loop_s: result.loop_s,
+        particle_steps_per_s: per_s,
+        memory_mb: None,
+        dir,
+    }
+}
+
+/// A completed cgdem run's figures from its `summary.json`.
+fn read_cgdem_summary(dir: &Path) -> RunResult {
+    let path = dir.join("summary.json");
+    let summary: Result<cgdem_core::run::RunSummary, String> = std::fs::read_to_string(&path)
+        .map_err(|e| e.to_string())
+        .and_then(|text| serde_json::from_str(&text).map_err(|e| e.to_string()));
+    match summary {
+        Ok(s) => RunResult {
+            status: "completed".into(),
+            n_particles: s.n_particles,
+            steps: s.steps,
+            loop_s: Some(s.wall_s),
+            particle_steps: Some(s.particle_steps),
+            ..Default::default()
+        },
+        Err(e) => RunResult::failed(format!("{}: {e}", path.display())),
+    }
 }
 
 fn outcome_run(
@@ -641,23 +912,24 @@ fn median(values: &mut [Real]) -> Real {
 }
 
 fn medians(runs: &[BenchRun]) -> Vec<BenchMedian> {
-    let mut groups: BTreeMap<(String, Code, usize), Vec<Real>> = BTreeMap::new();
+    let mut groups: BTreeMap<(String, Code, usize, Option<usize>), Vec<Real>> = BTreeMap::new();
     for r in runs {
         if let Some(v) = r.particle_steps_per_s {
             groups
-                .entry((r.case.clone(), r.code, r.threads))
+                .entry((r.case.clone(), r.code, r.threads, r.ranks))
                 .or_default()
                 .push(v);
         }
     }
     let mut out: Vec<BenchMedian> = groups
         .iter()
-        .map(|((case, code, threads), values)| {
+        .map(|((case, code, threads, ranks), values)| {
             let mut v = values.clone();
             BenchMedian {
                 case: case.clone(),
                 code: *code,
                 threads: *threads,
+                ranks: *ranks,
                 runs: v.len(),
                 median_particle_steps_per_s: median(&mut v),
                 min_particle_steps_per_s: v[0],
@@ -666,11 +938,18 @@ fn medians(runs: &[BenchRun]) -> Vec<BenchMedian> {
             }
         })
         .collect();
-    let singles: Vec<(String, Code, Real)> = out
-        .iter()
-        .filter(|m| m.threads == 1)
-        .map(|m| (m.case.clone(), m.code, m.median_particle_steps_per_s))
-        .collect();
+    // One worker: cgdem in one process (its ranks are measured against it too), a
+    // reference code serial; cgdem's single rank when it ran no single thread.
+    let mut singles: Vec<(String, Code, Real)> = Vec::new();
+    for m in out.iter().filter(|m| m.threads == 1) {
+        let base = m.code != Code::Cgdem || m.ranks.is_none();
+        let known = singles.iter().position(|s| s.0 == m.case && s.1 == m.code);
+        match known {
+            Some(k) if base => singles[k].2 = m.median_particle_steps_per_s,
+            Some(_) => {}
+            None => singles.push((m.case.clone(), m.code, m.median_particle_steps_per_s)),
+        }
+    }
     for m in &mut out {
         if let Some((_, _, one)) = singles.iter().find(|s| s.0 == m.case && s.1 == m.code) {
             m.parallel_efficiency = Some(m.median_particle_steps_per_s / (m.threads as Real * one));
@@ -679,15 +958,29 @@ fn medians(runs: &[BenchRun]) -> Vec<BenchMedian> {
     out
 }
 
+/// The throughput of one run: `case`, `code` and workers in repetition `rep`, cgdem's
+/// threaded run unless `cgdem_ranks`.
+fn speed_of(
+    runs: &[BenchRun],
+    (case, code, threads, rep): (&str, Code, usize, usize),
+    cgdem_ranks: bool,
+) -> Option<Real> {
+    runs.iter()
+        .find(|r| {
+            r.case == case
+                && r.code == code
+                && r.threads == threads
+                && r.repetition == rep
+                && (code != Code::Cgdem || r.ranks.is_some() == cgdem_ranks)
+        })
+        .and_then(|r| r.particle_steps_per_s)
+}
+
 /// Per repetition, cgdem over each other code on the same case, and cgdem on each case over
-/// cgdem on the first case.
+/// cgdem on the first case (cgdem on threads).
 fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
     let speed = |case: &str, code: Code, threads: usize, rep: usize| {
-        runs.iter()
-            .find(|r| {
-                r.case == case && r.code == code && r.threads == threads && r.repetition == rep
-            })
-            .and_then(|r| r.particle_steps_per_s)
+        speed_of(runs, (case, code, threads, rep), false)
     };
     let mut keys: Vec<(usize, usize)> = runs.iter().map(|r| (r.threads, r.repetition)).collect();
     keys.sort();
@@ -753,6 +1046,54 @@ fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
     out
 }
 
+/// Per repetition, cgdem's ranks on each decomposed case (`(case, base)`) over: cgdem on
+/// the same case on as many threads, cgdem on the undecomposed base case, and each
+/// reference code on the base case, at the same worker count.
+fn rank_ratios(runs: &[BenchRun], cases: &[(String, String)]) -> Vec<BenchRatio> {
+    let mut out = Vec::new();
+    let mut keys: Vec<(usize, usize)> = runs
+        .iter()
+        .filter(|r| r.code == Code::Cgdem && r.ranks.is_some())
+        .map(|r| (r.threads, r.repetition))
+        .collect();
+    keys.sort();
+    keys.dedup();
+    let mut workers: Vec<usize> = keys.iter().map(|k| k.0).collect();
+    workers.dedup();
+    for &n in &workers {
+        let reps: Vec<usize> = keys.iter().filter(|k| k.0 == n).map(|k| k.1).collect();
+        for (case, base) in cases {
+            let ranks = |rep| speed_of(runs, (case.as_str(), Code::Cgdem, n, rep), true);
+            let others = [
+                (case.as_str(), Code::Cgdem),
+                (base.as_str(), Code::Cgdem),
+                (base.as_str(), Code::Liggghts),
+                (base.as_str(), Code::Lammps),
+            ];
+            for (other_case, other) in others {
+                let values: Vec<Real> = reps
+                    .iter()
+                    .filter_map(|&rep| {
+                        Some(ranks(rep)? / speed_of(runs, (other_case, other, n, rep), false)?)
+                    })
+                    .collect();
+                if values.is_empty() {
+                    continue;
+                }
+                let mut v = values.clone();
+                out.push(BenchRatio {
+                    numerator: format!("{case} {}", label(Code::Cgdem, Some(n))),
+                    denominator: format!("{other_case} {}", other.name()),
+                    threads: n,
+                    median: median(&mut v),
+                    per_repetition: values,
+                });
+            }
+        }
+    }
+    out
+}
+
 fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
     let io = |path: &Path, e: &dyn std::fmt::Display| BenchError::Output {
         path: path.to_path_buf(),
@@ -766,6 +1107,7 @@ fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
         "case",
         "code",
         "threads",
+        "ranks",
         "repetition",
         "status",
         "n_particles",
@@ -780,6 +1122,7 @@ fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
             r.case.to_string(),
             r.code.name().to_string(),
             r.threads.to_string(),
+            r.ranks.map_or(String::new(), |n| n.to_string()),
             r.repetition.to_string(),
             r.status.to_string(),
             r.n_particles.to_string(),
@@ -798,8 +1141,8 @@ fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
         .iter()
         .map(|m| {
             (
-                format!("{}, {} thread(s)", m.case, m.threads),
-                m.code.name().to_string(),
+                format!("{}, {} worker(s)", m.case, m.threads),
+                label(m.code, m.ranks),
                 m.median_particle_steps_per_s / 1e6,
                 Some(0.5 * (m.max_particle_steps_per_s - m.min_particle_steps_per_s) / 1e6),
             )
@@ -830,12 +1173,12 @@ fn write_report(report: &BenchReport, out: &Path) -> Result<(), BenchError> {
 /// The report as text: medians, ratios, outcomes and memory.
 pub fn format_report(report: &BenchReport) -> String {
     let mut s = String::new();
-    s += "case | code | threads | runs | median particle-steps/s | range | parallel efficiency\n";
+    s += "case | code | workers | runs | median particle-steps/s | range | parallel efficiency\n";
     for m in &report.medians {
         s += &format!(
             "{} | {} | {} | {} | {:.3e} | {:.3e} .. {:.3e} | {}\n",
             m.case,
-            m.code.name(),
+            label(m.code, m.ranks),
             m.threads,
             m.runs,
             m.median_particle_steps_per_s,
@@ -845,7 +1188,7 @@ pub fn format_report(report: &BenchReport) -> String {
                 .map_or("-".into(), |e| format!("{:.0}%", 100.0 * e))
         );
     }
-    s += "\nratio | threads | median | per repetition\n";
+    s += "\nratio | workers | median | per repetition\n";
     for r in &report.ratios {
         s += &format!(
             "{} / {} | {} | {:.2} | {}\n",
@@ -898,6 +1241,7 @@ mod tests {
             case: "heap".into(),
             code,
             threads: 1,
+            ranks: None,
             repetition: rep,
             status: "completed".into(),
             reason: None,
@@ -923,5 +1267,192 @@ mod tests {
         let m = medians(&runs);
         assert_eq!(m[0].median_particle_steps_per_s, 10.0);
         assert_eq!(m[0].parallel_efficiency, Some(1.0));
+    }
+
+    fn heap_case(grid: Option<GridSpec>) -> PreparedCase {
+        let path = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../validation/bench/heap.toml"
+        ));
+        let scene = Scene::load(path).unwrap();
+        PreparedCase {
+            name: if grid.is_some() {
+                "bench_heap-grid2x1x1".into()
+            } else {
+                scene.name.clone()
+            },
+            source: path.to_path_buf(),
+            base: scene.name.clone(),
+            timed: with_duration(&scene, 1234.0 * 1e-5),
+            full: None,
+            state: Particles::new(true),
+            dt: 1e-5,
+            reference_codes: true,
+            grid,
+            state_file: Some(PathBuf::from("/tmp/bench/state.cgs")),
+        }
+    }
+
+    #[test]
+    fn the_ranks_run_the_timed_scene_from_the_state_on_the_grid() {
+        let case = heap_case(Some(GridSpec::Given([2, 1, 1])));
+        let argv = ranks_command(&case, Path::new("/opt/cgdem"), 2, 2, Path::new("/tmp/out"));
+        assert_eq!(
+            argv[..6],
+            [
+                "mpirun",
+                "--allow-run-as-root",
+                "-np",
+                "2",
+                "/opt/cgdem",
+                "run"
+            ]
+        );
+        let after = |flag: &str| {
+            let k = argv.iter().position(|a| a == flag).unwrap();
+            argv[k + 1].clone()
+        };
+        assert_eq!(after("--grid"), "2x1x1");
+        assert_eq!(after("--threads"), "1");
+        assert_eq!(after("--initial-state"), "/tmp/bench/state.cgs");
+        assert_eq!(after("--out"), "/tmp/out");
+        // The overrides turn the case file's scene into exactly the timed scene.
+        let overrides: Vec<_> = argv
+            .windows(2)
+            .filter(|w| w[0] == "--set")
+            .map(|w| cgdem_core::scene::Override::parse(&w[1], Path::new("--set")).unwrap())
+            .collect();
+        assert_eq!(overrides.len(), 3);
+        let scene = Scene::load_with_overrides(Path::new(&argv[6]), &overrides).unwrap();
+        assert!(scene == case.timed, "the ranks would run another scene");
+        // More ranks than cores: OpenMPI needs --oversubscribe.
+        let argv = ranks_command(&case, Path::new("/opt/cgdem"), 4, 2, Path::new("/tmp/out"));
+        assert_eq!(argv[2], "--oversubscribe");
+    }
+
+    #[test]
+    fn ranks_follow_the_threaded_run_of_the_decomposed_case() {
+        let cases = vec![heap_case(None), heap_case(Some(GridSpec::Given([2, 1, 1])))];
+        let options = BenchOptions {
+            cases: Vec::new(),
+            out: PathBuf::new(),
+            codes: vec![Code::Cgdem, Code::Lammps],
+            threads: vec![1, 2],
+            pairs: 1,
+            steps: 1,
+            prepare_s: 0.0,
+            outcome: false,
+            timeout: Duration::from_secs(1),
+            grid: Some(GridSpec::Given([2, 1, 1])),
+            np: vec![2],
+            cgdem_bin: None,
+        };
+        let names = |w| -> Vec<(String, Code, Option<usize>)> {
+            run_order(&cases, &options, w)
+                .into_iter()
+                .map(|(c, code, r)| (c.name.clone(), code, r))
+                .collect()
+        };
+        assert!(names(1).iter().all(|e| e.2.is_none()));
+        assert_eq!(names(1).len(), 4);
+        let two = names(2);
+        assert_eq!(two.len(), 5);
+        assert_eq!(two[2], ("bench_heap-grid2x1x1".into(), Code::Cgdem, None));
+        assert_eq!(
+            two[3],
+            ("bench_heap-grid2x1x1".into(), Code::Cgdem, Some(2))
+        );
+    }
+
+    #[test]
+    fn bad_rank_requests_are_refused_before_anything_runs() {
+        let mut options = BenchOptions {
+            cases: Vec::new(),
+            out: PathBuf::new(),
+            codes: vec![Code::Cgdem],
+            threads: vec![1],
+            pairs: 1,
+            steps: 1,
+            prepare_s: 0.0,
+            outcome: false,
+            timeout: Duration::from_secs(1),
+            grid: None,
+            np: vec![2],
+            cgdem_bin: None,
+        };
+        let err = |o: &BenchOptions| check_ranks(o).unwrap_err().to_string();
+        assert!(err(&options).contains("--grid"), "{}", err(&options));
+        options.grid = Some(GridSpec::Given([2, 1, 1]));
+        options.np = vec![4];
+        assert!(err(&options).contains("at least 4 subdomains"));
+        options.np = vec![2];
+        options.codes = vec![Code::Lammps];
+        assert!(err(&options).contains("--codes"));
+        options.codes = vec![Code::Cgdem];
+        // A binary without MPI (echo's --version does not say "with MPI").
+        if Path::new("/bin/echo").is_file() {
+            options.cgdem_bin = Some(PathBuf::from("/bin/echo"));
+            let e = err(&options);
+            assert!(e.contains("cargo build --release --features mpi"), "{e}");
+        }
+        options.np = Vec::new();
+        assert!(check_ranks(&options).unwrap().is_none());
+    }
+
+    #[test]
+    fn ranks_get_rows_efficiency_and_ratios_of_their_own() {
+        let run = |case: &str, code, threads, ranks, v| BenchRun {
+            case: case.into(),
+            code,
+            threads,
+            ranks,
+            repetition: 0,
+            status: "completed".into(),
+            reason: None,
+            n_particles: 1,
+            steps: 1,
+            loop_s: Some(1.0),
+            particle_steps_per_s: Some(v),
+            memory_mb: None,
+            dir: PathBuf::new(),
+        };
+        let g = "heap-grid2x1x1";
+        let runs = vec![
+            run("heap", Code::Cgdem, 1, None, 10.0),
+            run(g, Code::Cgdem, 1, None, 10.0),
+            run("heap", Code::Cgdem, 2, None, 17.0),
+            run(g, Code::Cgdem, 2, None, 18.0),
+            run(g, Code::Cgdem, 2, Some(2), 19.0),
+            run("heap", Code::Lammps, 2, Some(2), 12.5),
+        ];
+        let m = medians(&runs);
+        let ranks = m
+            .iter()
+            .find(|m| m.ranks == Some(2) && m.code == Code::Cgdem);
+        assert_eq!(ranks.unwrap().parallel_efficiency, Some(19.0 / 20.0));
+        let threads = m
+            .iter()
+            .find(|m| m.case == g && m.threads == 2 && m.ranks.is_none());
+        assert_eq!(threads.unwrap().parallel_efficiency, Some(0.9));
+        // The threaded ratios ignore the ranks' runs.
+        let r = ratios(&runs, &["heap".into(), g.into()]);
+        let grid = r
+            .iter()
+            .find(|r| r.threads == 2 && r.numerator.starts_with(g));
+        assert_eq!(grid.unwrap().median, 18.0 / 17.0);
+        let r = rank_ratios(&runs, &[(g.into(), "heap".into())]);
+        let values: Vec<(String, Real)> = r
+            .iter()
+            .map(|r| (r.denominator.clone(), r.median))
+            .collect();
+        assert_eq!(
+            values,
+            vec![
+                (format!("{g} cgdem"), 19.0 / 18.0),
+                ("heap cgdem".into(), 19.0 / 17.0),
+                ("heap lammps".into(), 19.0 / 12.5),
+            ]
+        );
+        assert_eq!(r[0].numerator, format!("{g} cgdem (2 ranks)"));
     }
 }

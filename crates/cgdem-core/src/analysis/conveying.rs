@@ -5,31 +5,7 @@
 use serde::Serialize;
 
 use crate::math::{Real, Vec3};
-
-/// Screw-conveyor measurements (paper A Eq. 7) during one stage.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ConveyingSettings {
-    pub stage: String,
-    /// The screw body (its rpm gives n_s).
-    pub body: String,
-    /// Start-up time discarded at the beginning of the stage, s.
-    pub discard: Real,
-    /// Blocks for the standard error of the mass flow.
-    pub blocks: u32,
-    pub outer_diameter: Real,
-    pub shaft_diameter: Real,
-    pub pitch: Real,
-    /// Casing bore radius: particles with centres inside it count for the fill ratio.
-    pub bore_radius: Real,
-    /// Axial range (along x, the screw axis) where the fill ratio is measured.
-    pub fill_x: [Real; 2],
-    /// Axial position of the plane the mass flow is measured through (inside the screw
-    /// section, downstream of the inlet); `None`: at the outlet, from the deleted mass alone.
-    pub flow_x: Option<Real>,
-    /// Box where the bulk density is measured (centres inside count).
-    pub bulk_lo: Vec3,
-    pub bulk_hi: Vec3,
-}
+use crate::scene::ConveyingSettings;
 
 /// Fill ratio: solid volume of the particles whose centres lie inside the bore between
 /// `fill_x` (axial coordinate along the screw axis through `point`) over the swept volume

@@ -17,6 +17,6 @@ pub use pore_size::{
     PoreSizeError, PoreSizeField, VoxelGrid,
 };
 pub use porosity::{
-    bed_measurement_region, porosity_voxel, porosity_z_slab, sphere_slab_volume, BedRegionRule,
-    MeasurementRegion, Porosity, PorosityError,
+    bed_measurement_region, porosity_voxel, porosity_z_slab, sphere_slab_volume, MeasurementRegion,
+    Porosity, PorosityError,
 };

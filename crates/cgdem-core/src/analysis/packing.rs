@@ -10,8 +10,9 @@
 use serde::Serialize;
 
 use super::pore_size::{pore_size_field_of_spheres, Boundary, PoreSizeDistribution, VoxelGrid};
-use super::porosity::{bed_measurement_region, porosity_z_slab, BedRegionRule};
+use super::porosity::{bed_measurement_region, porosity_z_slab};
 use crate::math::{Real, Vec3};
+use crate::scene::BedRegionRule;
 
 /// What was measured, for `summary.json`.
 #[derive(Clone, Debug, Serialize, serde::Deserialize)]

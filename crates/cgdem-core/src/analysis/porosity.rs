@@ -11,6 +11,7 @@
 //! under 1e-4). The test `overlap_error_is_second_order` pins this.
 
 use crate::math::{Real, Vec3};
+use crate::scene::BedRegionRule;
 use std::f64::consts::PI;
 use std::fmt;
 
@@ -214,35 +215,6 @@ pub fn porosity_voxel(
         solid_volume: fraction * region_volume,
         region_volume,
     })
-}
-
-/// Rule choosing the measurement region of a poured bed (lateral periodic, floor below, top
-/// open), in units of the mean particle diameter `d`.
-///
-/// Bottom: `floor_z + floor_margin * d`. Near a flat wall spheres order in layers (the local
-/// porosity oscillates with period about `d`, largest in the first layer, and has decayed to a
-/// few percent of its amplitude after about two diameters), so the first two layers are left out.
-///
-/// Top: `bed_height - top_margin * d`, where `bed_height` is the `top_quantile` quantile
-/// (nearest rank) of the particle-centre heights. A quantile instead of the maximum keeps a few
-/// particles perched on (or still bouncing above) the surface from setting the height; the
-/// 0.99 quantile of a 10 d x 10 d bed sits in its topmost layer. The free surface is rough over
-/// one to two diameters and looser below it, hence the two-diameter margin.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BedRegionRule {
-    pub floor_margin: Real,
-    pub top_quantile: Real,
-    pub top_margin: Real,
-}
-
-impl Default for BedRegionRule {
-    fn default() -> Self {
-        Self {
-            floor_margin: 2.0,
-            top_quantile: 0.99,
-            top_margin: 2.0,
-        }
-    }
 }
 
 /// Measurement region of a bed by `rule`: lateral extent `[lateral_lo, lateral_hi]` (x, y,

@@ -70,7 +70,7 @@ impl std::fmt::Display for BalanceSpec {
 }
 
 /// The balancing of a decomposed run and what it saw.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Balance {
     /// Rebalance at a rebuild when the imbalance passes this; None: the planes stay.
     pub threshold: Option<Real>,

@@ -11,7 +11,7 @@ use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 
 /// Owned particles (by index) that subdomain `to` keeps as ghosts, seen with `shift` added.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SendList {
     pub to: usize,
     pub shift: Vec3,

@@ -77,7 +77,7 @@ pub fn choose_counts(count: usize, extent: Vec3, periodic: [bool; 3]) -> [usize;
 }
 
 /// The subdomain grid: per axis the counts and the interior cut planes.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Grid {
     pub counts: [usize; 3],
     /// Per axis, `counts[a] - 1` increasing planes; subdomain `c` along `a` holds

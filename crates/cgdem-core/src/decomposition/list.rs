@@ -9,7 +9,7 @@ use crate::domain::Domain;
 use crate::math::{Real, Vec3};
 use crate::neighbor::CellGrid;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct LocalList<H> {
     /// `[i, j]` with `i` owned and `j > i` (owned or ghost), grouped by `i`, `j` increasing.
     pub pairs: Vec<[u32; 2]>,

@@ -26,17 +26,50 @@ pub mod exchange;
 pub mod forward;
 pub mod grid;
 pub mod list;
+pub mod state;
 pub mod step;
 pub mod team;
 pub mod transport;
 
 pub use balance::BalanceSpec;
 pub use grid::{choose_counts, Grid, GridSpec};
+pub use state::DecomposedState;
 pub use transport::Comm;
 
 use crate::contact::PairHistory;
-use crate::math::Vec3;
+use crate::math::{Real, Vec3};
 use crate::particles::Particles;
+
+/// What `summary.json` says of a decomposed run (`--grid`, issue 23).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct DecompositionSummary {
+    /// Subdomains along x, y, z.
+    pub grid: [usize; 3],
+    /// MPI ranks (1: threads in one process).
+    pub ranks: usize,
+    /// Owned particles per subdomain at the end.
+    pub subdomain_particles: Vec<usize>,
+    /// Most particles in one subdomain over the mean, at the end (1 is perfect balance).
+    pub imbalance: Real,
+    /// `--balance`: the imbalance past which the cut planes moved at a rebuild (none: off).
+    #[serde(default)]
+    pub balance_threshold: Option<Real>,
+    /// Rebuilds at which the cut planes moved.
+    #[serde(default)]
+    pub shifts: u64,
+    /// The largest imbalance the subdomains had after a rebuild, from the first shift on.
+    #[serde(default)]
+    pub imbalance_max_after_first_shift: Option<Real>,
+    /// The imbalance the start's cut planes (by count, never moved) would give at the end.
+    #[serde(default)]
+    pub static_imbalance: Real,
+    /// The largest imbalance the start's cut planes gave or would have given at a rebuild.
+    #[serde(default)]
+    pub static_imbalance_max: Real,
+    /// Bytes the ranks sent each other per step, averaged over the run (exchange, borders,
+    /// forward; 0 in one process, where the threads read the buffers in place).
+    pub bytes_sent_between_ranks_per_step: Real,
+}
 
 /// Per owned particle, the contact histories of its pairs keyed by the partner's id (LAMMPS
 /// `fix neigh/history`'s partner lists, kept with both particles of a pair when newton is

@@ -14,15 +14,16 @@ use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
+use crate::force::{
+    body_force, body_force_and_torque, larger, pair_force, ForceView, Owner, ParticleState,
+};
+use crate::geometry::aabb::in_delete_region;
 use crate::geometry::Aabb;
 use crate::integrate::{pcvv, Integrator};
 use crate::math::{Real, Vec3};
+use crate::memory_use::MemoryUse;
 use crate::neighbor::{CellGrid, Pair};
 use crate::particles::Particles;
-use crate::simulation::{
-    body_force, body_force_and_torque, in_delete_region, larger, pair_force, ForceView, MemoryUse,
-    Owner, ParticleState,
-};
 use crate::walls::{WallLaw, WallParticle, WallSet};
 
 /// The laws and what acts on a particle alone, for one force pass.
@@ -130,9 +131,9 @@ pub struct Decomposition<H, WH> {
     pub balance: Balance,
     /// Per group of body particles, their load at the last force pass (over all ranks).
     pub kinematic_loads: Vec<BodyLoad>,
-    buffers: Vec<Vec<States>>,
+    pub(super) buffers: Vec<Vec<States>>,
     /// Words each rank sends here in a forward, fixed between rebuilds.
-    forward_counts: Option<Vec<usize>>,
+    pub(super) forward_counts: Option<Vec<usize>>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
@@ -254,6 +255,12 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     /// rebuild), with their wall histories; under MPI gathered from every rank (to every
     /// rank, so each takes the same decisions from them).
     pub fn gathered(&self) -> (Particles, Vec<WH>) {
+        self.gathered_to(false).expect("gathered to every rank")
+    }
+
+    /// `gathered`, and with `to_root` under MPI at rank 0 only (None on the others): for
+    /// what only rank 0 writes. Collective.
+    pub fn gathered_to(&self, to_root: bool) -> Option<(Particles, Vec<WH>)> {
         let rotation = self.subdomains[0].particles.angular.is_some();
         let mut all = Particles::new(rotation);
         let mut wall = Vec::new();
@@ -264,17 +271,31 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 }
                 wall.extend_from_slice(&sub.wall_history);
             }
-            return (all, wall);
+            return Some((all, wall));
         }
-        let per_sub = self
-            .comm
-            .gather_by_subdomain(self.subdomains.len(), |s, out| {
-                let sub = &self.subdomains[s];
-                let mut owned = sub.particles.clone();
-                owned.truncate(sub.n_owned);
-                owned.write(out);
-                write_histories(&sub.wall_history, out);
-            });
+        let encode = |s: usize, out: &mut Vec<Real>| {
+            let sub = &self.subdomains[s];
+            let mut owned = sub.particles.clone();
+            owned.truncate(sub.n_owned);
+            owned.write(out);
+            write_histories(&sub.wall_history, out);
+        };
+        let count = self.subdomains.len();
+        if to_root {
+            let per_sub = self.comm.gather_by_subdomain_to_root(count, encode);
+            if !self.comm.is_root() {
+                return None;
+            }
+            return Some(Self::concatenated(per_sub, rotation));
+        }
+        let per_sub = self.comm.gather_by_subdomain(count, encode);
+        Some(Self::concatenated(per_sub, rotation))
+    }
+
+    /// The particles and wall histories each subdomain's words hold, side by side.
+    fn concatenated(per_sub: Vec<Vec<Real>>, rotation: bool) -> (Particles, Vec<WH>) {
+        let mut all = Particles::new(rotation);
+        let mut wall = Vec::new();
         for words in per_sub {
             let mut input = &words[..];
             let p = Particles::read(&mut input);

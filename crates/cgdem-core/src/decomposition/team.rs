@@ -28,7 +28,7 @@ type Job<'a> = dyn Fn(usize) + Sync + 'a;
 pub struct Team {
     shared: Arc<Shared>,
     workers: Vec<JoinHandle<()>>,
-    /// One phase at a time (a clone of the decomposition on another thread waits).
+    /// Held during a phase; a phase started meanwhile runs on its caller alone.
     running: Mutex<()>,
 }
 
@@ -93,7 +93,16 @@ impl Team {
             job(0);
             return;
         }
-        let _one_phase = self.running.lock().unwrap_or_else(PoisonError::into_inner);
+        // Busy with another phase (a task that starts a phase itself, or a clone of the
+        // decomposition stepped on another thread): this one runs every part here.
+        let _one_phase = match self.running.try_lock() {
+            Ok(guard) => guard,
+            Err(std::sync::TryLockError::Poisoned(e)) => e.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => {
+                (0..self.threads()).for_each(job);
+                return;
+            }
+        };
         let s = &*self.shared;
         // SAFETY: the workers read the pointer only during this phase, and this function
         // returns (or unwinds) only after every worker has finished with it.
@@ -282,6 +291,18 @@ mod tests {
                 assert_eq!(out[6], Some(212 + phase));
             }
         }
+    }
+
+    #[test]
+    fn a_phase_started_inside_a_phase_runs_on_its_caller() {
+        let team = Team::new(2);
+        let mut outer = vec![0u32; 2];
+        team.each_of(&mut outer, &[0, 1], |x| {
+            let mut inner = vec![1u32; 3];
+            team.each_of(&mut inner, &[0, 1, 2], |y| *y += 1);
+            *x = inner.iter().sum();
+        });
+        assert_eq!(outer, vec![6, 6]);
     }
 
     #[test]

@@ -212,12 +212,42 @@ impl Comm {
         vec![mine]
     }
 
+    /// Every rank's `mine` at rank 0, in rank order; the other ranks get nothing back: for
+    /// what only rank 0 writes.
+    #[allow(unused_variables)]
+    pub fn gather_to_root(&self, mine: Vec<Real>) -> Vec<Vec<Real>> {
+        #[cfg(feature = "mpi")]
+        if let Some(m) = &self.mpi {
+            return m.gather_to_root(mine);
+        }
+        vec![mine]
+    }
+
     /// Per subdomain (index order), the words each owner encoded for it with `encode`
-    /// (called for the owned subdomains only).
+    /// (called for the owned subdomains only), on every rank.
     pub fn gather_by_subdomain(
         &self,
         count: usize,
         encode: impl Fn(usize, &mut Vec<Real>),
+    ) -> Vec<Vec<Real>> {
+        self.subdomain_words(count, encode, false)
+    }
+
+    /// `gather_by_subdomain` at rank 0 only; the other ranks keep the words of their own
+    /// subdomains (the others empty).
+    pub fn gather_by_subdomain_to_root(
+        &self,
+        count: usize,
+        encode: impl Fn(usize, &mut Vec<Real>),
+    ) -> Vec<Vec<Real>> {
+        self.subdomain_words(count, encode, true)
+    }
+
+    fn subdomain_words(
+        &self,
+        count: usize,
+        encode: impl Fn(usize, &mut Vec<Real>),
+        to_root: bool,
     ) -> Vec<Vec<Real>> {
         let mut mine = Vec::new();
         let mut per_sub = vec![Vec::new(); count];
@@ -236,7 +266,12 @@ impl Comm {
                 mine.extend_from_slice(words);
             }
         }
-        for buffer in self.all_gather(mine) {
+        let gathered = if to_root {
+            self.gather_to_root(mine)
+        } else {
+            self.all_gather(mine)
+        };
+        for buffer in gathered {
             let mut input = &buffer[..];
             while !input.is_empty() {
                 let sub = take_count(&mut input);
@@ -496,6 +531,30 @@ mod mpi_comm {
                 // Dropping the guards waits for every request.
             });
             received
+        }
+
+        pub(super) fn gather_to_root(&self, mine: Vec<Real>) -> Vec<Vec<Real>> {
+            let root = self.world.process_at_rank(0);
+            let count = mine.len() as Count;
+            if self.rank != 0 {
+                root.gather_into(&count);
+                root.gather_varcount_into(&mine[..]);
+                return Vec::new();
+            }
+            let mut counts = vec![0 as Count; self.size];
+            root.gather_into_root(&count, &mut counts[..]);
+            let displs = Self::displacements(&counts);
+            let total: Count = counts.iter().sum();
+            let mut all = vec![0.0 as Real; total as usize];
+            {
+                let mut r = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
+                root.gather_varcount_into_root(&mine[..], &mut r);
+            }
+            counts
+                .iter()
+                .zip(&displs)
+                .map(|(&c, &d)| all[d as usize..(d + c) as usize].to_vec())
+                .collect()
         }
 
         pub(super) fn all_gather(&self, mine: Vec<Real>) -> Vec<Vec<Real>> {

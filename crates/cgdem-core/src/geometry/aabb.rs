@@ -62,3 +62,10 @@ impl Aabb {
         (p - self.min).abs().max((p - self.max).abs()).length()
     }
 }
+
+/// Whether `p` lies in one of the delete regions (bounds included).
+pub(crate) fn in_delete_region(regions: &[Aabb], p: Vec3) -> bool {
+    regions
+        .iter()
+        .any(|r| p.cmpge(r.min).all() && p.cmple(r.max).all())
+}

@@ -1,6 +1,5 @@
 //! Files a run writes: VTK for ParaView, CSV tables, the JSON summary.
 
-pub mod lammps_data;
 pub mod vtk;
 
 use std::io::Write;

@@ -43,12 +43,6 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         std::any::type_name::<L>(),
         std::any::type_name::<W>()
     );
-    if options.grid.is_some() && (options.checkpoint.is_some() || resume.is_some()) {
-        return Err(RunError::NotAvailable(format!(
-            "{}: restart files (--checkpoint-every, --resume) are not supported with --grid yet: the subdomains' state is not gathered into them; run without --grid",
-            scene.source.display()
-        )));
-    }
     if let Some(r) = resume {
         check_resumable(scene, &r.restart, &r.path, &laws)?;
     }
@@ -60,7 +54,10 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     }
     let (mut world, mut n_inserted, mut n_body_particles) =
         build_world(scene, law, wall_law, dt, &scales, options)?;
-    let mut observers = observers(scene, out, resume.is_some())?;
+    // Under MPI only rank 0 writes into the run's directory: the others' outputs (in a
+    // scratch directory) start afresh.
+    let root = options.comm.is_root();
+    let mut observers = observers(scene, out, resume.is_some() && root)?;
     let checkpoint = match (&options.checkpoint, resume) {
         (Some(c), _) => Some(c.clone()),
         (None, Some(r)) => Some(CheckpointOptions {
@@ -108,6 +105,7 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             let (at, counts) =
                 driver.resume_from(&mut world, &mut observers, &mut warnings, loaded)?;
             (n_inserted, n_body_particles) = counts;
+            resume_grid(&mut world, scene, options, &loaded.path)?;
             at
         }
         None => {
@@ -126,8 +124,8 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     let started = Instant::now();
     let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings, resume_at)?;
     driver.progress.finish();
-    // Under MPI every rank gathers the final state (rank 0 writes it).
-    world.sync_particles();
+    // Under MPI rank 0 gathers the final state and writes it.
+    world.sync_particles_for_output();
     let wall_s = started.elapsed().as_secs_f64();
     for (kind, count) in driver.guard_counts.iter().filter(|(_, count)| *count > 1) {
         warnings.push(format!(
@@ -175,6 +173,39 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             out_dir: out.clone(),
         }),
         None => Ok(summary),
+    }
+}
+
+/// A resumed world back on its subdomains (`--grid`: the same grid steps on bit for bit,
+/// another deals the particles out again); an error when the restart file and the options
+/// disagree on whether the run is decomposed.
+fn resume_grid<L: PairLaw, W: WallLaw>(
+    world: &mut World<L, W>,
+    scene: &Scene,
+    options: &RunOptions,
+    path: &Path,
+) -> Result<(), RunError> {
+    match (options.grid, world.restored_grid()) {
+        (None, None) => Ok(()),
+        (None, Some([x, y, z])) => Err(RunError::Restart(format!(
+            "{}: written by a run with --grid {x}x{y}x{z}: resume it with --grid (the same grid continues bit for bit, another one from the stored particles)",
+            path.display()
+        ))),
+        (Some(spec), None) => Err(RunError::Restart(format!(
+            "{}: written by a run without --grid: resume it without --grid (not --grid {spec})",
+            path.display()
+        ))),
+        (Some(spec), Some(_)) => {
+            world.set_grid(spec, options.comm.clone()).map_err(|e| {
+                RunError::Restart(format!(
+                    "{}: --grid {spec}: {e} (restart file {})",
+                    scene.source.display(),
+                    path.display()
+                ))
+            })?;
+            world.set_balance(options.balance);
+            Ok(())
+        }
     }
 }
 
@@ -295,7 +326,8 @@ fn build_world<L: PairLaw, W: WallLaw>(
             .map(|&(min, max)| Aabb { min, max })
             .collect(),
     );
-    if let Some(spec) = options.grid {
+    // A resumed run takes its subdomains from the restart file (`resume_grid`).
+    if let Some(spec) = options.grid.filter(|_| options.resume.is_none()) {
         world.set_grid(spec, options.comm.clone()).map_err(|e| {
             RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
         })?;
@@ -568,7 +600,8 @@ impl Driver<'_> {
                     stage.name
                 ));
             }
-            world.sync_particles();
+            // The stage-end measurements go into rank 0's outputs only.
+            world.sync_particles_for_output();
             for o in observers.iter_mut() {
                 o.observer().stage_ends(world, &clock, warnings)?;
             }
@@ -635,9 +668,14 @@ impl Driver<'_> {
             if k % 256 == 0 {
                 self.progress.advance(256);
             }
-            // Under MPI the observers read the particles gathered at the steps they are due.
-            if observers.iter().any(|o| o.is_due(world, clock)) {
-                world.sync_particles();
+            // While decomposed the observers read the particles gathered at the steps where
+            // one that is due reads them; under MPI to rank 0 only, which writes, unless
+            // what one reads decides the run's course on every rank.
+            let reading = observers.iter().filter(|o| o.reads_particles(world, clock));
+            match reading.map(|o| o.decides()).reduce(|a, b| a || b) {
+                Some(true) => world.sync_particles(),
+                Some(false) => world.sync_particles_for_output(),
+                None => {}
             }
             for o in observers.iter_mut() {
                 if let Flow::EndStage(reason) = o.after_step(world, clock)? {
@@ -699,11 +737,8 @@ impl Driver<'_> {
             return Ok(());
         };
         let path = c.out.join(restart::RESTART_FILE);
-        let Some(state) = world.state() else {
-            return Err(RunError::NotAvailable(
-                "restart files are not supported with --grid".into(),
-            ));
-        };
+        // Collective under MPI: every rank gathers, rank 0 writes.
+        let state = world.state();
         let observers = observers
             .iter_mut()
             .map(|o| o.observer().save())
@@ -728,7 +763,9 @@ impl Driver<'_> {
             },
             observers,
         };
-        restart::write(&c.out, &file).map_err(|e| output_error(&path, e))?;
+        if world.comm().is_root() {
+            restart::write(&c.out, &file).map_err(|e| output_error(&path, e))?;
+        }
         Ok(())
     }
 

@@ -13,6 +13,7 @@ mod progress;
 mod refill;
 pub mod restart;
 mod setup;
+pub mod state_file;
 
 pub use hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
 pub use laws::{seed_laws, with_laws, LawVisitor};
@@ -290,41 +291,10 @@ pub struct RunSummary {
     #[serde(skip)]
     pub final_state: Option<Particles>,
     /// The solver's arrays at the end (none for reference codes).
-    pub memory: Option<crate::simulation::MemoryUse>,
+    pub memory: Option<crate::memory_use::MemoryUse>,
     /// The subdomains of a `--grid` run (absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub decomposition: Option<DecompositionSummary>,
-}
-
-/// What `summary.json` says of a decomposed run (`--grid`, issue 23).
-#[derive(Clone, Debug, Serialize, serde::Deserialize)]
-pub struct DecompositionSummary {
-    /// Subdomains along x, y, z.
-    pub grid: [usize; 3],
-    /// MPI ranks (1: threads in one process).
-    pub ranks: usize,
-    /// Owned particles per subdomain at the end.
-    pub subdomain_particles: Vec<usize>,
-    /// Most particles in one subdomain over the mean, at the end (1 is perfect balance).
-    pub imbalance: Real,
-    /// `--balance`: the imbalance past which the cut planes moved at a rebuild (none: off).
-    #[serde(default)]
-    pub balance_threshold: Option<Real>,
-    /// Rebuilds at which the cut planes moved.
-    #[serde(default)]
-    pub shifts: u64,
-    /// The largest imbalance the subdomains had after a rebuild, from the first shift on.
-    #[serde(default)]
-    pub imbalance_max_after_first_shift: Option<Real>,
-    /// The imbalance the start's cut planes (by count, never moved) would give at the end.
-    #[serde(default)]
-    pub static_imbalance: Real,
-    /// The largest imbalance the start's cut planes gave or would have given at a rebuild.
-    #[serde(default)]
-    pub static_imbalance_max: Real,
-    /// Bytes the ranks sent each other per step, averaged over the run (exchange, borders,
-    /// forward; 0 in one process, where the threads read the buffers in place).
-    pub bytes_sent_between_ranks_per_step: Real,
+    pub decomposition: Option<crate::decomposition::DecompositionSummary>,
 }
 
 /// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.

@@ -23,8 +23,9 @@ use super::StageRecord;
 pub const RESTART_FILE: &str = "restart.cgr";
 pub const PREVIOUS_RESTART_FILE: &str = "restart.prev.cgr";
 const MAGIC: &[u8; 8] = b"CGDEMRST";
-/// Bumped whenever the payload's layout changes; an older file is refused by name.
-pub const FORMAT_VERSION: u32 = 1;
+/// Bumped whenever the payload's layout changes; an older file is refused by name (2: the
+/// world state holds the subdomains of a `--grid` run).
+pub const FORMAT_VERSION: u32 = 2;
 const HEADER_LEN: usize = 32;
 
 /// Where in the stage list a checkpoint was taken.
@@ -97,33 +98,52 @@ pub(crate) fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, String> {
 
 /// The file bytes of a restart: header and payload.
 pub fn to_bytes(restart: &Restart) -> Vec<u8> {
-    let payload = encode(restart);
-    let mut bytes = Vec::with_capacity(HEADER_LEN + payload.len());
-    bytes.extend_from_slice(MAGIC);
-    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-    bytes.extend_from_slice(&[0; 8]);
-    bytes.extend_from_slice(&payload);
-    bytes
+    frame(MAGIC, FORMAT_VERSION, &encode(restart))
 }
 
 /// Checks the header and checksum and decodes the payload; the error says what is wrong.
 pub fn from_bytes(bytes: &[u8]) -> Result<Restart, String> {
+    let payload = unframe(MAGIC, FORMAT_VERSION, bytes)?;
+    decode(payload).map_err(|e| format!("payload does not decode: {e}"))
+}
+
+/// `magic`, format `version`, payload length and CRC-32, 8 reserved zero bytes, then the
+/// payload: the layout of restart files and of the bench's state files.
+pub(crate) fn frame(magic: &[u8; 8], version: u32, payload: &[u8]) -> Vec<u8> {
+    let mut bytes = Vec::with_capacity(HEADER_LEN + payload.len());
+    bytes.extend_from_slice(magic);
+    bytes.extend_from_slice(&version.to_le_bytes());
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&crc32fast::hash(payload).to_le_bytes());
+    bytes.extend_from_slice(&[0; 8]);
+    bytes.extend_from_slice(payload);
+    bytes
+}
+
+/// The payload of `frame`'s bytes, after checking the magic, version, length and checksum.
+pub(crate) fn unframe<'b>(
+    magic: &[u8; 8],
+    version: u32,
+    bytes: &'b [u8],
+) -> Result<&'b [u8], String> {
     if bytes.len() < HEADER_LEN {
         return Err(format!(
             "{} bytes, shorter than the {HEADER_LEN}-byte header (torn write)",
             bytes.len()
         ));
     }
-    if &bytes[..8] != MAGIC {
-        return Err("not a cgdem restart file (no CGDEMRST magic)".into());
+    if &bytes[..8] != magic {
+        return Err(format!(
+            "not a cgdem {} file (no {} magic)",
+            if magic == MAGIC { "restart" } else { "state" },
+            String::from_utf8_lossy(magic)
+        ));
     }
     let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
-    let version = word(8);
-    if version != FORMAT_VERSION {
+    let found = word(8);
+    if found != version {
         return Err(format!(
-            "format version {version}, this cgdem reads version {FORMAT_VERSION}"
+            "format version {found}, this cgdem reads version {version}"
         ));
     }
     if bytes[24..HEADER_LEN] != [0; 8] {
@@ -144,7 +164,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<Restart, String> {
             "checksum mismatch (CRC-32 {actual:08x}, the header says {stored:08x}): the file is corrupt"
         ));
     }
-    decode(payload).map_err(|e| format!("payload does not decode: {e}"))
+    Ok(payload)
 }
 
 /// Writes `restart` into `dir` atomically, keeping the previous file as

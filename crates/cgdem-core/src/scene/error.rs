@@ -22,6 +22,6 @@ pub enum SceneError {
     #[error("{}: read_data: {source}", .scene.display())]
     DataFile {
         scene: PathBuf,
-        source: Box<crate::io::lammps_data::DataFileError>,
+        source: Box<crate::lammps_data::DataFileError>,
     },
 }

@@ -6,7 +6,6 @@ mod overrides;
 mod raw;
 mod validate;
 
-pub use crate::analysis::conveying::ConveyingSettings;
 pub use cg_rule::CoarseGrainRule;
 pub use error::SceneError;
 pub use overrides::Override;
@@ -278,12 +277,66 @@ pub struct BodySettings {
     pub start_stage: Option<String>,
 }
 
+/// Rule choosing the measurement region of a poured bed (lateral periodic, floor below, top
+/// open), in units of the mean particle diameter `d`.
+///
+/// Bottom: `floor_z + floor_margin * d`. Near a flat wall spheres order in layers (the local
+/// porosity oscillates with period about `d`, largest in the first layer, and has decayed to a
+/// few percent of its amplitude after about two diameters), so the first two layers are left out.
+///
+/// Top: `bed_height - top_margin * d`, where `bed_height` is the `top_quantile` quantile
+/// (nearest rank) of the particle-centre heights. A quantile instead of the maximum keeps a few
+/// particles perched on (or still bouncing above) the surface from setting the height; the
+/// 0.99 quantile of a 10 d x 10 d bed sits in its topmost layer. The free surface is rough over
+/// one to two diameters and looser below it, hence the two-diameter margin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BedRegionRule {
+    pub floor_margin: Real,
+    pub top_quantile: Real,
+    pub top_margin: Real,
+}
+
+impl Default for BedRegionRule {
+    fn default() -> Self {
+        Self {
+            floor_margin: 2.0,
+            top_quantile: 0.99,
+            top_margin: 2.0,
+        }
+    }
+}
+
+/// Screw-conveyor measurements (paper A Eq. 7) during one stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConveyingSettings {
+    pub stage: String,
+    /// The screw body (its rpm gives n_s).
+    pub body: String,
+    /// Start-up time discarded at the beginning of the stage, s.
+    pub discard: Real,
+    /// Blocks for the standard error of the mass flow.
+    pub blocks: u32,
+    pub outer_diameter: Real,
+    pub shaft_diameter: Real,
+    pub pitch: Real,
+    /// Casing bore radius: particles with centres inside it count for the fill ratio.
+    pub bore_radius: Real,
+    /// Axial range (along x, the screw axis) where the fill ratio is measured.
+    pub fill_x: [Real; 2],
+    /// Axial position of the plane the mass flow is measured through (inside the screw
+    /// section, downstream of the inlet); `None`: at the outlet, from the deleted mass alone.
+    pub flow_x: Option<Real>,
+    /// Box where the bulk density is measured (centres inside count).
+    pub bulk_lo: Vec3,
+    pub bulk_hi: Vec3,
+}
+
 /// Porosity and pore sizes of a poured bed (paper B sec. 3), measured when `stage` ends.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PackingSettings {
     pub stage: String,
-    /// The measurement region, in diameters (see `analysis::porosity::BedRegionRule`).
-    pub rule: crate::analysis::BedRegionRule,
+    /// The measurement region, in diameters (see [`BedRegionRule`]).
+    pub rule: BedRegionRule,
     /// Pore-size voxels per particle diameter (the lateral period must hold a whole number).
     pub voxels_per_diameter: u32,
     /// Width of the pore-size histogram bins, in diameters.

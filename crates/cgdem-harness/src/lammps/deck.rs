@@ -211,7 +211,7 @@ pub fn data_file(
         scene.name,
         scene.lambda
     );
-    cgdem_core::io::lammps_data::data_text(
+    cgdem_core::lammps_data::data_text(
         &title,
         scene.domain.lo,
         scene.domain.hi,

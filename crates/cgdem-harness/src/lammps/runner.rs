@@ -124,6 +124,23 @@ pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
     }
 }
 
+/// `mpirun` for `np` ranks as the harness starts every MPI run (root allowed, as in the
+/// containers this runs in; `--oversubscribe` when there are more ranks than `cores`, which
+/// OpenMPI otherwise refuses).
+pub fn mpirun_argv(np: u32, cores: usize) -> Vec<String> {
+    let mut argv = vec!["mpirun".to_string(), "--allow-run-as-root".to_string()];
+    if np as usize > cores {
+        argv.push("--oversubscribe".into());
+    }
+    argv.extend(["-np".to_string(), np.to_string()]);
+    argv
+}
+
+/// Cores this machine offers (1 if unknown).
+pub fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// Runs `program -in deck_file -log log_file` in `dir` (LAMMPS and LIGGGHTS take the same
 /// arguments) and waits, killing it at the time limit.
 pub fn run_program(
@@ -135,12 +152,7 @@ pub fn run_program(
 ) -> RunStatus {
     let mut argv: Vec<String> = Vec::new();
     if let Some(np) = options.np {
-        argv.extend([
-            "mpirun".into(),
-            "--allow-run-as-root".into(),
-            "-np".into(),
-            np.to_string(),
-        ]);
+        argv.extend(mpirun_argv(np, cores()));
     }
     argv.extend([
         program.display().to_string(),
@@ -149,6 +161,18 @@ pub fn run_program(
         "-log".into(),
         log_file.into(),
     ]);
+    run_command(&argv, dir, log_file, options)
+}
+
+/// Runs `argv` in `dir` (which keeps `command.txt` and `stdout.txt`) and waits, ending its
+/// whole process tree at the time limit or when the stop flag is raised; a failure's tail
+/// is `log_file`'s (or stdout's). `options.np` is not read: `argv` holds any `mpirun`.
+pub fn run_command(
+    argv: &[String],
+    dir: &Path,
+    log_file: &str,
+    options: &RunnerOptions,
+) -> RunStatus {
     let failed = |message: String| RunStatus::Failed {
         exit_code: None,
         log_tail: message,
@@ -225,7 +249,7 @@ pub fn run_program(
                 ));
             }
             Ok(None) => std::thread::sleep(Duration::from_millis(50)),
-            Err(e) => return failed(format!("waiting for {}: {e}", program.display())),
+            Err(e) => return failed(format!("waiting for {}: {e}", argv[0])),
         }
     }
 }

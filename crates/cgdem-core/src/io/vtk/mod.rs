@@ -19,7 +19,7 @@
 //! particles' ids), `normal_force` (N, positive pushes apart) and `overlap` (m), per line.
 //!
 //! With `[output] write_data = true` each frame's particles are also written as a LAMMPS data
-//! file (`particles_NNNNNN.data`, see `io::lammps_data`), from which a scene can start.
+//! file (`particles_NNNNNN.data`, see `lammps_data`), from which a scene can start.
 
 mod appended;
 mod series;
@@ -190,7 +190,7 @@ impl VtkOutput {
                 env!("CARGO_PKG_VERSION"),
                 d.scene
             );
-            let text = crate::io::lammps_data::data_text(
+            let text = crate::lammps_data::data_text(
                 &title,
                 d.lo,
                 d.hi,

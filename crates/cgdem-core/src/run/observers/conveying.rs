@@ -87,6 +87,12 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ConveyingMeter<'_> {
         Due::EveryStep
     }
 
+    /// Every step it reads only the body's load (summed over the subdomains already); the
+    /// particles only for a sample.
+    fn reads_particles(&self, world: &World<L, W>, clock: &StageClock) -> bool {
+        self.measuring && world.time + 0.5 * clock.dt >= self.next_row
+    }
+
     fn observe(&mut self, world: &World<L, W>, clock: &StageClock) -> Result<Flow, RunError> {
         let body = &world.bodies()[self.body];
         if self.measuring && world.time - clock.start >= self.settings.discard - 0.5 * clock.dt {

@@ -84,6 +84,16 @@ pub(crate) trait Observer<L: PairLaw, W: WallLaw> {
     /// When this observer wants to be called next (asked after each call).
     fn due(&self) -> Due;
     fn observe(&mut self, world: &World<L, W>, clock: &StageClock) -> Result<Flow, RunError>;
+    /// Whether `observe` reads the particles at this due step (while decomposed they are
+    /// gathered, under MPI from every rank, only at the steps where one does); most do.
+    fn reads_particles(&self, _world: &World<L, W>, _clock: &StageClock) -> bool {
+        true
+    }
+    /// Whether what `observe` reads decides the run's course (ends the stage), so that under
+    /// MPI every rank must read the same particles; otherwise only rank 0's outputs use them.
+    fn decides(&self) -> bool {
+        false
+    }
     /// The stage ended by its own condition (not by a guard).
     fn stage_ends(
         &mut self,
@@ -138,6 +148,15 @@ impl<'s, L: PairLaw, W: WallLaw> Scheduled<'s, L, W> {
     /// Whether the observer is due after the step that ended at `world.time`.
     pub(crate) fn is_due(&self, world: &World<L, W>, clock: &StageClock) -> bool {
         self.due.is_due(world.time, clock.start, clock.dt)
+    }
+
+    /// Whether the observer is due and reads the particles after this step.
+    pub(crate) fn reads_particles(&self, world: &World<L, W>, clock: &StageClock) -> bool {
+        self.is_due(world, clock) && self.observer.reads_particles(world, clock)
+    }
+
+    pub(crate) fn decides(&self) -> bool {
+        self.observer.decides()
     }
 
     /// Runs the observer if it is due after the step that ended at `world.time`.

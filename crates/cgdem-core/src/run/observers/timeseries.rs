@@ -27,6 +27,8 @@ pub(crate) struct TimeSeries<'s> {
     conveying: Option<(&'s ConveyingSettings, usize)>,
     /// The stage's settling condition: (kinetic energy per mass, minimum duration).
     settle: Option<(Real, Real)>,
+    /// The file is the resumed run's (not a fresh one, as an MPI rank's scratch copy).
+    resumed: bool,
 }
 
 impl<'s> TimeSeries<'s> {
@@ -49,6 +51,7 @@ impl<'s> TimeSeries<'s> {
                 next_row: 0.0,
                 conveying,
                 settle: None,
+                resumed: true,
             });
         }
         let file = File::create(&path).map_err(|e| output_error(&path, e))?;
@@ -59,6 +62,7 @@ impl<'s> TimeSeries<'s> {
             next_row: 0.0,
             conveying,
             settle: None,
+            resumed: false,
         };
         let mut header: Vec<String> = TIMESERIES_COLUMNS.map(String::from).into();
         header.push("deleted_mass_kg".into());
@@ -94,6 +98,11 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
 
     fn due(&self) -> Due {
         Due::At(self.next_row)
+    }
+
+    /// A settling stage ends on the kinetic energy of the particles it reads.
+    fn decides(&self) -> bool {
+        self.settle.is_some()
     }
 
     fn observe(&mut self, world: &World<L, W>, clock: &StageClock) -> Result<Flow, RunError> {
@@ -159,6 +168,10 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
     fn restore(&mut self, state: &[u8]) -> Result<(), String> {
         let len: u64;
         (self.next_row, len) = decode(state)?;
+        if !self.resumed {
+            // A fresh file (an MPI rank's scratch copy): the rows from here on follow it.
+            return Ok(());
+        }
         // `&File` seeks and truncates; the writer's buffer is empty (flushed every row).
         let mut file: &File = self.file.get_ref();
         let actual = file

@@ -32,7 +32,7 @@ pub(super) fn packing(
             "exactly one species with [packing] (monodisperse beds)",
         ));
     }
-    let default = crate::analysis::BedRegionRule::default();
+    let default = crate::scene::BedRegionRule::default();
     let margin = |field: &str, v: Option<f64>, default: f64| -> Result<f64, SceneError> {
         let v = v.unwrap_or(default);
         if v.is_finite() && (0.0..=50.0).contains(&v) {
@@ -84,7 +84,7 @@ pub(super) fn packing(
     }
     Ok(PackingSettings {
         stage: pk.stage.clone(),
-        rule: crate::analysis::BedRegionRule {
+        rule: crate::scene::BedRegionRule {
             floor_margin: margin(
                 "packing.floor_margin",
                 pk.floor_margin,

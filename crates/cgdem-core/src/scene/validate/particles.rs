@@ -8,7 +8,7 @@ use std::path::Path;
 use super::super::raw::*;
 use super::super::*;
 use super::{names, Checker};
-use crate::io::lammps_data::{parse_data, DataFileError};
+use crate::lammps_data::{parse_data, DataFileError};
 
 /// Relative tolerance of a given diameter or density against its species'.
 const MATCH: Real = 1e-6;

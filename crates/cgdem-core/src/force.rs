@@ -1,0 +1,252 @@
+//! The force kernels the world and its subdomains share: the particle arrays a force pass
+//! borrows, one listed pair seen from its owner, and a body acting on one particle. Generic
+//! over the laws and inlined into each pass, so both compile to the same loop body.
+
+use crate::bodies::{Body, BodyLoad};
+use crate::contact::{Contact, PairLaw, PairResult};
+use crate::guard::overlap_fraction;
+use crate::math::{Real, Vec3};
+use crate::neighbor::Pair;
+use crate::particles::Particles;
+use crate::walls::{WallContact, WallLaw, WallParticle};
+
+/// The particle arrays the owner pass reads.
+#[derive(Clone, Copy)]
+pub(crate) struct ParticleState<'a> {
+    pub(crate) position: &'a [Vec3],
+    pub(crate) velocity: &'a [Vec3],
+    pub(crate) omega: Option<&'a [Vec3]>,
+    pub(crate) radius: &'a [Real],
+    pub(crate) mass: &'a [Real],
+    pub(crate) inv_mass: &'a [Real],
+    pub(crate) species: &'a [u16],
+}
+
+/// What a force pass borrows from the particles at once: the state it reads, the force and
+/// torque arrays it writes (torque empty without rotation), and the ids.
+pub(crate) struct ForceView<'a> {
+    pub(crate) id: &'a [u32],
+    pub(crate) state: ParticleState<'a>,
+    pub(crate) force: &'a mut [Vec3],
+    pub(crate) torque: &'a mut [Vec3],
+}
+
+impl<'a> ParticleState<'a> {
+    /// The state of `p`, read only.
+    pub(crate) fn of(p: &'a Particles) -> Self {
+        ParticleState {
+            position: &p.position,
+            velocity: &p.velocity,
+            omega: p.angular.as_ref().map(|a| a.omega.as_slice()),
+            radius: &p.radius,
+            mass: &p.mass,
+            inv_mass: &p.inv_mass,
+            species: &p.species,
+        }
+    }
+
+    /// `p` split into the state a force pass reads and the arrays it writes.
+    pub(crate) fn split(p: &'a mut Particles) -> ForceView<'a> {
+        let Particles {
+            id,
+            position,
+            velocity,
+            force,
+            radius,
+            mass,
+            inv_mass,
+            species,
+            angular,
+        } = p;
+        let (omega, torque) = match angular.as_mut() {
+            Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
+            None => (None, &mut [][..]),
+        };
+        ForceView {
+            id,
+            state: ParticleState {
+                position,
+                velocity,
+                omega,
+                radius,
+                mass,
+                inv_mass,
+                species,
+            },
+            force,
+            torque,
+        }
+    }
+}
+
+/// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
+#[derive(Clone, Copy)]
+pub(crate) struct Owner {
+    pub(crate) index: usize,
+    pub(crate) position: Vec3,
+    pub(crate) velocity: Vec3,
+    pub(crate) omega: Vec3,
+    pub(crate) radius: Real,
+    pub(crate) inv_mass: Real,
+    /// `species_i * n_species`: the row of the species-pair tables.
+    pub(crate) species_row: usize,
+}
+
+/// The force of one listed pair `(i, j)` seen from its owner `i`; zero (and history reset)
+/// when out of range. Also returns the overlap and the smaller radius, for the guard.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn pair_force<L: PairLaw>(
+    law: &L,
+    p: &ParticleState,
+    images: &[Vec3; 27],
+    owner: &Owner,
+    pair: Pair,
+    history: &mut L::History,
+    dt: Real,
+) -> (PairResult, Real, Real) {
+    let j = pair.j as usize;
+    let d = owner.position - (p.position[j] + images[pair.image as usize]);
+    let distance_sq = d.length_squared();
+    let (radius_i, radius_j) = (owner.radius, p.radius[j]);
+    let species_pair = owner.species_row + p.species[j] as usize;
+    let cutoff = law.cutoff(species_pair, radius_i, radius_j);
+    if distance_sq >= cutoff * cutoff {
+        *history = L::History::default();
+        return (PairResult::default(), 0.0, 1.0);
+    }
+    let distance = distance_sq.sqrt();
+    // One division, as LIGGGHTS's `rinv`.
+    let normal = d * (1.0 / distance);
+    let overlap = radius_i + radius_j - distance;
+    let mut relative_velocity = owner.velocity - p.velocity[j];
+    let mut spins = (Vec3::ZERO, Vec3::ZERO);
+    if L::NEEDS_ROTATION {
+        if let Some(omega) = p.omega {
+            spins = (owner.omega, omega[j]);
+            // Contact point on the line of centres, inside each sphere by half the overlap.
+            let arm_i = -normal * (radius_i - 0.5 * overlap);
+            let arm_j = normal * (radius_j - 0.5 * overlap);
+            relative_velocity += spins.0.cross(arm_i) - spins.1.cross(arm_j);
+        }
+    }
+    let normal_speed = relative_velocity.dot(normal);
+    let (inv_mass_i, inv_mass_j) = (owner.inv_mass, p.inv_mass[j]);
+    let contact = Contact {
+        species_pair,
+        normal,
+        distance,
+        overlap,
+        radius_i,
+        radius_j,
+        r_eff: radius_i * radius_j / (radius_i + radius_j),
+        inv_mass_i,
+        inv_mass_j,
+        // A frozen particle (inverse mass 0) acts with infinite mass, as in LIGGGHTS and
+        // LAMMPS with `fix freeze`; two frozen particles are never listed.
+        m_eff: 1.0 / (inv_mass_i + inv_mass_j),
+        relative_velocity,
+        normal_speed,
+        tangential_velocity: relative_velocity - normal_speed * normal,
+    };
+    (
+        law.evaluate(&contact, history, spins, dt),
+        overlap,
+        radius_i.min(radius_j),
+    )
+}
+
+/// Force of one body on one particle (the wall law with the SDF distance and normal and the
+/// velocity relative to the body's surface), the particle's load on the body and its overlap
+/// with the body as a fraction of the radius.
+#[inline(always)]
+pub(crate) fn body_force<W: WallLaw>(
+    body: &Body,
+    law: &W,
+    particle: &WallParticle,
+    dt: Real,
+) -> (Vec3, BodyLoad, Real) {
+    let reach = law.reach(particle.species, particle.radius);
+    let Some((distance, normal)) = body.query(particle.position, reach) else {
+        return (Vec3::ZERO, BodyLoad::default(), 0.0);
+    };
+    let overlap = overlap_fraction(distance, particle.radius);
+    // A centre inside the body has passed through it: no force (as for planar walls).
+    if distance <= 0.0 || distance >= reach {
+        return (Vec3::ZERO, BodyLoad::default(), overlap);
+    }
+    let contact_point = particle.position - distance * normal;
+    let contact = WallContact {
+        species: particle.species,
+        normal,
+        distance,
+        relative_velocity: particle.velocity - body.surface_velocity(contact_point),
+        radius: particle.radius,
+        mass: particle.mass,
+    };
+    let force = law.force(&contact, dt);
+    let load = BodyLoad {
+        force: -force,
+        torque: (contact_point - body.center()).cross(-force),
+    };
+    (force, load, overlap)
+}
+
+/// `body_force` for spinning particles: the wall law's force and torque with the contact's
+/// history (tangential and rolling springs kept per particle per body, as for planar walls,
+/// and reset when they part). The body's own motion enters through the surface velocity at
+/// the contact point.
+pub(crate) fn body_force_and_torque<W: WallLaw>(
+    body: &Body,
+    law: &W,
+    particle: &WallParticle,
+    omega: Vec3,
+    history: &mut W::History,
+    dt: Real,
+) -> (Vec3, Vec3, BodyLoad, Real) {
+    let reach = law.reach(particle.species, particle.radius);
+    let reset = |history: &mut W::History| {
+        if *history != W::History::default() {
+            *history = W::History::default();
+        }
+    };
+    let Some((distance, normal)) = body.query(particle.position, reach) else {
+        reset(history);
+        return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), 0.0);
+    };
+    let overlap = overlap_fraction(distance, particle.radius);
+    if distance <= 0.0 || distance >= reach {
+        reset(history);
+        return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), overlap);
+    }
+    let contact_point = particle.position - distance * normal;
+    let contact = WallContact {
+        species: particle.species,
+        normal,
+        distance,
+        relative_velocity: particle.velocity - body.surface_velocity(contact_point),
+        radius: particle.radius,
+        mass: particle.mass,
+    };
+    let (force, torque) = if W::NEEDS_ROTATION {
+        law.force_and_torque_with_history(&contact, omega, history, dt)
+    } else {
+        (law.force(&contact, dt), Vec3::ZERO)
+    };
+    let load = BodyLoad {
+        force: -force,
+        torque: (contact_point - body.center()).cross(-force),
+    };
+    (force, torque, load, overlap)
+}
+
+/// The larger of two overlap fractions (a plain comparison: cheaper than `f64::max`'s NaN
+/// handling, and a NaN state is the non-finite guard's business).
+#[inline(always)]
+pub(crate) fn larger(a: Real, b: Real) -> Real {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
