@@ -228,6 +228,8 @@ fn grid_runs_resume_bit_for_bit_on_their_grid_and_go_on_on_another() {
             "stage[0].min_duration=0.01",
             "--set",
             "stage[1].duration=0.01",
+            "--set",
+            "repose.at_times=[0.005]",
             "--checkpoint-every",
             "0.1",
             "--out",
