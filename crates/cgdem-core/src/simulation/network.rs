@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use super::{pair_force, Owner, ParticleState, World};
 use crate::contact::PairLaw;
 use crate::math::{Real, Vec3};
+use crate::neighbor::VerletList;
 use crate::walls::WallLaw;
 
 /// One pair the law acts on now (centre distance below its cut-off).
@@ -41,12 +42,26 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     /// step, the elastic part of each normal force is the one the step applied; the damping
     /// part sees the velocities after the step's closing kick, where the step saw them half a
     /// step earlier (a difference of order `dt` / contact time).
+    ///
+    /// While decomposed the world keeps no list of its own (the subdomains do): a list of
+    /// the gathered particles is built for the output, its pairs evaluated without their
+    /// tangential history, which the reported normal force does not depend on (the
+    /// tangential force is perpendicular to the normal).
     pub fn contact_network(&self) -> ContactNetwork {
-        let p = &self.particles;
+        let gathered = self.decomposition.is_some().then(|| {
+            // The build wraps periodic positions: the pairs' images are those of the copy.
+            let mut wrapped = self.particles.clone();
+            let mut fresh = VerletList::new(self.neighbor.skin);
+            fresh.build(&mut wrapped, &self.domain, self.law.reach(), false);
+            (wrapped, fresh)
+        });
+        let (p, list, history): (_, _, &[L::History]) = match &gathered {
+            Some((wrapped, fresh)) => (wrapped, fresh, &[]),
+            None => (&self.particles, &self.list, &self.history),
+        };
         let state = ParticleState::of(p);
         let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
-        let pairs: Vec<PairContact> = self
-            .list
+        let pairs: Vec<PairContact> = list
             .pairs
             .par_iter()
             .enumerate()
@@ -62,7 +77,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     inv_mass: p.inv_mass[i],
                     species_row: p.species[i] as usize * self.n_species,
                 };
-                let mut history = self.history.get(k).copied().unwrap_or_default();
+                let mut history = history.get(k).copied().unwrap_or_default();
                 let (result, overlap, _) = pair_force(
                     &self.law,
                     &state,
@@ -208,6 +223,35 @@ pub(crate) mod tests {
         let before = (p.force.clone(), w.history().to_vec());
         let _ = w.contact_network();
         assert_eq!((w.particles.force.clone(), w.history().to_vec()), before);
+    }
+
+    #[test]
+    fn a_decomposed_world_reports_the_contacts_of_its_gathered_particles() {
+        // The world's own list is empty while decomposed: the network must still hold the
+        // contacts, with the same normal forces (they do not depend on tangential history).
+        let x = [
+            Vec3::new(-1.9 * R, 0.0, 0.0),
+            Vec3::ZERO,
+            Vec3::new(1.95 * R, 0.2 * R, 0.0),
+        ];
+        let v = [Vec3::new(0.1, 0.02, 0.0), Vec3::ZERO, Vec3::ZERO];
+        let whole = hertz_world(&x, &v, 0.01, false, 1.0);
+        let mut split = hertz_world(&x, &v, 0.01, false, 1.0);
+        split
+            .set_grid(
+                crate::decomposition::GridSpec::Given([2, 1, 1]),
+                crate::decomposition::Comm::local(),
+            )
+            .expect("a 2x1x1 grid fits");
+        let (a, b) = (whole.contact_network(), split.contact_network());
+        assert_eq!(b.coordination, [1, 2, 1]);
+        assert_eq!(a.coordination, b.coordination);
+        let force = |n: &ContactNetwork| {
+            let mut f: Vec<Real> = n.pairs.iter().map(|c| c.normal_force).collect();
+            f.sort_by(Real::total_cmp);
+            f
+        };
+        assert_eq!(force(&a), force(&b));
     }
 
     #[test]
