@@ -622,7 +622,20 @@ fn geometry(command: GeometryCommand) -> ExitCode {
     }
 }
 
+/// Rust starts programs with SIGPIPE ignored, so a closed pipe (`cgdem advise ... | head -1`)
+/// makes every later `println!` panic with "Broken pipe". With the default action the process
+/// ends quietly when its reader has gone, as `grep` or `lmp` do; files are written through
+/// their own handles, which a closed stdout does not touch.
+fn restore_default_sigpipe() {
+    // SAFETY: called first in `main`, before any thread starts; `signal` with `SIG_DFL` only
+    // resets the disposition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    restore_default_sigpipe();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate {

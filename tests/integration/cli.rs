@@ -356,3 +356,32 @@ fn strict_names_the_rule_and_the_parameter_it_cannot_keep() {
     );
     assert!(!stderr.contains("panicked"));
 }
+
+/// `cgdem ... | head -1`: when the reader of stdout has gone, the command ends without a
+/// panic's "Broken pipe" message (SIGPIPE at its default, as C tools). The pipe's read end is
+/// closed before the command starts, so its first line of output meets a closed pipe.
+#[test]
+fn a_closed_stdout_ends_the_command_quietly_not_with_a_panic() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = cgdem()
+        .args([
+            "advise",
+            "packing_vdw",
+            "--quantity",
+            "porosity",
+            "--target",
+            "0.02",
+            "--matrix",
+            "reports/cg_fidelity",
+            "--json",
+        ])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    use std::os::unix::process::ExitStatusExt;
+    const SIGPIPE: i32 = 13; // Linux; the tests do not link libc
+    assert_eq!(out.status.signal(), Some(SIGPIPE), "{:?}", out.status);
+}
