@@ -1235,14 +1235,21 @@ pub fn format_report(report: &BenchReport) -> String {
 mod tests {
     use super::*;
 
-    #[test]
-    fn ratios_pair_adjacent_runs_and_take_the_median() {
-        let run = |code, rep, v| BenchRun {
-            case: "heap".into(),
+    /// A completed run of `case` by `code` at `v` particle-steps per second.
+    fn completed_run(
+        case: &str,
+        code: Code,
+        threads: usize,
+        ranks: Option<usize>,
+        repetition: usize,
+        v: Real,
+    ) -> BenchRun {
+        BenchRun {
+            case: case.into(),
             code,
-            threads: 1,
-            ranks: None,
-            repetition: rep,
+            threads,
+            ranks,
+            repetition,
             status: "completed".into(),
             reason: None,
             n_particles: 1,
@@ -1251,7 +1258,12 @@ mod tests {
             particle_steps_per_s: Some(v),
             memory_mb: None,
             dir: PathBuf::new(),
-        };
+        }
+    }
+
+    #[test]
+    fn ratios_pair_adjacent_runs_and_take_the_median() {
+        let run = |code, rep, v| completed_run("heap", code, 1, None, rep, v);
         let runs = vec![
             run(Code::Cgdem, 0, 10.0),
             run(Code::Lammps, 0, 5.0),
@@ -1401,21 +1413,8 @@ mod tests {
 
     #[test]
     fn ranks_get_rows_efficiency_and_ratios_of_their_own() {
-        let run = |case: &str, code, threads, ranks, v| BenchRun {
-            case: case.into(),
-            code,
-            threads,
-            ranks,
-            repetition: 0,
-            status: "completed".into(),
-            reason: None,
-            n_particles: 1,
-            steps: 1,
-            loop_s: Some(1.0),
-            particle_steps_per_s: Some(v),
-            memory_mb: None,
-            dir: PathBuf::new(),
-        };
+        let run =
+            |case: &str, code, threads, ranks, v| completed_run(case, code, threads, ranks, 0, v);
         let g = "heap-grid2x1x1";
         let runs = vec![
             run("heap", Code::Cgdem, 1, None, 10.0),
