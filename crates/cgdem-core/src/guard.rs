@@ -131,6 +131,36 @@ pub(crate) fn forced_step_cause(dt: Real, stable_dt: Real) -> Option<String> {
     })
 }
 
+/// Why the deepest contact passed the overlap limit when the step was not forced: its overlap
+/// `fraction`, its normal approach `speed` (positive while closing), the step, the contact's
+/// own stable step (NaN when unknown) and the smallest radius.
+pub(crate) fn overlap_cause(
+    fraction: Real,
+    speed: Real,
+    dt: Real,
+    local_limit: Real,
+    smallest_radius: Real,
+) -> String {
+    if fraction > 1.0 {
+        format!(
+            "the particle passed through the surface: at {speed:.3} m/s it moved {:.0}% of its radius per step",
+            100.0 * speed.abs() * dt / smallest_radius
+        )
+    } else if speed <= 0.0 {
+        // Not closing: the contact was pressed in by something else, not by the particle's
+        // own approach (a parcel caught between a turning screw and its casing leaves at
+        // whatever speed the jam gave it).
+        format!(
+            "the particle is moving away from the surface at {:.3e} m/s, so its own approach did not drive it in: likely squeezed between surfaces that close on it (a moving body against a wall or another body; particles too large for a gap: a smaller lambda or diameter), or thrown back within one step by a contact stiffer than the step resolves",
+            -speed
+        )
+    } else if dt > local_limit {
+        format!("an impact at {speed:.3} m/s (normal approach speed) made the contact stiffer than the step resolves (Hertz scenes: contact.characteristic_velocity below the impact speed)")
+    } else {
+        format!("an impact at {speed:.3} m/s (normal approach speed) is more than the contact law absorbs within this overlap; the step is inside the stable limit, so the material is too soft for the impact (raise youngs_modulus or epsilon) or the impact too fast")
+    }
+}
+
 /// Undamped stable step `2 / omega` of a contact of local stiffness `k` on mass `m`.
 pub(crate) fn undamped_limit(stiffness: Real, mass: Real) -> Real {
     if stiffness > 0.0 && mass > 0.0 {
@@ -184,5 +214,27 @@ pub fn overlap_fraction(distance: Real, radius: Real) -> Real {
         1.0 - distance / radius
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A contact pressed in while its particle moves away was squeezed (a parcel caught by a
+    /// turning screw), not hit: the cause says so instead of quoting a negative impact speed.
+    #[test]
+    fn a_separating_contact_is_reported_as_squeezed_not_as_an_impact() {
+        let squeezed = overlap_cause(0.895, -1.7e13, 2.2e-4, Real::NAN, 0.02);
+        assert!(squeezed.contains("squeezed between surfaces"), "{squeezed}");
+        assert!(squeezed.contains("1.700e13"), "{squeezed}");
+        assert!(!squeezed.contains("impact at"), "{squeezed}");
+        let hit = overlap_cause(0.4, 3.0, 1e-6, 1e-5, 0.001);
+        assert!(hit.contains("an impact at 3.000 m/s"), "{hit}");
+        assert!(hit.contains("too soft"), "{hit}");
+        let stiff = overlap_cause(0.4, 3.0, 1e-5, 1e-6, 0.001);
+        assert!(stiff.contains("stiffer than the step resolves"), "{stiff}");
+        let through = overlap_cause(1.2, 50.0, 1e-5, 1e-6, 0.001);
+        assert!(through.contains("passed through"), "{through}");
     }
 }

@@ -25,8 +25,8 @@ use crate::force::{
 use crate::geometry::aabb::in_delete_region;
 use crate::geometry::Aabb;
 use crate::guard::{
-    forced_step_cause, overlap_fraction, undamped_limit, GuardKind, GuardPeaks, GuardSettings,
-    GuardState, GuardTrip,
+    forced_step_cause, overlap_cause, overlap_fraction, undamped_limit, GuardKind, GuardPeaks,
+    GuardSettings, GuardState, GuardTrip,
 };
 use crate::integrate::{complete_and_kick, drift_kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
@@ -1544,12 +1544,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             format!("the particles were placed overlapping (largest overlap {:.0}% of the radius before the first step)", 100.0 * initial)
         } else if let Some(forced) = forced_step_cause(self.dt, s.stable_dt) {
             forced
-        } else if fraction > 1.0 {
-            format!("the particle passed through the surface: at {speed:.3} m/s it moved {:.0}% of its radius per step", 100.0 * speed.abs() * self.dt / p.radius.iter().cloned().fold(Real::INFINITY, Real::min))
-        } else if self.dt > local_limit {
-            format!("an impact at {speed:.3} m/s (normal approach speed) made the contact stiffer than the step resolves (Hertz scenes: contact.characteristic_velocity below the impact speed)")
         } else {
-            format!("an impact at {speed:.3} m/s (normal approach speed) is more than the contact law absorbs within this overlap; the step is inside the stable limit, so the material is too soft for the impact (raise youngs_modulus or epsilon) or the impact too fast")
+            let smallest_radius = p.radius.iter().cloned().fold(Real::INFINITY, Real::min);
+            overlap_cause(fraction, speed, self.dt, local_limit, smallest_radius)
         };
         let mut trip = self.trip(
             GuardKind::Overlap,
