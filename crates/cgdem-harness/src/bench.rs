@@ -976,71 +976,88 @@ fn speed_of(
         .and_then(|r| r.particle_steps_per_s)
 }
 
+/// The worker counts among the runs `include` accepts, each with its repetitions, in order.
+fn repetitions_by_workers(
+    runs: &[BenchRun],
+    include: impl Fn(&BenchRun) -> bool,
+) -> Vec<(usize, Vec<usize>)> {
+    let mut keys: Vec<(usize, usize)> = runs
+        .iter()
+        .filter(|r| include(r))
+        .map(|r| (r.threads, r.repetition))
+        .collect();
+    keys.sort();
+    keys.dedup();
+    let mut out: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (workers, rep) in keys {
+        match out.last_mut() {
+            Some((w, reps)) if *w == workers => reps.push(rep),
+            _ => out.push((workers, vec![rep])),
+        }
+    }
+    out
+}
+
+/// The row `numerator / denominator` at `workers`: `ratio(rep)` for every repetition that
+/// measured both, with their median; None when none did.
+fn ratio_row(
+    numerator: String,
+    denominator: String,
+    workers: usize,
+    reps: &[usize],
+    ratio: impl Fn(usize) -> Option<Real>,
+) -> Option<BenchRatio> {
+    let per_repetition: Vec<Real> = reps.iter().filter_map(|&rep| ratio(rep)).collect();
+    if per_repetition.is_empty() {
+        return None;
+    }
+    let mut sorted = per_repetition.clone();
+    Some(BenchRatio {
+        numerator,
+        denominator,
+        threads: workers,
+        median: median(&mut sorted),
+        per_repetition,
+    })
+}
+
 /// Per repetition, cgdem over each other code on the same case, and cgdem on each case over
 /// cgdem on the first case (cgdem on threads).
 fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
     let speed = |case: &str, code: Code, threads: usize, rep: usize| {
         speed_of(runs, (case, code, threads, rep), false)
     };
-    let mut keys: Vec<(usize, usize)> = runs.iter().map(|r| (r.threads, r.repetition)).collect();
-    keys.sort();
-    keys.dedup();
-    let mut thread_counts: Vec<usize> = keys.iter().map(|k| k.0).collect();
-    thread_counts.dedup();
     let mut out = Vec::new();
-    let mut push = |numerator: String, denominator: String, threads: usize, values: Vec<Real>| {
-        if !values.is_empty() {
-            let mut v = values.clone();
-            out.push(BenchRatio {
-                numerator,
-                denominator,
-                threads,
-                per_repetition: values,
-                median: median(&mut v),
-            });
-        }
-    };
-    for &threads in &thread_counts {
-        let reps: Vec<usize> = keys
-            .iter()
-            .filter(|k| k.0 == threads)
-            .map(|k| k.1)
-            .collect();
+    for (threads, reps) in repetitions_by_workers(runs, |_| true) {
         for case in cases {
             for other in [Code::Liggghts, Code::Lammps] {
-                let values: Vec<Real> = reps
-                    .iter()
-                    .filter_map(|&rep| {
+                out.extend(ratio_row(
+                    format!("{case} cgdem"),
+                    format!("{case} {}", other.name()),
+                    threads,
+                    &reps,
+                    |rep| {
                         Some(
                             speed(case, Code::Cgdem, threads, rep)?
                                 / speed(case, other, threads, rep)?,
                         )
-                    })
-                    .collect();
-                push(
-                    format!("{case} cgdem"),
-                    format!("{case} {}", other.name()),
-                    threads,
-                    values,
-                );
+                    },
+                ));
             }
         }
         for case in cases.iter().skip(1) {
-            let values: Vec<Real> = reps
-                .iter()
-                .filter_map(|&rep| {
+            out.extend(ratio_row(
+                format!("{case} cgdem"),
+                format!("{} cgdem", cases[0]),
+                threads,
+                &reps,
+                |rep| {
                     Some(
                         speed(case, Code::Cgdem, threads, rep)?
                             / speed(&cases[0], Code::Cgdem, threads, rep)?,
                     )
-                })
-                .collect();
-            push(
-                format!("{case} cgdem"),
-                format!("{} cgdem", cases[0]),
-                threads,
-                values,
-            );
+                },
+            ));
         }
     }
     out
@@ -1051,17 +1068,8 @@ fn ratios(runs: &[BenchRun], cases: &[String]) -> Vec<BenchRatio> {
 /// reference code on the base case, at the same worker count.
 fn rank_ratios(runs: &[BenchRun], cases: &[(String, String)]) -> Vec<BenchRatio> {
     let mut out = Vec::new();
-    let mut keys: Vec<(usize, usize)> = runs
-        .iter()
-        .filter(|r| r.code == Code::Cgdem && r.ranks.is_some())
-        .map(|r| (r.threads, r.repetition))
-        .collect();
-    keys.sort();
-    keys.dedup();
-    let mut workers: Vec<usize> = keys.iter().map(|k| k.0).collect();
-    workers.dedup();
-    for &n in &workers {
-        let reps: Vec<usize> = keys.iter().filter(|k| k.0 == n).map(|k| k.1).collect();
+    let with_ranks = |r: &BenchRun| r.code == Code::Cgdem && r.ranks.is_some();
+    for (n, reps) in repetitions_by_workers(runs, with_ranks) {
         for (case, base) in cases {
             let ranks = |rep| speed_of(runs, (case.as_str(), Code::Cgdem, n, rep), true);
             let others = [
@@ -1071,23 +1079,13 @@ fn rank_ratios(runs: &[BenchRun], cases: &[(String, String)]) -> Vec<BenchRatio>
                 (base.as_str(), Code::Lammps),
             ];
             for (other_case, other) in others {
-                let values: Vec<Real> = reps
-                    .iter()
-                    .filter_map(|&rep| {
-                        Some(ranks(rep)? / speed_of(runs, (other_case, other, n, rep), false)?)
-                    })
-                    .collect();
-                if values.is_empty() {
-                    continue;
-                }
-                let mut v = values.clone();
-                out.push(BenchRatio {
-                    numerator: format!("{case} {}", label(Code::Cgdem, Some(n))),
-                    denominator: format!("{other_case} {}", other.name()),
-                    threads: n,
-                    median: median(&mut v),
-                    per_repetition: values,
-                });
+                out.extend(ratio_row(
+                    format!("{case} {}", label(Code::Cgdem, Some(n))),
+                    format!("{other_case} {}", other.name()),
+                    n,
+                    &reps,
+                    |rep| Some(ranks(rep)? / speed_of(runs, (other_case, other, n, rep), false)?),
+                ));
             }
         }
     }
