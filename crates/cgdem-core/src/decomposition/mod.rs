@@ -49,7 +49,8 @@ pub struct DecompositionSummary {
     pub ranks: usize,
     /// Owned particles per subdomain at the end.
     pub subdomain_particles: Vec<usize>,
-    /// Most particles in one subdomain over the mean, at the end (1 is perfect balance).
+    /// Most particles in one subdomain over the mean, at the end (1 is perfect balance), by
+    /// owner: the owners are those of the last rebuild.
     pub imbalance: Real,
     /// `--balance`: the imbalance past which the cut planes moved at a rebuild (none: off).
     #[serde(default)]
@@ -60,10 +61,13 @@ pub struct DecompositionSummary {
     /// The largest imbalance the subdomains had after a rebuild, from the first shift on.
     #[serde(default)]
     pub imbalance_max_after_first_shift: Option<Real>,
-    /// The imbalance the start's cut planes (by count, never moved) would give at the end.
+    /// The imbalance the start's cut planes (by count, never moved) would give at the end, by
+    /// position: particles that crossed a plane since the last rebuild count on their new
+    /// side, so between rebuilds this can differ from `imbalance` even when no plane moved.
     #[serde(default)]
     pub static_imbalance: Real,
-    /// The largest imbalance the start's cut planes gave or would have given at a rebuild.
+    /// The largest imbalance the start's cut planes gave or would have given at a rebuild,
+    /// or at the end (by position, as `static_imbalance`).
     #[serde(default)]
     pub static_imbalance_max: Real,
     /// Bytes the ranks sent each other per step, averaged over the run (exchange, borders,
