@@ -2,7 +2,7 @@
 
 use crate::math::{Real, Vec3};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Domain {
     pub lo: Vec3,
     pub hi: Vec3,

@@ -65,7 +65,7 @@ impl Timescales {
 }
 
 /// How the scene asks for its time step.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum TimeStepRequest {
     /// This fraction of the shortest contact period.
     FractionOfPeriod(Real),
