@@ -2,7 +2,8 @@
 # The MPI transport of the decomposed step (issue 23): installs OpenMPI (as root with apt),
 # builds cgdem with `--features mpi` in the workspace's target directory, and checks that
 # the tiny Hertz collapse on 2 MPI ranks (and on 4 oversubscribed ranks) writes bitwise the
-# CSVs the same --grid writes on threads in one process. A few seconds beyond the build
+# CSVs the same --grid writes on threads in one process, and that `validate --np 2` runs the
+# harness's cgdem runs as ranks with the same CSVs. A few seconds beyond the build
 # (none when scripts/test.sh has built the workspace with --features mpi already).
 # Usage: bash scripts/mpi-check.sh [--prepare]
 #   --prepare: only install what the MPI build needs; exit 0 when it is there, 1 when not
@@ -59,3 +60,20 @@ check() { # GRID RANKS
 }
 check 2x1x1 2
 check 2x1x2 4
+
+# The harness's ranks (`validate --np`): the scene it builds, handed to the ranks as
+# scene.json, gives bitwise the CSVs of the same grid on threads.
+suite=tests/data/tiny_suite_np.toml
+"$bin" validate --suite "$suite" --grid 2x1x1 --balance 1.0 --threads 2 --quiet \
+    --out "$out/validate-threads" >/dev/null
+"$bin" validate --suite "$suite" --grid 2x1x1 --balance 1.0 --np 2 --threads 2 --quiet \
+    --out "$out/validate-ranks" >/dev/null
+run=runs/tiny_hertz_collapse-short/cgdem-lambda1-seed1
+grep -q '"ranks": 2' "$out/validate-ranks/$run/summary.json" || {
+    echo "validate --np 2: the run in $out/validate-ranks/$run did not run as 2 ranks"
+    exit 1
+}
+for f in timeseries.csv repose.csv profile.csv; do
+    cmp "$out/validate-threads/$run/$f" "$out/validate-ranks/$run/$f"
+done
+echo "validate --np 2: the harness's runs as MPI ranks write bitwise the CSVs of 2 threads"

@@ -103,7 +103,8 @@ struct Cli {
 enum Command {
     /// Run a scene (a TOML case file) and write its outputs.
     Run {
-        /// The scene file, e.g. validation/cases/aor_collapse.toml (not with --resume).
+        /// The scene file, e.g. validation/cases/aor_collapse.toml (not with --resume), or the
+        /// `scene.json` a harness run wrote (`validate --np`), run as written.
         #[arg(required_unless_present = "resume", conflicts_with = "resume")]
         case: Option<PathBuf>,
         /// Coarse-graining level: a power of two (1 = the original, uncoarsened system).
@@ -246,6 +247,15 @@ enum Command {
         /// With --grid: as `cgdem run --balance`.
         #[arg(long, value_name = "THRESH|off", default_value_t, requires = "grid")]
         balance: cgdem_core::decomposition::BalanceSpec,
+        /// With --grid: run each of cgdem's runs as N MPI ranks (`mpirun -np N cgdem run
+        /// RUN/scene.json --grid G ...`, the scene the harness built written beside the
+        /// run), sharing --threads; bitwise the outputs of the same grid on threads. Needs
+        /// mpirun and a cgdem built with `--features mpi` (this one, or --cgdem-bin).
+        #[arg(long, value_name = "N", requires = "grid")]
+        np: Option<usize>,
+        /// The cgdem binary the ranks of --np run (default: this one).
+        #[arg(long, value_name = "PATH", requires = "np")]
+        cgdem_bin: Option<PathBuf>,
     },
     /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
     /// starts from one state that cgdem prepares, runs the same steps, alternating (A B C,
@@ -651,7 +661,19 @@ fn main() -> ExitCode {
             history,
             grid,
             balance,
+            np,
+            cgdem_bin,
         } => {
+            let ranks = match np
+                .map(|n| cgdem_harness::ranks::Ranks::checked(n, grid, cgdem_bin.as_deref()))
+                .transpose()
+            {
+                Ok(ranks) => ranks,
+                Err(e) => {
+                    eprintln!("error: --np: {e}");
+                    return ExitCode::from(2);
+                }
+            };
             let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
                 PathBuf::from(&suite)
             } else {
@@ -674,7 +696,11 @@ fn main() -> ExitCode {
                 stop: interrupt.as_ref().map(|i| i.flag()),
                 cgdem_faults: fault,
                 history,
-                decomposition: cgdem_harness::runs::CgdemDecomposition { grid, balance },
+                decomposition: cgdem_harness::runs::CgdemDecomposition {
+                    grid,
+                    balance,
+                    ranks,
+                },
             };
             let result = pool.install(|| cgdem_harness::validate::validate(&options));
             if let Some(code) = interrupted(&interrupt, &out) {

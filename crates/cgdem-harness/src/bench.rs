@@ -637,54 +637,19 @@ fn check_ranks(options: &BenchOptions) -> Result<Option<PathBuf>, BenchError> {
     let Some(&most) = options.np.iter().max() else {
         return Ok(None);
     };
-    let bad = |m: String| Err(BenchError::Ranks(m));
-    if options.np.contains(&0) {
-        return bad("rank counts must be at least 1".into());
-    }
     if !options.codes.contains(&Code::Cgdem) {
-        return bad("the ranks are cgdem's: add cgdem to --codes".into());
-    }
-    let subdomains = match options.grid {
-        None => return bad("cgdem's ranks step subdomains: give --grid (e.g. 2x1x1)".into()),
-        Some(GridSpec::Given(c)) => c.iter().product(),
-        Some(GridSpec::Auto(n)) => n,
-    };
-    if subdomains < most {
-        return bad(format!(
-            "{most} ranks need at least {most} subdomains; --grid {} has {subdomains}",
-            options.grid.expect("checked")
+        return Err(BenchError::Ranks(
+            "the ranks are cgdem's: add cgdem to --codes".into(),
         ));
     }
-    let bin = match &options.cgdem_bin {
-        Some(bin) => bin.clone(),
-        None => std::env::current_exe()
-            .map_err(|e| BenchError::Ranks(format!("cannot find this cgdem's binary: {e}")))?,
-    };
-    // `cgdem --version` names the MPI feature when built with it.
-    let version = std::process::Command::new(&bin)
-        .arg("--version")
-        .output()
-        .map_err(|e| BenchError::Ranks(format!("cannot run {} --version: {e}", bin.display())))?;
-    let version = String::from_utf8_lossy(&version.stdout);
-    if !version.contains(MPI_MARK) {
-        return bad(format!(
-            "{} ({}) is built without MPI: build one with `cargo build --release --features mpi` and give it with --cgdem-bin PATH (or run that binary)",
-            bin.display(),
-            version.trim()
-        ));
-    }
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    if !std::env::split_paths(&path).any(|dir| dir.join("mpirun").is_file()) {
-        return bad(
-            "mpirun not found on PATH; install OpenMPI (apt-get install openmpi-bin libopenmpi-dev)"
-                .into(),
-        );
-    }
-    Ok(Some(bin))
+    // A zero among the counts is refused as such, whatever the largest.
+    let np = if options.np.contains(&0) { 0 } else { most };
+    crate::ranks::Ranks::checked(np, options.grid, options.cgdem_bin.as_deref())
+        .map(|r| Some(r.bin))
+        .map_err(BenchError::Ranks)
 }
 
-/// What `cgdem --version` prints in a build with the `mpi` feature (src/main.rs).
-pub const MPI_MARK: &str = "with MPI";
+pub use crate::ranks::MPI_MARK;
 
 /// The scene overrides that make a case file's scene the bench's timed scene (as
 /// `with_duration` makes it): one stage of `duration`, one output row at its end, no VTK.

@@ -12,6 +12,7 @@ pub mod dynamics;
 pub mod history;
 pub mod lammps;
 pub mod liggghts;
+pub mod ranks;
 pub mod reference;
 pub mod report;
 pub mod runs;

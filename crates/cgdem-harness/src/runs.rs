@@ -8,10 +8,11 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::code::Code;
+use crate::ranks::{run_scene, Ranks};
 use crate::suite_entry::SuiteError;
 use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
 use cgdem_core::decomposition::{BalanceSpec, GridSpec};
-use cgdem_core::run::{run, Progress, RunOptions};
+use cgdem_core::run::{Progress, RunOptions};
 use cgdem_core::scene::Scene;
 
 /// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`.
@@ -173,12 +174,16 @@ pub struct ValidateOptions {
 
 /// `validate --grid` and `--balance`: every cgdem run of the suite (cases, accuracy sweeps,
 /// stability) split into subdomains on the suite's threads, so that its verdicts can be
-/// compared with the undecomposed suite's. The reference codes run as without it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// compared with the undecomposed suite's; with `--np`, as MPI ranks. The reference codes
+/// run as without it.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CgdemDecomposition {
     /// None: undecomposed (the default).
     pub grid: Option<GridSpec>,
     pub balance: BalanceSpec,
+    /// `--np`: each run as this many MPI ranks (`mpirun`) instead of threads in this
+    /// process; bitwise the same outputs, so `--reuse` takes either for the other.
+    pub ranks: Option<Ranks>,
 }
 
 impl CgdemDecomposition {
@@ -322,9 +327,10 @@ fn run_cgdem(
         balance: options.decomposition.balance,
         ..Default::default()
     };
-    run(&coarse, &run_options)
+    let ranks = options.decomposition.ranks.as_ref();
+    run_scene(&coarse, &run_options, ranks)
         .map(|_| false)
-        .map_err(|e| RunOutcome::Failed(e.to_string()))
+        .map_err(RunOutcome::Failed)
 }
 
 /// `dir/summary.json`, if a finished run left one.
@@ -482,8 +488,11 @@ mod tests {
     fn reuse_takes_only_a_run_decomposed_as_asked() {
         let plain = serde_json::json!({ "scene_digest": "x" });
         let split = |grid: [u64; 3], threshold: Option<f64>| serde_json::json!({ "decomposition": { "grid": grid, "balance_threshold": threshold } });
-        let asked =
-            |grid: Option<GridSpec>, balance: BalanceSpec| CgdemDecomposition { grid, balance };
+        let asked = |grid: Option<GridSpec>, balance: BalanceSpec| CgdemDecomposition {
+            grid,
+            balance,
+            ranks: None,
+        };
         let none = CgdemDecomposition::default();
         assert!(none.made(&plain));
         assert!(!none.made(&split([2, 1, 1], Some(1.1))));

@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use super::lammps::runner::{log_tail_of, RunStatus, RunnerOptions};
 use crate::code::Code;
 use crate::csv_table::CsvTable;
+use crate::ranks::run_scene;
 use crate::report::{Cell, Report, Table};
 use crate::runs::CgdemDecomposition;
 use crate::suite_entry::{load_variant, parse_codes, parse_variant, SuiteError};
@@ -32,7 +33,7 @@ use cgdem_core::guard::overlap_fraction;
 use cgdem_core::io::CsvBuffer;
 use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
-use cgdem_core::run::{run, RunOptions};
+use cgdem_core::run::RunOptions;
 use cgdem_core::scene::{ContactSettings, Override, Scene, SceneError};
 
 /// One `[[stability]]` entry of a suite file, as written.
@@ -222,7 +223,7 @@ pub fn run_stability(
     quiet: bool,
     keep_going: bool,
     reference_timeout_s: u64,
-    decomposition: CgdemDecomposition,
+    decomposition: &CgdemDecomposition,
     report: &mut Report,
 ) -> Result<Vec<StabilityRecord>, String> {
     if cases.is_empty() {
@@ -326,7 +327,7 @@ pub(crate) fn run_cgdem(
     case: &StabilityCase,
     dir: &Path,
     keep_going: bool,
-    decomposition: CgdemDecomposition,
+    decomposition: &CgdemDecomposition,
 ) -> StabilityRecord {
     let mut rec = record(scene, Code::Cgdem, case, dir);
     let options = RunOptions {
@@ -337,10 +338,11 @@ pub(crate) fn run_cgdem(
         balance: decomposition.balance,
         ..Default::default()
     };
-    let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| run(scene, &options)));
+    let ranks = decomposition.ranks.as_ref();
+    let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| run_scene(scene, &options, ranks)));
     let stop = match outcome {
         Ok(Ok(_)) => None,
-        Ok(Err(e)) => Some(e.to_string()),
+        Ok(Err(e)) => Some(e),
         Err(_) => {
             rec.verdict = Verdict::Failed;
             rec.message = "cgdem panicked".into();
@@ -1011,7 +1013,7 @@ mod tests {
             true,
             false,
             1,
-            CgdemDecomposition::default(),
+            &CgdemDecomposition::default(),
             &mut report,
         )
         .unwrap();

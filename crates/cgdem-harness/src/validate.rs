@@ -162,7 +162,7 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
         options.quiet,
         options.keep_going,
         options.reference_timeout_s,
-        options.decomposition,
+        &options.decomposition,
         &mut report,
     )
     .map_err(|message| ValidateError::Case {
@@ -460,6 +460,12 @@ fn provenance(suite: &Suite, options: &ValidateOptions) -> BTreeMap<String, Stri
         p.insert(
             "cgdem decomposed (--grid, --balance)".into(),
             format!("{grid}, balance {}", options.decomposition.balance),
+        );
+    }
+    if let Some(ranks) = &options.decomposition.ranks {
+        p.insert(
+            "cgdem as MPI ranks (--np)".into(),
+            format!("{} ranks of {}", ranks.np, ranks.bin.display()),
         );
     }
     p
