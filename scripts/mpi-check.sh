@@ -63,7 +63,7 @@ check 2x1x2 4
 
 # The harness's ranks (`validate --np`): the scene it builds, handed to the ranks as
 # scene.json, gives bitwise the CSVs of the same grid on threads.
-suite=tests/data/tiny_suite_np.toml
+suite=tests/data/tiny_suite.toml
 "$bin" validate --suite "$suite" --grid 2x1x1 --balance 1.0 --threads 2 --quiet \
     --out "$out/validate-threads" >/dev/null
 "$bin" validate --suite "$suite" --grid 2x1x1 --balance 1.0 --np 2 --threads 2 --quiet \

@@ -256,6 +256,11 @@ enum Command {
         /// The cgdem binary the ranks of --np run (default: this one).
         #[arg(long, value_name = "PATH", requires = "np")]
         cgdem_bin: Option<PathBuf>,
+        /// cgdem's case and accuracy runs write restart files this many simulated seconds
+        /// apart (as `cgdem run --checkpoint-every`); with --reuse, a run killed in an
+        /// earlier attempt goes on from its last one instead of starting again.
+        #[arg(long, value_name = "SECONDS", conflicts_with = "np")]
+        checkpoint_every: Option<f64>,
     },
     /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
     /// starts from one state that cgdem prepares, runs the same steps, alternating (A B C,
@@ -663,7 +668,14 @@ fn main() -> ExitCode {
             balance,
             np,
             cgdem_bin,
+            checkpoint_every,
         } => {
+            if let Some(t) = checkpoint_every {
+                if !(t.is_finite() && t > 0.0) {
+                    eprintln!("error: --checkpoint-every {t}: must be a positive number of simulated seconds");
+                    return ExitCode::from(2);
+                }
+            }
             let ranks = match np
                 .map(|n| cgdem_harness::ranks::Ranks::checked(n, grid, cgdem_bin.as_deref()))
                 .transpose()
@@ -701,6 +713,7 @@ fn main() -> ExitCode {
                     balance,
                     ranks,
                 },
+                checkpoint_every,
             };
             let result = pool.install(|| cgdem_harness::validate::validate(&options));
             if let Some(code) = interrupted(&interrupt, &out) {

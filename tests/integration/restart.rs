@@ -249,3 +249,42 @@ fn grid_runs_resume_bit_for_bit_on_their_grid_and_go_on_on_another() {
         "{stderr}"
     );
 }
+
+/// `validate --checkpoint-every` with `--reuse`: a suite whose cgdem run was killed after a
+/// checkpoint goes on from it, and the run's outputs are the uninterrupted run's.
+#[test]
+fn validate_resumes_a_killed_run_from_its_restart_file() {
+    let validate = |out: &Path, reuse: bool| {
+        let mut args = vec![
+            "validate",
+            "--suite",
+            "tests/data/tiny_suite.toml",
+            "--threads",
+            "1",
+            "--quiet",
+            "--checkpoint-every",
+            "0.12",
+        ];
+        if reuse {
+            args.push("--reuse");
+        }
+        args.push("--out");
+        let o = cgdem(&args, out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let run = "runs/tiny_hertz_collapse-short/cgdem-lambda1-seed1";
+    let whole = tmp("validate-whole");
+    validate(&whole, false);
+    assert!(whole.join(run).join("restart.cgr").is_file());
+    // As a kill after the last checkpoint leaves the suite: no summary, a torn row, no report.
+    let killed = tmp("validate-killed");
+    copy_dir(&whole.join(run), &killed.join(run));
+    std::fs::remove_file(killed.join(run).join("summary.json")).unwrap();
+    let mut series = std::fs::read(killed.join(run).join("timeseries.csv")).unwrap();
+    series.extend_from_slice(b"9.99e-1,collapse,1.2");
+    std::fs::write(killed.join(run).join("timeseries.csv"), series).unwrap();
+    let stderr = validate(&killed, true);
+    assert!(stderr.contains("resuming"), "{stderr}");
+    assert_same_outputs(&whole.join(run), &killed.join(run));
+}

@@ -12,7 +12,8 @@ use crate::ranks::{run_scene, Ranks};
 use crate::suite_entry::SuiteError;
 use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
 use cgdem_core::decomposition::{BalanceSpec, GridSpec};
-use cgdem_core::run::{Progress, RunOptions};
+use cgdem_core::math::Real;
+use cgdem_core::run::{restart, CheckpointOptions, Progress, RunOptions};
 use cgdem_core::scene::Scene;
 
 /// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`.
@@ -170,6 +171,9 @@ pub struct ValidateOptions {
     pub history: Option<PathBuf>,
     /// `--grid`/`--balance`: cgdem's runs decomposed as `cgdem run --grid` decomposes them.
     pub decomposition: CgdemDecomposition,
+    /// `--checkpoint-every`: cgdem's case and accuracy runs write restart files this many
+    /// simulated seconds apart; with `reuse`, a run that was killed goes on from its last one.
+    pub checkpoint_every: Option<Real>,
 }
 
 /// `validate --grid` and `--balance`: every cgdem run of the suite (cases, accuracy sweeps,
@@ -317,6 +321,17 @@ fn run_cgdem(
     {
         return Ok(true);
     }
+    // A run killed in an earlier attempt goes on from its last restart file, if it holds
+    // this very scene.
+    let resume = options
+        .reuse
+        .then(|| restart::read_latest(dir).ok())
+        .flatten()
+        .filter(|r| r.restart.scene_digest == coarse.digest())
+        .map(std::sync::Arc::new);
+    if let Some(r) = &resume {
+        eprintln!("resuming {}", r.path.display());
+    }
     let run_options = RunOptions {
         out_dir: dir.to_path_buf(),
         progress: options.progress.clone(),
@@ -325,6 +340,11 @@ fn run_cgdem(
         stop: options.stop.clone(),
         grid: options.decomposition.grid,
         balance: options.decomposition.balance,
+        checkpoint: options.checkpoint_every.map(|every| CheckpointOptions {
+            every,
+            invocation: "cgdem validate".into(),
+        }),
+        resume,
         ..Default::default()
     };
     let ranks = options.decomposition.ranks.as_ref();

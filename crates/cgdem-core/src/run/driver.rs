@@ -99,6 +99,8 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             n_inserted,
             n_body_particles,
         }),
+        wall_before: 0.0,
+        started: Instant::now(),
     };
     let resume_at = match resume {
         Some(loaded) => {
@@ -121,12 +123,13 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             }
         }
     };
-    let started = Instant::now();
+    driver.started = Instant::now();
     let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings, resume_at)?;
     driver.progress.finish();
     // Under MPI rank 0 gathers the final state and writes it.
     world.sync_particles_for_output();
-    let wall_s = started.elapsed().as_secs_f64();
+    // A resumed run counts the wall time its earlier processes spent up to its checkpoint.
+    let wall_s = driver.wall_s();
     for (kind, count) in driver.guard_counts.iter().filter(|(_, count)| *count > 1) {
         warnings.push(format!(
             "--keep-going: the {} guard fired in {count} steps",
@@ -413,6 +416,11 @@ struct Driver<'s> {
     stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     interrupted: bool,
     checkpoint: Option<Checkpointer>,
+    /// Wall seconds the run spent in the processes before this one (from the restart file
+    /// it resumed), up to their last checkpoint.
+    wall_before: Real,
+    /// When this process began stepping.
+    started: Instant,
 }
 
 /// Writes the restart files (`--checkpoint-every`).
@@ -478,6 +486,11 @@ type Refill<'r> = (usize, &'r RefillRegion, usize, u64);
 impl Driver<'_> {
     /// Runs every stage from `resume.at` on; returns the guard trip that stopped the run, if
     /// one did.
+    /// Wall seconds of stepping so far, over every process of the run.
+    fn wall_s(&self) -> Real {
+        self.wall_before + self.started.elapsed().as_secs_f64()
+    }
+
     /// Takes over a stored run: the world's state, the driver's counters and warnings, and
     /// where the stage loop goes on (observers restored now, or at their stage's start when
     /// the run stopped within a stage); with the inserted and body particle counts.
@@ -499,6 +512,7 @@ impl Driver<'_> {
         let d = &r.driver;
         self.refilled = d.refilled;
         self.particle_steps = d.particle_steps;
+        self.wall_before = d.wall_s;
         self.stages = d.stages.clone();
         self.guard_counts = d.guard_counts.clone();
         // Already printed by the run that met them.
@@ -760,6 +774,7 @@ impl Driver<'_> {
                 warnings: warnings.0.clone(),
                 n_inserted: c.n_inserted,
                 n_body_particles: c.n_body_particles,
+                wall_s: self.wall_s(),
             },
             observers,
         };

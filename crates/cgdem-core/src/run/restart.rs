@@ -24,8 +24,8 @@ pub const RESTART_FILE: &str = "restart.cgr";
 pub const PREVIOUS_RESTART_FILE: &str = "restart.prev.cgr";
 const MAGIC: &[u8; 8] = b"CGDEMRST";
 /// Bumped whenever the payload's layout changes; an older file is refused by name (2: the
-/// world state holds the subdomains of a `--grid` run).
-pub const FORMAT_VERSION: u32 = 2;
+/// world state holds the subdomains of a `--grid` run; 3: the driver keeps the wall time).
+pub const FORMAT_VERSION: u32 = 3;
 const HEADER_LEN: usize = 32;
 
 /// Where in the stage list a checkpoint was taken.
@@ -51,6 +51,9 @@ pub struct DriverState {
     pub warnings: Vec<String>,
     pub n_inserted: usize,
     pub n_body_particles: usize,
+    /// Wall seconds the run had spent stepping when the file was written (over every
+    /// process it ran in): a resumed run's `wall_s` goes on from it.
+    pub wall_s: Real,
 }
 
 /// One restart file's content.
@@ -265,6 +268,7 @@ mod tests {
                 warnings: vec!["w".into()],
                 n_inserted: 10,
                 n_body_particles: 0,
+                wall_s: 12.5,
             },
             observers: vec![vec![9; 17]],
         }
