@@ -250,8 +250,9 @@ fn grid_runs_resume_bit_for_bit_on_their_grid_and_go_on_on_another() {
     );
 }
 
-/// `validate --checkpoint-every` with `--reuse`: a suite whose cgdem run was killed after a
-/// checkpoint goes on from it, and the run's outputs are the uninterrupted run's.
+/// `validate --checkpoint-every` with `--reuse`: a suite whose cgdem run was stopped after a
+/// checkpoint goes on from it (its interrupted summary is not taken for a finished run),
+/// and the run's outputs are the uninterrupted run's.
 #[test]
 fn validate_resumes_a_killed_run_from_its_restart_file() {
     let validate = |out: &Path, reuse: bool| {
@@ -277,10 +278,17 @@ fn validate_resumes_a_killed_run_from_its_restart_file() {
     let whole = tmp("validate-whole");
     validate(&whole, false);
     assert!(whole.join(run).join("restart.cgr").is_file());
-    // As a kill after the last checkpoint leaves the suite: no summary, a torn row, no report.
+    // As SIGTERM after the last checkpoint leaves the suite: the run's summary says its last
+    // stage was interrupted (so --reuse must not take it as finished), a torn row, no report.
     let killed = tmp("validate-killed");
     copy_dir(&whole.join(run), &killed.join(run));
-    std::fs::remove_file(killed.join(run).join("summary.json")).unwrap();
+    let mut s: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(whole.join(run).join("summary.json")).unwrap(),
+    )
+    .unwrap();
+    let last = s["stages"].as_array().unwrap().len() - 1;
+    s["stages"][last]["ended_by"] = "interrupted (SIGINT/SIGTERM)".into();
+    std::fs::write(killed.join(run).join("summary.json"), s.to_string()).unwrap();
     let mut series = std::fs::read(killed.join(run).join("timeseries.csv")).unwrap();
     series.extend_from_slice(b"9.99e-1,collapse,1.2");
     std::fs::write(killed.join(run).join("timeseries.csv"), series).unwrap();

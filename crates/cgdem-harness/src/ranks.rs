@@ -87,11 +87,20 @@ pub fn mpi_binary(given: Option<&Path>) -> Result<PathBuf, String> {
 
 /// Runs `scene` as `options` ask: in this process, or with `ranks` as that many MPI ranks
 /// (`options.grid` must be set) sharing the threads of the calling pool (at least one each).
+/// Once `options.stop` is raised no run starts (its directory is left as it was), as for
+/// the reference codes.
 pub fn run_scene(
     scene: &Scene,
     options: &RunOptions,
     ranks: Option<&Ranks>,
 ) -> Result<RunSummary, String> {
+    if options
+        .stop
+        .as_ref()
+        .is_some_and(|s| s.load(std::sync::atomic::Ordering::SeqCst))
+    {
+        return Err(format!("{}: not started", runner::INTERRUPTED));
+    }
     match ranks {
         None => cgdem_core::run::run(scene, options).map_err(|e| e.to_string()),
         Some(ranks) => {
@@ -272,6 +281,21 @@ mod tests {
             Path::new("d"),
         );
         assert!(e.unwrap_err().contains("--grid"));
+    }
+
+    #[test]
+    fn no_run_starts_once_the_stop_flag_is_raised() {
+        let dir = std::env::temp_dir().join(format!("cgdem-stopped-{}", std::process::id()));
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+        let options = RunOptions {
+            out_dir: dir.clone(),
+            stop: Some(stop),
+            ..Default::default()
+        };
+        let scene = Scene::load(Path::new("../../tests/data/tiny_hertz_collapse.toml")).unwrap();
+        let e = run_scene(&scene, &options, None).unwrap_err();
+        assert!(e.contains("not started"), "{e}");
+        assert!(!dir.exists(), "the run's directory was created");
     }
 
     #[test]

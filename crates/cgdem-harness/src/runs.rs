@@ -13,7 +13,7 @@ use crate::suite_entry::SuiteError;
 use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
 use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_core::math::Real;
-use cgdem_core::run::{restart, CheckpointOptions, Progress, RunOptions};
+use cgdem_core::run::{restart, CheckpointOptions, Progress, RunOptions, StageEnding};
 use cgdem_core::scene::Scene;
 
 /// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`.
@@ -353,10 +353,12 @@ fn run_cgdem(
         .map_err(RunOutcome::Failed)
 }
 
-/// `dir/summary.json`, if a finished run left one.
+/// `dir/summary.json`, if a finished run left one (an interrupted run leaves one too).
 fn finished_summary(dir: &Path) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
-    serde_json::from_str(&text).ok()
+    serde_json::from_str(&text)
+        .ok()
+        .filter(|s| !StageEnding::interrupted_summary(s))
 }
 
 /// The scene digest in `dir/summary.json`, if a finished run left one.

@@ -197,6 +197,19 @@ impl std::fmt::Display for StageEnding {
     }
 }
 
+impl StageEnding {
+    /// Whether `summary` (a summary.json) is that of a run SIGINT/SIGTERM ended: its last
+    /// stage ended so, and its outputs stop there. Such a run is not finished; `validate
+    /// --reuse` runs it again (or resumes it from its restart file).
+    pub fn interrupted_summary(summary: &serde_json::Value) -> bool {
+        summary["stages"]
+            .as_array()
+            .and_then(|stages| stages.last())
+            .and_then(|stage| stage["ended_by"].as_str())
+            == Some(StageEnding::Interrupted.to_string().as_str())
+    }
+}
+
 /// The angle measured at one time after the repose stage began.
 #[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ReposeSample {

@@ -10,7 +10,7 @@ use std::path::Path;
 use crate::report::{write_figure, Figure, Series, SeriesStyle};
 use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::Real;
-use cgdem_core::run::{run, Progress, RunOptions, RunSummary};
+use cgdem_core::run::{run, Progress, RunOptions, RunSummary, StageEnding};
 use cgdem_core::scene::{Scene, StageEnd};
 
 mod diameter;
@@ -96,7 +96,9 @@ fn run_or_reuse(scene: &Scene, options: &RunOptions, reuse: bool) -> Result<RunS
         let path = options.out_dir.join("summary.json");
         if let Some(summary) = std::fs::read_to_string(&path)
             .ok()
-            .and_then(|text| serde_json::from_str::<RunSummary>(&text).ok())
+            .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+            .filter(|s| !StageEnding::interrupted_summary(s))
+            .and_then(|s| serde_json::from_value::<RunSummary>(s).ok())
             .filter(|s| s.scene_digest == scene.digest() && s.conveying.is_some())
         {
             eprintln!("reusing {}", path.display());
