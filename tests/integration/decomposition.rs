@@ -7,7 +7,7 @@ use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{run, RunOptions, RunSummary};
-use cgdem_core::scene::{Override, Scene};
+use cgdem_core::scene::{ContactSettings, InsertAmount, Override, Scene};
 
 /// The tiny Hertz collapse (Hertz-Mindlin, rolling friction, walls with history, a gate
 /// removed, periodic y), shortened to 0.25 s (2384 steps).
@@ -179,6 +179,52 @@ fn a_decomposed_run_is_bitwise_the_same_on_one_and_two_threads() {
         by_id(one.final_state.as_ref().unwrap()),
         by_id(two.final_state.as_ref().unwrap())
     );
+}
+
+/// A thin periodic slab (a quasi-2D collapse): the periodic y axis, 0.023 m, is shorter than
+/// two ghost layers (0.025 m) but longer than two contact distances (0.02 m). Subdomains then
+/// list a partner through both images; the run still follows the undecomposed one.
+#[test]
+fn a_periodic_axis_shorter_than_two_ghost_layers_follows_the_undecomposed_run() {
+    let mut slab = scene();
+    slab.domain.hi.y = 0.023;
+    slab.insertions[0].hi.y = 0.023;
+    let run = |grid, name| run_scene(&slab, grid, BalanceSpec::Shift(1.0), 2, name);
+    let reference = run(None, "slab-none");
+    let split = run(Some(GridSpec::Given([2, 1, 1])), "slab-2x1x1");
+    // Rounding grows faster in the slab, whose beads touch their own images' neighbours: the
+    // bound is what one ulp of Young's modulus does to the undecomposed run.
+    let mut nudged = slab.clone();
+    if let ContactSettings::Hertz(h) = &mut nudged.contact {
+        h.youngs_modulus = h.youngs_modulus.next_up();
+    }
+    let ulp = run_scene(&nudged, None, BalanceSpec::Shift(1.0), 1, "slab-ulp");
+    let by_ulp = largest_differences(&reference, &ulp, "slab ulp");
+    let by_split = largest_differences(&reference, &split, "slab 2x1x1");
+    eprintln!("slab: one ulp {by_ulp:?}, 2x1x1 {by_split:?}");
+    assert!(
+        (0..3).all(|c| by_split[c] <= 10.0 * by_ulp[c]),
+        "slab 2x1x1 {by_split:?} against one ulp {by_ulp:?}"
+    );
+    // Shorter than two contact distances: refused, as the undecomposed world refuses it.
+    let mut thinner = scene();
+    thinner.domain.hi.y = 0.0199;
+    thinner.insertions[0].hi.y = 0.0199;
+    thinner.insertions[0].amount = InsertAmount::Count(30);
+    let options = RunOptions {
+        out_dir: std::env::temp_dir().join("cgdem-decomposition-thinner"),
+        grid: Some(GridSpec::Given([2, 1, 1])),
+        ..Default::default()
+    };
+    let e = run_scene_err(&thinner, &options);
+    assert!(
+        e.contains("periodic y") && e.contains("twice the contact distance"),
+        "{e}"
+    );
+}
+
+fn run_scene_err(scene: &Scene, options: &RunOptions) -> String {
+    run(scene, options).unwrap_err().to_string()
 }
 
 #[test]

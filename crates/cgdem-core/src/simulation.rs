@@ -956,6 +956,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             balance::clamp_to_width(&mut grid, width);
         }
         grid.check_width(width)?;
+        // The ghost layer is the contact distance plus the skin.
+        grid.check_periodic_images(width - self.neighbor.skin)?;
         if ranks > grid.len() {
             return Err(format!(
                 "{ranks} MPI ranks need at least as many subdomains, and the grid {}x{}x{} has {}; give a grid of at least {ranks} subdomains",

@@ -168,16 +168,17 @@ impl Grid {
     }
 
     /// Checks that ghosts of width `width` come from the adjacent subdomains only (each
-    /// subdomain at least `width` thick where it has neighbours on both sides) and that a pair
-    /// sees its partner through one periodic image only (a periodic axis at least twice
-    /// `width` long). Returns what is wrong, for the user.
+    /// subdomain at least `width` thick where it has neighbours on both sides; a periodic axis
+    /// that is not cut at least `width` long, its ghosts being its own images one period
+    /// away). Returns what is wrong, for the user. A cut periodic axis is then at least two
+    /// layers long; an uncut one may be shorter (see [`Grid::check_periodic_images`]).
     pub fn check_width(&self, width: Real) -> Result<(), String> {
         for a in 0..3 {
             let axis = ["x", "y", "z"][a];
             let length = self.hi[a] - self.lo[a];
-            if self.periodic[a] && length < 2.0 * width {
+            if self.periodic[a] && length < width {
                 return Err(format!(
-                    "the periodic {axis} axis ({length:.4e} m) is shorter than twice the ghost layer ({width:.4e} m: the largest diameter plus the contact reach plus the skin); use a longer box"
+                    "the periodic {axis} axis ({length:.4e} m) is shorter than the ghost layer ({width:.4e} m: the largest diameter plus the contact reach plus the skin); use a longer box"
                 ));
             }
             for c in 0..self.counts[a] {
@@ -204,6 +205,24 @@ impl Grid {
     /// with the shift that takes a position from `index`'s frame into the neighbour's:
     /// one entry per offset in {-1, 0, 1}^3 that stays inside bounded axes, except
     /// `(index, 0)`. Fixed order (z, y, x offsets increasing).
+    /// Checks that a particle touches a partner through one periodic image at most: every
+    /// periodic axis at least twice `contact` (the largest contact distance) long, as the
+    /// undecomposed world's minimum image needs. On an axis shorter than two ghost layers a
+    /// subdomain then lists a partner through both images, but the farther one never comes
+    /// within contact: its pair gives no force and its history stays at rest.
+    pub fn check_periodic_images(&self, contact: Real) -> Result<(), String> {
+        for a in 0..3 {
+            let length = self.hi[a] - self.lo[a];
+            if self.periodic[a] && length < 2.0 * contact {
+                return Err(format!(
+                    "the periodic {} axis ({length:.4e} m) is shorter than twice the contact distance ({contact:.4e} m: the largest diameter plus the contact reach); use a longer box",
+                    ["x", "y", "z"][a]
+                ));
+            }
+        }
+        Ok(())
+    }
+
     pub fn neighbours(&self, index: usize) -> Vec<(usize, Vec3)> {
         let c = self.coords(index);
         let length = self.hi - self.lo;
@@ -340,7 +359,15 @@ mod tests {
             .check_width(0.34)
             .unwrap_err()
             .contains("subdomain 2 along x"));
+        // An uncut periodic axis needs one ghost layer, and two contact distances.
         let one = Grid::balanced([1, 1, 1], &domain, &[]);
-        assert!(one.check_width(0.6).unwrap_err().contains("periodic y"));
+        assert!(one.check_width(0.6).is_ok());
+        assert!(one.check_width(1.1).unwrap_err().contains("periodic y"));
+        assert!(one.check_periodic_images(0.5).is_ok());
+        let e = one.check_periodic_images(0.55).unwrap_err();
+        assert!(
+            e.contains("periodic y") && e.contains("contact distance"),
+            "{e}"
+        );
     }
 }
