@@ -484,8 +484,6 @@ fn check_resumable(
 type Refill<'r> = (usize, &'r RefillRegion, usize, u64);
 
 impl Driver<'_> {
-    /// Runs every stage from `resume.at` on; returns the guard trip that stopped the run, if
-    /// one did.
     /// Wall seconds of stepping so far, over every process of the run.
     fn wall_s(&self) -> Real {
         self.wall_before + self.started.elapsed().as_secs_f64()
@@ -542,6 +540,8 @@ impl Driver<'_> {
         Ok((resume, (d.n_inserted, d.n_body_particles)))
     }
 
+    /// Runs every stage from `resume.at` on; returns the guard trip that stopped the run, if
+    /// one did.
     fn run_stages<L: PairLaw, W: WallLaw>(
         &mut self,
         world: &mut World<L, W>,
