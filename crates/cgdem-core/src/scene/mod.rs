@@ -18,7 +18,7 @@ use crate::integrate::Integrator;
 use crate::math::{Real, Vec3};
 use crate::timestep::TimeStepRequest;
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Species {
     pub name: String,
     pub diameter: Real,
@@ -41,7 +41,7 @@ impl Species {
 
 /// The seed's WCA model's parameters (`model = "wca"`): the energy `epsilon` and length
 /// `sigma` of the repulsion, the normal and tangential damping `gamma_n`, `gamma_t`.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WcaSettings {
     pub epsilon: Real,
     pub sigma: Real,
@@ -50,7 +50,7 @@ pub struct WcaSettings {
 }
 
 /// The particle-particle contact law and its parameters (one set for all species pairs).
-#[derive(Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ContactSettings {
     /// The seed's model, paper A Eq. (1)-(2): WCA repulsion plus normal and tangential
     /// viscous damping.
@@ -77,7 +77,7 @@ impl std::fmt::Debug for ContactSettings {
 }
 
 /// `damping = "hertz" | "yang"`.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum HertzDampingKind {
     /// LIGGGHTS `model hertz`: restitution-based, `2 sqrt(5/6) |beta(e)| sqrt(S_n m_eff)`.
     Restitution,
@@ -86,14 +86,14 @@ pub enum HertzDampingKind {
 }
 
 /// `tangential = "history" | "yang"`.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TangentialKind {
     History,
     Yang,
 }
 
 /// `rolling = "none" | "constant_torque" | "epsd2"`.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum RollingKind {
     None,
     ConstantTorque,
@@ -101,7 +101,7 @@ pub enum RollingKind {
 }
 
 /// `cohesion = "none" | "vdw"`.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum CohesionKind {
     None,
     /// Paper B Eq. (7)-(8); `cutoff` is the gap beyond touching where it stops (default:
@@ -113,7 +113,7 @@ pub enum CohesionKind {
     },
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HertzSettings {
     pub youngs_modulus: Real,
     pub poisson_ratio: Real,
@@ -127,7 +127,7 @@ pub struct HertzSettings {
     /// Impact speed (m/s) at which Hertz contacts are linearized for the time step.
     pub characteristic_velocity: Real,
 }
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WallContactSettings {
     pub restitution: Real,
     pub friction: Real,
@@ -137,14 +137,14 @@ pub struct WallContactSettings {
     pub rolling_friction: Real,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WallSettings {
     pub name: String,
     pub point: Vec3,
     pub normal: Vec3,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum InsertAmount {
     Count(u64),
     /// Total solid volume, m^3: the count follows from the particle size, so coarse-graining
@@ -157,13 +157,13 @@ pub enum InsertAmount {
 /// `lattice = "cubic" | "hexagonal"`: hexagonal layers (close-packed rows in x, rows
 /// `spacing sqrt(3)/2` apart in y, every other row shifted by half a spacing) stacked
 /// `spacing` apart in z.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum LatticeKind {
     Cubic,
     Hexagonal,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Lattice {
     pub kind: LatticeKind,
     /// Distance between nearest sites, m.
@@ -177,7 +177,7 @@ pub struct Lattice {
 
 /// A particle the run starts with, from `read_data` or a `[[particle]]` table; its size and
 /// density are its species'.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GivenParticle {
     pub species: usize,
     pub position: Vec3,
@@ -187,7 +187,7 @@ pub struct GivenParticle {
     pub omega: Vec3,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Insertion {
     pub species: usize,
     /// The box sampled; with `mesh`, only positions inside the mesh (by at least one radius)
@@ -212,7 +212,7 @@ pub struct Insertion {
 /// Top-up of an insertion region: from the start of `stage`, every `interval` seconds, new
 /// particles are inserted at random (no overlap) in the region until it again holds as many
 /// particles of the species as it did when the stage began.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Refill {
     /// s of simulated time between top-ups.
     pub interval: Real,
@@ -221,7 +221,7 @@ pub struct Refill {
 
 /// A body built of particles of a frozen species on an fcc lattice fitted inside its mesh
 /// (paper A sec. 4), moving with the body's prescribed motion.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BodyParticles {
     /// Index into `Scene::species` (a frozen species).
     pub species: usize,
@@ -231,7 +231,7 @@ pub struct BodyParticles {
 /// the prefix `screw-feeder:`, one part of the seed's screw feeder generated with the default
 /// [`ScrewFeederSpec`](crate::geometry::screw_feeder::ScrewFeederSpec): `screw`, `casing`,
 /// `hopper` or `insertion`.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum MeshSource {
     Stl(PathBuf),
     ScrewFeeder(String),
@@ -259,7 +259,7 @@ impl MeshSource {
 }
 
 /// A rigid body from a mesh, turned into an SDF grid, with prescribed motion.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BodySettings {
     pub name: String,
     pub mesh: MeshSource,
@@ -289,7 +289,7 @@ pub struct BodySettings {
 /// particles perched on (or still bouncing above) the surface from setting the height; the
 /// 0.99 quantile of a 10 d x 10 d bed sits in its topmost layer. The free surface is rough over
 /// one to two diameters and looser below it, hence the two-diameter margin.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BedRegionRule {
     pub floor_margin: Real,
     pub top_quantile: Real,
@@ -307,7 +307,7 @@ impl Default for BedRegionRule {
 }
 
 /// Screw-conveyor measurements (paper A Eq. 7) during one stage.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ConveyingSettings {
     pub stage: String,
     /// The screw body (its rpm gives n_s).
@@ -332,7 +332,7 @@ pub struct ConveyingSettings {
 }
 
 /// Porosity and pore sizes of a poured bed (paper B sec. 3), measured when `stage` ends.
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PackingSettings {
     pub stage: String,
     /// The measurement region, in diameters (see [`BedRegionRule`]).
@@ -343,7 +343,7 @@ pub struct PackingSettings {
     pub bin_width_diameters: Real,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum StageEnd {
     /// Run for this long.
     Duration(Real),
@@ -356,14 +356,14 @@ pub enum StageEnd {
     },
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Stage {
     pub name: String,
     pub remove_walls: Vec<String>,
     pub end: StageEnd,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct OutputSettings {
     /// Simulated seconds between VTK frames; 0 = none.
     pub vtk_interval: Real,
@@ -377,7 +377,7 @@ pub struct OutputSettings {
 }
 
 /// How and when the repose angle of a collapsed heap is measured (see `analysis::heap`).
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ReposeSettings {
     /// The stage after whose start the `at_times` count.
     pub stage: String,
@@ -393,7 +393,7 @@ pub struct ReposeSettings {
     pub exclude_toe_fraction: Real,
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Scene {
     pub name: String,
     pub description: String,
