@@ -119,6 +119,12 @@ fn run_as_ranks(
     threads: usize,
 ) -> Result<RunSummary, String> {
     let dir = std::path::absolute(&options.out_dir).unwrap_or_else(|_| options.out_dir.clone());
+    if options.checkpoint.is_some() || options.resume.is_some() {
+        return Err(format!(
+            "{}: restart files are not handed to MPI ranks by the harness (--checkpoint-every, or a restart file to resume from with --reuse); run this suite without --np, or remove the run's restart files to start it again",
+            dir.display()
+        ));
+    }
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     // A summary left by an earlier run must not pass for this one's.
     let summary_path = dir.join("summary.json");
