@@ -18,7 +18,7 @@ fn shipped_cases_validate_and_coarse_grain_to_lambda_2() {
     }
 }
 
-/// `Scene::write_json` hands a scene to another process (the harness's MPI ranks): every
+/// `Scene::to_json` hands a scene to another process (the harness's MPI ranks): every
 /// shipped case, coarse-grained and re-seeded, reads back equal, to the last bit, with the
 /// same digest; an edited file is refused, naming the file and the field.
 #[test]
@@ -44,7 +44,7 @@ fn a_written_scene_reads_back_bit_for_bit_and_an_edited_one_is_refused() {
                 };
                 let scene = scene.with_insertion_seed(7);
                 let file = dir.join("scene.json");
-                scene.write_json(&file).unwrap();
+                std::fs::write(&file, scene.to_json()).unwrap();
                 let back = Scene::load(&file).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
                 assert_eq!(back.digest(), scene.digest(), "{}", path.display());
                 let mut back = back;
@@ -58,7 +58,7 @@ fn a_written_scene_reads_back_bit_for_bit_and_an_edited_one_is_refused() {
     // An edited number: the digest no longer matches.
     let file = dir.join("scene.json");
     let scene = Scene::load(Path::new("validation/cases/aor_hertz.toml")).unwrap();
-    scene.write_json(&file).unwrap();
+    std::fs::write(&file, scene.to_json()).unwrap();
     let text = std::fs::read_to_string(&file).unwrap();
     let edited = text.replacen("\"density\": ", "\"density\": 1", 1);
     assert_ne!(edited, text);

@@ -3,7 +3,7 @@
 //!
 //! The harness builds each scene in memory (the case, the suite's overrides, the
 //! coarse-graining level and rule, the seed), so the ranks are handed exactly that scene:
-//! it is written beside the run as `scene.json` ([`Scene::write_json`], every number to the
+//! it is written beside the run as `scene.json` ([`Scene::to_json`], every number to the
 //! last bit), `mpirun -np N cgdem run DIR/scene.json --grid G ...` runs it, and the run is
 //! accepted only when its `summary.json` names the same scene digest. A run on N ranks is
 //! bitwise the run on the same grid on threads (scripts/mpi-check.sh), so `--reuse` takes
@@ -135,8 +135,7 @@ fn run_as_ranks(
         _ => {}
     }
     let scene_path = dir.join("scene.json");
-    scene
-        .write_json(&scene_path)
+    cgdem_core::io::write_atomic(&scene_path, scene.to_json().as_bytes())
         .map_err(|e| format!("cannot write {}: {e}", scene_path.display()))?;
     let argv = ranks_argv(scene, options, ranks, threads, &scene_path, &dir)?;
     let runner_options = RunnerOptions {

@@ -431,7 +431,7 @@ pub struct Scene {
     pub packing: Option<PackingSettings>,
 }
 
-/// What [`Scene::write_json`] writes.
+/// What [`Scene::to_json`] writes.
 #[derive(serde::Serialize, serde::Deserialize)]
 struct WrittenScene {
     format: String,
@@ -443,7 +443,7 @@ const WRITTEN_SCENE_FORMAT: &str = "cgdem-scene-1";
 
 impl Scene {
     /// Reads and validates a scene file: TOML, or a scene cgdem wrote (`.json`, see
-    /// [`Scene::write_json`]).
+    /// [`Scene::to_json`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         Scene::load_with_overrides(path, &[])
     }
@@ -468,19 +468,19 @@ impl Scene {
         Scene::parse(&overrides::apply_overrides(&text, path, overrides)?, path)
     }
 
-    /// Writes the scene, exactly as it is (every number to the last bit), for another cgdem
-    /// process to run: the harness hands a coarse-grained, re-seeded scene to `mpirun -np N
-    /// cgdem run DIR/scene.json`. Not an input format: the file carries the scene's digest,
-    /// and [`Scene::load`] refuses one whose content no longer matches it, since a scene
-    /// read this way skips the checks a TOML scene goes through.
-    pub fn write_json(&self, path: &Path) -> std::io::Result<()> {
+    /// The scene, exactly as it is (every number to the last bit), as the text of a
+    /// `scene.json` for another cgdem process to run: the harness hands a coarse-grained,
+    /// re-seeded scene to `mpirun -np N cgdem run DIR/scene.json`. Not an input format: the
+    /// text carries the scene's digest, and [`Scene::load`] refuses a file whose content no
+    /// longer matches it, since a scene read this way skips the checks a TOML scene goes
+    /// through.
+    pub fn to_json(&self) -> String {
         let written = WrittenScene {
             format: WRITTEN_SCENE_FORMAT.into(),
             digest: self.digest(),
             scene: self.clone(),
         };
-        let text = serde_json::to_string_pretty(&written).map_err(std::io::Error::other)?;
-        crate::io::write_atomic(path, text.as_bytes())
+        serde_json::to_string_pretty(&written).expect("a scene is plain data")
     }
 
     fn from_written_json(text: &str, path: &Path) -> Result<Scene, SceneError> {
