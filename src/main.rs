@@ -78,8 +78,8 @@ impl From<CgRule> for CoarseGrainRule {
     }
 }
 
-/// `cgdem --version`; a build with MPI says so (`cgdem bench --np` looks for
-/// `cgdem_harness::bench::MPI_MARK` in it).
+/// `cgdem --version`; a build with MPI says so (`bench --np` and `validate --np` look for
+/// `cgdem_harness::ranks::MPI_MARK` in it).
 #[cfg(feature = "mpi")]
 const VERSION: &str = concat!(
     env!("CARGO_PKG_VERSION"),

@@ -649,8 +649,6 @@ fn check_ranks(options: &BenchOptions) -> Result<Option<PathBuf>, BenchError> {
         .map_err(BenchError::Ranks)
 }
 
-pub use crate::ranks::MPI_MARK;
-
 /// The scene overrides that make a case file's scene the bench's timed scene (as
 /// `with_duration` makes it): one stage of `duration`, one output row at its end, no VTK.
 fn timed_overrides(duration: Real) -> Vec<String> {
