@@ -242,7 +242,8 @@ mod tests {
 
     #[test]
     fn the_ranks_run_the_written_scene_on_the_grid_in_the_harness_directory() {
-        let scene = Scene::load(Path::new("../../validation/cases/aor_hertz.toml")).unwrap();
+        crate::at_repo_root();
+        let scene = Scene::load(Path::new("validation/cases/aor_hertz.toml")).unwrap();
         let options = RunOptions {
             out_dir: "/tmp/x".into(),
             grid: Some("2x1x1".parse::<GridSpec>().unwrap()),
@@ -297,7 +298,8 @@ mod tests {
             stop: Some(stop),
             ..Default::default()
         };
-        let scene = Scene::load(Path::new("../../tests/data/tiny_hertz_collapse.toml")).unwrap();
+        crate::at_repo_root();
+        let scene = Scene::load(Path::new("tests/data/tiny_hertz_collapse.toml")).unwrap();
         let e = run_scene(&scene, &options, None).unwrap_err();
         assert!(e.contains("not started"), "{e}");
         assert!(!dir.exists(), "the run's directory was created");
