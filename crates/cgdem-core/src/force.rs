@@ -167,14 +167,16 @@ pub(crate) fn body_force<W: WallLaw>(
     dt: Real,
 ) -> (Vec3, BodyLoad, Real) {
     let reach = law.reach(particle.species, particle.radius);
-    let Some((distance, normal)) = body.query(particle.position, reach) else {
+    let Some(sample) = body.sample(particle.position, reach) else {
         return (Vec3::ZERO, BodyLoad::default(), 0.0);
     };
+    let distance = sample.distance();
     let overlap = overlap_fraction(distance, particle.radius);
     // A centre inside the body has passed through it: no force (as for planar walls).
     if distance <= 0.0 || distance >= reach {
         return (Vec3::ZERO, BodyLoad::default(), overlap);
     }
+    let normal = sample.normal();
     let contact_point = particle.position - distance * normal;
     let contact = WallContact {
         species: particle.species,
@@ -210,15 +212,17 @@ pub(crate) fn body_force_and_torque<W: WallLaw>(
             *history = W::History::default();
         }
     };
-    let Some((distance, normal)) = body.query(particle.position, reach) else {
+    let Some(sample) = body.sample(particle.position, reach) else {
         reset(history);
         return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), 0.0);
     };
+    let distance = sample.distance();
     let overlap = overlap_fraction(distance, particle.radius);
     if distance <= 0.0 || distance >= reach {
         reset(history);
         return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), overlap);
     }
+    let normal = sample.normal();
     let contact_point = particle.position - distance * normal;
     let contact = WallContact {
         species: particle.species,

@@ -2,6 +2,7 @@
 
 use glam::{DMat3, DQuat};
 
+use super::shape::ShapeSample;
 use super::{BodyShape, Motion};
 use crate::geometry::Aabb;
 use crate::math::{Real, Vec3};
@@ -160,6 +161,19 @@ impl Body {
         Some((distance, self.rotation * normal))
     }
 
+    /// As [`Body::query`], the normal computed only when asked for ([`BodySample::normal`]).
+    #[inline(always)]
+    pub fn sample(&self, p: Vec3, reach: Real) -> Option<BodySample> {
+        let b = &self.world_bounds;
+        if p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any() {
+            return None;
+        }
+        Some(BodySample {
+            shape: self.shape.sample(self.to_body(p))?,
+            rotation: self.rotation,
+        })
+    }
+
     /// Velocity of the body's material at world point `p`: `v + omega x (p - c)`.
     #[inline(always)]
     pub fn surface_velocity(&self, p: Vec3) -> Vec3 {
@@ -188,6 +202,24 @@ impl Body {
             return 0.0;
         }
         -(self.load.torque.dot(self.motion.omega()) + self.load.force.dot(self.motion.velocity))
+    }
+}
+
+/// A body's signed distance at a world point, and its world normal there on demand.
+#[derive(Clone, Copy, Debug)]
+pub struct BodySample {
+    shape: ShapeSample,
+    rotation: DMat3,
+}
+
+impl BodySample {
+    pub fn distance(&self) -> Real {
+        self.shape.distance()
+    }
+
+    /// The outward unit normal in the world frame.
+    pub fn normal(&self) -> Vec3 {
+        self.rotation * self.shape.normal()
     }
 }
 

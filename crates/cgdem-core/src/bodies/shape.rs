@@ -1,6 +1,6 @@
 //! The shape of a body in its own frame: a signed-distance grid or an analytic SDF.
 
-use crate::geometry::{Aabb, AxisAlignedBox, Cylinder, Sdf, SdfGrid, Sphere};
+use crate::geometry::{Aabb, AxisAlignedBox, Cylinder, GridSample, Sdf, SdfGrid, Sphere};
 use crate::math::{Real, Vec3};
 
 /// A body's shape in the body frame. An enum rather than a trait object: the match is
@@ -17,6 +17,32 @@ pub enum BodyShape {
     Particles(Aabb),
 }
 
+/// A shape's signed distance at a point, with its normal there: computed on demand for a
+/// grid (its gradient is most of a query's cost, and only touching particles need it),
+/// already known for an analytic shape.
+#[derive(Clone, Copy, Debug)]
+pub enum ShapeSample {
+    Grid(GridSample),
+    Exact(Real, Vec3),
+}
+
+impl ShapeSample {
+    pub fn distance(&self) -> Real {
+        match self {
+            ShapeSample::Grid(s) => s.distance,
+            ShapeSample::Exact(d, _) => *d,
+        }
+    }
+
+    /// The outward unit normal, in the shape's frame.
+    pub fn normal(&self) -> Vec3 {
+        match self {
+            ShapeSample::Grid(s) => s.normal(),
+            ShapeSample::Exact(_, n) => *n,
+        }
+    }
+}
+
 impl BodyShape {
     /// Signed distance (negative inside) and outward unit normal at `p`, or `None` where the
     /// shape has no data (outside a grid).
@@ -28,6 +54,15 @@ impl BodyShape {
             BodyShape::Cylinder(c) => Some((c.distance(p), c.normal(p))),
             BodyShape::Box(b) => Some((b.distance(p), b.normal(p))),
             BodyShape::Particles(_) => None,
+        }
+    }
+
+    /// As [`BodyShape::query`], the normal left to be computed when asked for.
+    #[inline(always)]
+    pub fn sample(&self, p: Vec3) -> Option<ShapeSample> {
+        match self {
+            BodyShape::Grid(grid) => grid.sample(p).map(ShapeSample::Grid),
+            _ => self.query(p).map(|(d, n)| ShapeSample::Exact(d, n)),
         }
     }
 

@@ -22,7 +22,7 @@ pub use analytic::{
 pub use bvh::{Bvh, Nearest};
 pub use finite_plane::FinitePlane;
 pub use mesh::{EdgeDefect, TopologyReport, TriMesh};
-pub use sdf_grid::{SdfGrid, SdfGridError};
+pub use sdf_grid::{GridSample, SdfGrid, SdfGridError};
 pub use stl::{read_stl, read_stl_unchecked, write_stl_ascii, write_stl_binary, StlError};
 pub use triangle_distance::{closest_point_on_triangle, TriangleFeature};
 pub use winding_number::{winding_number, FastWindingNumber};

@@ -208,17 +208,29 @@ impl SdfGrid {
     /// Signed distance and unit normal at `p`, or `None` outside the grid. The normal is the
     /// normalized gradient of the trilinear interpolant (zero where that gradient vanishes).
     pub fn query(&self, p: Vec3) -> Option<(Real, Vec3)> {
+        self.sample(p).map(|s| (s.distance, s.normal()))
+    }
+
+    /// The signed distance at `p`, with what its normal needs ([`GridSample::normal`]), or
+    /// `None` outside the grid: a contact test needs the distance of every particle near the
+    /// body, the normal only of those that touch it.
+    pub fn sample(&self, p: Vec3) -> Option<GridSample> {
         let u = (p - self.origin) / self.cell_size;
         for a in 0..3 {
             if !(u[a] >= 0.0 && u[a] <= (self.dims[a] - 1) as Real) {
                 return None; // also rejects NaN
             }
         }
-        Some(self.interpolate_at(u))
+        Some(self.sample_at(u))
     }
 
     /// Interpolates at continuous node coordinates `u`, clamped into the grid.
     fn interpolate_at(&self, u: Vec3) -> (Real, Vec3) {
+        let s = self.sample_at(u);
+        (s.distance, s.normal())
+    }
+
+    fn sample_at(&self, u: Vec3) -> GridSample {
         let mut cell = [0usize; 3];
         let mut t = [0.0; 3];
         for a in 0..3 {
@@ -229,33 +241,73 @@ impl SdfGrid {
             cell[a] = c;
             t[a] = ua - c as Real;
         }
-        self.interpolate(cell, t)
-    }
-
-    fn interpolate(&self, [i, j, k]: [usize; 3], [tx, ty, tz]: [Real; 3]) -> (Real, Vec3) {
+        let [i, j, k] = cell;
         let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
         let base = i + nx * j + nxy * k;
         let v = |o: usize| self.values[base + o] as Real;
-        let (v000, v100, v010, v110) = (v(0), v(1), v(nx), v(nx + 1));
-        let (v001, v101, v011, v111) = (v(nxy), v(nxy + 1), v(nxy + nx), v(nxy + nx + 1));
-        let lerp = |a: Real, b: Real, t: Real| a + (b - a) * t;
-        let c00 = lerp(v000, v100, tx);
-        let c10 = lerp(v010, v110, tx);
-        let c01 = lerp(v001, v101, tx);
-        let c11 = lerp(v011, v111, tx);
-        let c0 = lerp(c00, c10, ty);
-        let c1 = lerp(c01, c11, ty);
-        let distance = lerp(c0, c1, tz);
-        // Exact partial derivatives of the trilinear interpolant.
+        let corners = [
+            v(0),
+            v(1),
+            v(nx),
+            v(nx + 1),
+            v(nxy),
+            v(nxy + 1),
+            v(nxy + nx),
+            v(nxy + nx + 1),
+        ];
+        let [c00, c10, c01, c11] = GridSample::edges(&corners, t[0]);
+        let (c0, c1) = (lerp(c00, c10, t[1]), lerp(c01, c11, t[1]));
+        GridSample {
+            corners,
+            t,
+            distance: lerp(c0, c1, t[2]),
+        }
+    }
+}
+
+/// The trilinear interpolant at one point of an [`SdfGrid`]: its value, and the cell's
+/// corner values for the normal.
+#[derive(Clone, Copy, Debug)]
+pub struct GridSample {
+    /// v000, v100, v010, v110, v001, v101, v011, v111.
+    corners: [Real; 8],
+    t: [Real; 3],
+    pub distance: Real,
+}
+
+impl GridSample {
+    /// The interpolant along x on the cell's four x edges: c00, c10, c01, c11.
+    fn edges(v: &[Real; 8], tx: Real) -> [Real; 4] {
+        [
+            lerp(v[0], v[1], tx),
+            lerp(v[2], v[3], tx),
+            lerp(v[4], v[5], tx),
+            lerp(v[6], v[7], tx),
+        ]
+    }
+
+    /// The normalized gradient of the trilinear interpolant (zero where it vanishes): the
+    /// exact partial derivatives, computed as they were with the distance, so that the
+    /// normal is the same to the bit whether asked for or not.
+    pub fn normal(&self) -> Vec3 {
+        let v = &self.corners;
+        let [tx, ty, tz] = self.t;
+        let [c00, c10, c01, c11] = Self::edges(v, tx);
+        let (c0, c1) = (lerp(c00, c10, ty), lerp(c01, c11, ty));
         let gx = lerp(
-            lerp(v100 - v000, v110 - v010, ty),
-            lerp(v101 - v001, v111 - v011, ty),
+            lerp(v[1] - v[0], v[3] - v[2], ty),
+            lerp(v[5] - v[4], v[7] - v[6], ty),
             tz,
         );
         let gy = lerp(c10 - c00, c11 - c01, tz);
         let gz = c1 - c0;
-        (distance, Vec3::new(gx, gy, gz).normalize_or_zero())
+        Vec3::new(gx, gy, gz).normalize_or_zero()
     }
+}
+
+#[inline(always)]
+fn lerp(a: Real, b: Real, t: Real) -> Real {
+    a + (b - a) * t
 }
 
 /// Outside the grid the distance continues as `d(q) + |p - q|` with `q` the nearest grid
