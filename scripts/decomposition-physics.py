@@ -282,6 +282,14 @@ def item_heap(a):
 # ---- Hertz collapse -----------------------------------------------------------------------
 
 
+def two_means(a, b):
+    """Means and seed standard deviations of two samples (at least two values each), and the
+    standard error of the difference of the means."""
+    m1, m2 = statistics.mean(a), statistics.mean(b)
+    s1, s2 = statistics.stdev(a), statistics.stdev(b)
+    return m1, s1, m2, s2, math.sqrt(s1 ** 2 / len(a) + s2 ** 2 / len(b))
+
+
 def item_hertz(a):
     runs, out = Path(a.runs) / "hertz", Path(a.out)
     rows = []
@@ -317,9 +325,7 @@ def item_hertz(a):
             print(f"grid {g}: {statistics.mean(v):.3f} +- {statistics.stdev(v):.3f} deg (n={len(v)})")
     summary = []
     if len(stats["none"]) > 1 and len(stats["2x1x1"]) > 1:
-        m1, m2 = statistics.mean(stats["none"]), statistics.mean(stats["2x1x1"])
-        s1, s2 = statistics.stdev(stats["none"]), statistics.stdev(stats["2x1x1"])
-        se = math.sqrt(s1 ** 2 / len(stats["none"]) + s2 ** 2 / len(stats["2x1x1"]))
+        m1, s1, m2, s2, se = two_means(stats["none"], stats["2x1x1"])
         summary.append({"grid": "none", "n": len(stats["none"]), "mean_deg": m1, "seed_sd_deg": s1})
         summary.append({"grid": "2x1x1", "n": len(stats["2x1x1"]), "mean_deg": m2, "seed_sd_deg": s2,
                         "d_mean_deg": m2 - m1, "se_of_difference_deg": se,
@@ -375,9 +381,7 @@ def item_screw(a):
                      if r["case"] == case and r["grid"] == g and "mass_flow_kg_s" in r]
                  for g in ("none", "2x1x1")}
         if all(len(v) > 1 for v in flows.values()):
-            m1, m2 = (statistics.mean(flows[g]) for g in ("none", "2x1x1"))
-            s1, s2 = (statistics.stdev(flows[g]) for g in ("none", "2x1x1"))
-            se = math.sqrt(s1 ** 2 / len(flows["none"]) + s2 ** 2 / len(flows["2x1x1"]))
+            m1, s1, m2, s2, se = two_means(flows["none"], flows["2x1x1"])
             summary.append({"case": case, "grid": "none", "n": len(flows["none"]),
                             "mean_kg_s": m1, "seed_sd_kg_s": s1})
             summary.append({"case": case, "grid": "2x1x1", "n": len(flows["2x1x1"]),

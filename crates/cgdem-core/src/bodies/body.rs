@@ -163,14 +163,14 @@ impl Body {
 
     /// As [`Body::query`], the normal computed only when asked for ([`BodySample::normal`]).
     #[inline(always)]
-    pub fn sample(&self, p: Vec3, reach: Real) -> Option<BodySample> {
+    pub fn sample(&self, p: Vec3, reach: Real) -> Option<BodySample<'_>> {
         let b = &self.world_bounds;
         if p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any() {
             return None;
         }
         Some(BodySample {
             shape: self.shape.sample(self.to_body(p))?,
-            rotation: self.rotation,
+            rotation: &self.rotation,
         })
     }
 
@@ -207,19 +207,20 @@ impl Body {
 
 /// A body's signed distance at a world point, and its world normal there on demand.
 #[derive(Clone, Copy, Debug)]
-pub struct BodySample {
+pub struct BodySample<'b> {
     shape: ShapeSample,
-    rotation: DMat3,
+    /// The body's, borrowed: the sample is taken per particle and body every step.
+    rotation: &'b DMat3,
 }
 
-impl BodySample {
+impl BodySample<'_> {
     pub fn distance(&self) -> Real {
         self.shape.distance()
     }
 
     /// The outward unit normal in the world frame.
     pub fn normal(&self) -> Vec3 {
-        self.rotation * self.shape.normal()
+        *self.rotation * self.shape.normal()
     }
 }
 
