@@ -2,8 +2,10 @@
 # The MPI transport of the decomposed step (issue 23): installs OpenMPI (as root with apt),
 # builds cgdem with `--features mpi` in the workspace's target directory, and checks that
 # the tiny Hertz collapse on 2 MPI ranks (and on 4 oversubscribed ranks) writes bitwise the
-# CSVs the same --grid writes on threads in one process, and that `validate --np 2` runs the
-# harness's cgdem runs as ranks with the same CSVs. A few seconds beyond the build
+# CSVs the same --grid writes on threads in one process, that `validate --np 2` runs the
+# harness's cgdem runs as ranks with the same CSVs, and that its ranks resume a killed run
+# from the restart files threads or ranks wrote (`--checkpoint-every`, `--reuse`), bitwise.
+# A few seconds beyond the build
 # (none when scripts/test.sh has built the workspace with --features mpi already).
 # Usage: bash scripts/mpi-check.sh [--prepare]
 #   --prepare: only install what the MPI build needs; exit 0 when it is there, 1 when not
@@ -77,3 +79,33 @@ for f in timeseries.csv repose.csv profile.csv; do
     cmp "$out/validate-threads/$run/$f" "$out/validate-ranks/$run/$f"
 done
 echo "validate --np 2: the harness's runs as MPI ranks write bitwise the CSVs of 2 threads"
+
+# Restart files under `validate --np` (`--checkpoint-every`, then `--reuse`): a run whose
+# restart files the harness's threads wrote, and one whose files the ranks wrote, each as a
+# kill after a checkpoint leaves it (no summary, the newest file gone, so the resume starts
+# before the end), go on as 2 ranks to bitwise the CSVs of the uninterrupted run.
+resume_check() { # WRITER_ARGS...
+    local dir=$out/validate-resume
+    rm -rf "$dir"
+    "$bin" validate --suite "$suite" --grid 2x1x1 --balance 1.0 --threads 2 --quiet \
+        --checkpoint-every 0.04 --out "$dir" "$@" >/dev/null
+    [ -f "$dir/$run/restart.prev.cgr" ] || {
+        echo "validate --checkpoint-every $*: no restart files in $dir/$run"
+        exit 1
+    }
+    rm "$dir/$run/summary.json"
+    mv "$dir/$run/restart.prev.cgr" "$dir/$run/restart.cgr"
+    "$bin" validate --suite "$suite" --grid 2x1x1 --balance 1.0 --np 2 --threads 2 --quiet \
+        --checkpoint-every 0.04 --reuse --out "$dir" >"$dir/resume.log" 2>&1
+    grep -q "resuming" "$dir/$run/stdout.txt" || {
+        echo "validate --np 2 --reuse: the ranks did not resume $dir/$run (see its stdout.txt)"
+        exit 1
+    }
+    grep -q '"ranks": 2' "$dir/$run/summary.json"
+    for f in timeseries.csv repose.csv profile.csv; do
+        cmp "$out/validate-threads/$run/$f" "$dir/$run/$f"
+    done
+}
+resume_check
+resume_check --np 2
+echo "validate --np 2 --checkpoint-every: ranks resume from restart files threads or ranks wrote, bitwise"

@@ -103,9 +103,11 @@ struct Cli {
 enum Command {
     /// Run a scene (a TOML case file) and write its outputs.
     Run {
-        /// The scene file, e.g. validation/cases/aor_collapse.toml (not with --resume), or the
-        /// `scene.json` a harness run wrote (`validate --np`), run as written.
-        #[arg(required_unless_present = "resume", conflicts_with = "resume")]
+        /// The scene file, e.g. validation/cases/aor_collapse.toml, or the `scene.json` a
+        /// harness run wrote (`validate --np`), run as written. With --resume it names the
+        /// scene to continue instead of the command line the run stored (the digests must
+        /// match): how `validate --np` resumes the runs it started.
+        #[arg(required_unless_present = "resume")]
         case: Option<PathBuf>,
         /// Coarse-graining level: a power of two (1 = the original, uncoarsened system).
         /// Diameters grow by lambda, the particle count falls by lambda^3 (paper A Eq. 3-6).
@@ -183,16 +185,17 @@ enum Command {
         /// Write a restart file (OUT/restart.cgr, the one before kept as restart.prev.cgr)
         /// every this many simulated seconds, at the start, at every stage end and when
         /// SIGINT/SIGTERM stops the run. Not with --sweep. With --grid it holds the
-        /// subdomains (gathered from every rank; rank 0 writes it).
+        /// subdomains (gathered from every rank; rank 0 writes it). With --resume: the
+        /// interval from the resumed checkpoint on (default: the stored one).
         #[arg(long, value_name = "SECONDS")]
         checkpoint_every: Option<f64>,
         /// Continue the run in DIR from its newest usable restart file: the case file and
-        /// options (--lambda, --set, --grid, ...) are the ones the run stored, and the
-        /// scene's digest must match the stored one. Outputs come out as those of an
+        /// options (--lambda, --set, --grid, ...) are the ones the run stored, unless a scene
+        /// file is given, and the scene's digest must match the stored one. Outputs come out as those of an
         /// uninterrupted run (with --grid: on the same grid, on any number of threads or MPI
         /// ranks). `--grid` here continues a decomposed run on another grid, from the stored
         /// particles (to rounding, not bitwise).
-        #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "sweep", "set", "seed", "variant", "checkpoint_every", "strict"])]
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "sweep", "set", "seed", "variant", "strict"])]
         resume: Option<PathBuf>,
         /// Start from the particles of this state file instead of the scene's insertions
         /// (`cgdem bench --np` writes its prepared state into one for the ranks it starts).
@@ -258,8 +261,9 @@ enum Command {
         cgdem_bin: Option<PathBuf>,
         /// cgdem's case and accuracy runs write restart files this many simulated seconds
         /// apart (as `cgdem run --checkpoint-every`); with --reuse, a run killed in an
-        /// earlier attempt goes on from its last one instead of starting again.
-        #[arg(long, value_name = "SECONDS", conflicts_with = "np")]
+        /// earlier attempt goes on from its last one instead of starting again (with --np,
+        /// as ranks, from a file the ranks or threads on the same grid wrote).
+        #[arg(long, value_name = "SECONDS")]
         checkpoint_every: Option<f64>,
     },
     /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
@@ -919,16 +923,17 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             }
-            // What rebuilds the scene: this command line, or the one a resumed run stored.
-            let (invocation, resumed) = match &resume {
-                Some(dir) => match RunInvocation::resumed(dir) {
+            // What rebuilds the scene: this command line, or the one a resumed run stored
+            // when no scene file is given.
+            let (invocation, resumed) = match (&resume, &case) {
+                (Some(dir), None) => match RunInvocation::resumed(dir) {
                     Ok((inv, loaded)) => (inv, Some(loaded)),
                     Err(e) => {
                         eprintln!("error: {e}");
                         return ExitCode::FAILURE;
                     }
                 },
-                None => (
+                (resume, _) => (
                     RunInvocation {
                         case: case
                             .clone()
@@ -944,7 +949,18 @@ fn main() -> ExitCode {
                         grid: grid.map(|g| g.to_string()),
                         balance: grid.map(|_| balance.to_string()),
                     },
-                    None,
+                    match resume.as_deref().map(restart::read_latest).transpose() {
+                        Ok(loaded) => {
+                            if let Some(l) = &loaded {
+                                eprintln!("resuming from {}", l.path.display());
+                            }
+                            loaded.map(std::sync::Arc::new)
+                        }
+                        Err(e) => {
+                            eprintln!("error: {e}");
+                            return ExitCode::FAILURE;
+                        }
+                    },
                 ),
             };
             // A resumed run keeps its grid and balance unless given another grid.

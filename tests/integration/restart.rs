@@ -215,6 +215,38 @@ fn grid_runs_resume_bit_for_bit_on_their_grid_and_go_on_on_another() {
         serde_json::json!([1, 1, 2])
     );
     assert_eq!(summary(&dir)["steps"], summary(&reference)["steps"]);
+    // With the scene file given (as `validate --np` resumes its runs), the scene comes from
+    // it, not from the stored command line: bit for bit again, and another scene is refused.
+    let dir = killed_copy(&reference, "grid-case-given", |b| b.truncate(b.len() / 2));
+    let given = |case: &str| {
+        cgdem(
+            &[
+                "run",
+                case,
+                "--quiet",
+                "--threads",
+                "1",
+                "--grid",
+                "2x1x1",
+                "--resume",
+            ],
+            &dir,
+        )
+    };
+    let out = given("tests/data/tiny_drop.toml");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("written for a scene with digest")
+            && stderr.contains("tiny_drop.toml")
+            && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    let out = given("tests/data/tiny_hertz_collapse.toml");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("restart.prev.cgr"), "{stderr}");
+    assert_same_outputs(&reference, &dir);
     // A checkpoint of a run without --grid is not resumed with one.
     let plain = tmp("grid-plain");
     let run = cgdem(

@@ -7,7 +7,10 @@
 //! last bit), `mpirun -np N cgdem run DIR/scene.json --grid G ...` runs it, and the run is
 //! accepted only when its `summary.json` names the same scene digest. A run on N ranks is
 //! bitwise the run on the same grid on threads (scripts/mpi-check.sh), so `--reuse` takes
-//! either for the other.
+//! either for the other. Restart files too: with `--checkpoint-every` the ranks write them
+//! (rank 0 gathers), and a run killed in an earlier attempt goes on as ranks from its last
+//! one (`cgdem run DIR/scene.json --resume DIR`: the scene is the written one, not the
+//! command line the file stores, so it may have been written by threads in the harness).
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -119,12 +122,6 @@ fn run_as_ranks(
     threads: usize,
 ) -> Result<RunSummary, String> {
     let dir = std::path::absolute(&options.out_dir).unwrap_or_else(|_| options.out_dir.clone());
-    if options.checkpoint.is_some() || options.resume.is_some() {
-        return Err(format!(
-            "{}: restart files are not handed to MPI ranks by the harness (--checkpoint-every, or a restart file to resume from with --reuse); run this suite without --np, or remove the run's restart files to start it again",
-            dir.display()
-        ));
-    }
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     // A summary left by an earlier run must not pass for this one's.
     let summary_path = dir.join("summary.json");
@@ -197,10 +194,19 @@ fn ranks_argv(
         options.balance.to_string(),
         "--threads".into(),
         threads.max(1).to_string(),
-        "--out".into(),
-        dir.display().to_string(),
         "--quiet".into(),
     ]);
+    // A run killed in an earlier attempt goes on from the restart file the harness found
+    // (`options.resume`, checked to hold this scene): the ranks read it from the run's
+    // directory, which is then their output directory too.
+    if options.resume.is_some() {
+        argv.extend(["--resume".into(), dir.display().to_string()]);
+    } else {
+        argv.extend(["--out".into(), dir.display().to_string()]);
+    }
+    if let Some(c) = &options.checkpoint {
+        argv.extend(["--checkpoint-every".into(), c.every.to_string()]);
+    }
     if options.keep_going {
         argv.push("--keep-going".into());
     }
@@ -241,7 +247,7 @@ mod tests {
     use cgdem_core::decomposition::BalanceSpec;
 
     #[test]
-    fn the_ranks_run_the_written_scene_on_the_grid_in_the_harness_directory() {
+    fn the_ranks_run_the_written_scene_on_the_grid_in_the_harness_directory_with_its_checkpoints() {
         crate::at_repo_root();
         let scene = Scene::load(Path::new("validation/cases/aor_hertz.toml")).unwrap();
         let options = RunOptions {
@@ -249,6 +255,10 @@ mod tests {
             grid: Some("2x1x1".parse::<GridSpec>().unwrap()),
             balance: BalanceSpec::Shift(1.2),
             keep_going: true,
+            checkpoint: Some(cgdem_core::run::CheckpointOptions {
+                every: 0.25,
+                invocation: "cgdem validate".into(),
+            }),
             ..Default::default()
         };
         let ranks = Ranks {
@@ -269,7 +279,7 @@ mod tests {
         assert!(line.starts_with("mpirun --allow-run-as-root"), "{line}");
         assert!(
             line.contains(&format!(
-                "-np 2 -wdir {} /opt/cgdem run /tmp/x/scene.json --cg-rule seed --grid 2x1x1 --balance 1.2 --threads 1 --out /tmp/x --quiet --keep-going",
+                "-np 2 -wdir {} /opt/cgdem run /tmp/x/scene.json --cg-rule seed --grid 2x1x1 --balance 1.2 --threads 1 --quiet --out /tmp/x --checkpoint-every 0.25 --keep-going",
                 here.display()
             )),
             "{line}"
