@@ -2,7 +2,7 @@
 //! borrows, one listed pair seen from its owner, and a body acting on one particle. Generic
 //! over the laws and inlined into each pass, so both compile to the same loop body.
 
-use crate::bodies::{Body, BodyLoad};
+use crate::bodies::{Body, BodyLoad, Clearance};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
@@ -158,16 +158,20 @@ pub(crate) fn pair_force<L: PairLaw>(
 
 /// Force of one body on one particle (the wall law with the SDF distance and normal and the
 /// velocity relative to the body's surface), the particle's load on the body and its overlap
-/// with the body as a fraction of the radius.
+/// with the body as a fraction of the radius. `clearance`: the particle's for this body,
+/// which spares lookups far from it (the result is the same).
 #[inline(always)]
 pub(crate) fn body_force<W: WallLaw>(
     body: &Body,
     law: &W,
     particle: &WallParticle,
+    clearance: &mut Clearance,
     dt: Real,
 ) -> (Vec3, BodyLoad, Real) {
     let reach = law.reach(particle.species, particle.radius);
-    let Some(sample) = body.sample(particle.position, reach) else {
+    // Beyond both the reach and the radius: no force, and no overlap for the guard.
+    let beyond = reach.max(particle.radius);
+    let Some(sample) = body.sample_near(particle.position, reach, beyond, clearance) else {
         return (Vec3::ZERO, BodyLoad::default(), 0.0);
     };
     let distance = sample.distance();
@@ -204,15 +208,17 @@ pub(crate) fn body_force_and_torque<W: WallLaw>(
     particle: &WallParticle,
     omega: Vec3,
     history: &mut W::History,
+    clearance: &mut Clearance,
     dt: Real,
 ) -> (Vec3, Vec3, BodyLoad, Real) {
     let reach = law.reach(particle.species, particle.radius);
+    let beyond = reach.max(particle.radius);
     let reset = |history: &mut W::History| {
         if *history != W::History::default() {
             *history = W::History::default();
         }
     };
-    let Some(sample) = body.sample(particle.position, reach) else {
+    let Some(sample) = body.sample_near(particle.position, reach, beyond, clearance) else {
         reset(history);
         return (Vec3::ZERO, Vec3::ZERO, BodyLoad::default(), 0.0);
     };

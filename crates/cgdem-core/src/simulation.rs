@@ -10,7 +10,7 @@ pub use network::{ContactNetwork, PairContact};
 
 use rayon::prelude::*;
 
-use crate::bodies::{Body, BodyLoad, KinematicParticles};
+use crate::bodies::{Body, BodyLoad, Clearance, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::{Contact, PairLaw};
 use crate::decomposition::step::{Decomposition, Drive, Physics};
@@ -130,6 +130,9 @@ pub struct World<L: PairLaw, W: WallLaw> {
     /// Per particle, per body (particle-major) load, reduced in fixed order after the owner
     /// pass.
     body_loads: Vec<BodyLoad>,
+    /// Per particle, per body (particle-major): where it needs no SDF lookup. Not part of
+    /// the state: it only spares work, so a world without it steps on the same.
+    body_clearances: Vec<Clearance>,
     /// Frozen particles that move with a body (a body built of particles).
     kinematic: Vec<KinematicParticles>,
     /// Particles whose centre enters one of these boxes are deleted (e.g. an outlet).
@@ -200,6 +203,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             reaction_spin: Vec::new(),
             bodies: Vec::new(),
             body_loads: Vec::new(),
+            body_clearances: Vec::new(),
             kinematic: Vec::new(),
             delete_regions: Vec::new(),
             deleted: 0,
@@ -323,6 +327,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.bodies = bodies;
         // Bodies take history slots after the planar walls': start them empty.
         self.wall_history.clear();
+        self.body_clearances.clear();
         let time = self.time;
         for body in &mut self.bodies {
             body.set_time(time);
@@ -482,6 +487,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         let particle_bytes = p.array_bytes()
             + bytes(&self.wall_history)
             + bytes(&self.body_loads)
+            + bytes(&self.body_clearances)
             + bytes(&self.old_force)
             + bytes(&self.old_torque)
             + self.list.particle_bytes();
@@ -784,11 +790,16 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         }
         let n_bodies = self.bodies.len();
         self.body_loads.resize(n * n_bodies, BodyLoad::default());
+        // Allocated to the size exactly, so that the memory summary.json reports does not
+        // depend on the run's history (a resumed run starts without clearances).
+        if self.body_clearances.len() != n * n_bodies {
+            self.body_clearances = vec![Clearance::NONE; n * n_bodies];
+        }
         let ForceView {
+            id,
             state,
             force,
             torque,
-            ..
         } = ParticleState::split(&mut self.particles);
         let pass = OwnerPass {
             law: &self.law,
@@ -801,6 +812,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             out_start: &self.list.out_start,
             walls: &self.walls,
             bodies: &self.bodies,
+            ids: id,
             gravity: self.gravity,
             rotates: Self::ROTATES,
             wall_slots,
@@ -816,6 +828,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 reaction_spin: &mut self.reaction_spin,
                 wall_history: &mut self.wall_history,
                 body_loads: &mut self.body_loads,
+                body_clearances: &mut self.body_clearances,
             },
         );
         self.guard.pair_overlap = deepest.pairs;
@@ -1002,6 +1015,8 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             comm,
         );
         self.decomposition = Some(Box::new(decomposition));
+        // The subdomains keep their own clearances.
+        self.body_clearances = Vec::new();
         self.decomposed_forces(None);
         // The forces live in the subdomains: gather them (every rank).
         self.sync_particles();
@@ -1658,6 +1673,8 @@ struct OwnerPass<'a, L: PairLaw, W: WallLaw> {
     out_start: &'a [u32],
     walls: &'a WallSet,
     bodies: &'a [Body],
+    /// The particles' ids, which key their body clearances.
+    ids: &'a [u32],
     gravity: Vec3,
     /// Whether torques are summed and stored (a constant of the world's laws).
     rotates: bool,
@@ -1676,6 +1693,7 @@ struct OwnerSlices<'s, H, WH> {
     reaction_spin: &'s mut [[Vec3; 2]],
     wall_history: &'s mut [WH],
     body_loads: &'s mut [BodyLoad],
+    body_clearances: &'s mut [Clearance],
 }
 
 impl<'s, H, WH> OwnerSlices<'s, H, WH> {
@@ -1695,6 +1713,7 @@ impl<'s, H, WH> OwnerSlices<'s, H, WH> {
         let (wall_history_a, wall_history_b) =
             split_or_empty(self.wall_history, particles * wall_slots);
         let (body_loads_a, body_loads_b) = self.body_loads.split_at_mut(particles * bodies);
+        let (clearances_a, clearances_b) = self.body_clearances.split_at_mut(particles * bodies);
         (
             OwnerSlices {
                 force: force_a,
@@ -1704,6 +1723,7 @@ impl<'s, H, WH> OwnerSlices<'s, H, WH> {
                 reaction_spin: reaction_spin_a,
                 wall_history: wall_history_a,
                 body_loads: body_loads_a,
+                body_clearances: clearances_a,
             },
             OwnerSlices {
                 force: force_b,
@@ -1713,6 +1733,7 @@ impl<'s, H, WH> OwnerSlices<'s, H, WH> {
                 reaction_spin: reaction_spin_b,
                 wall_history: wall_history_b,
                 body_loads: body_loads_b,
+                body_clearances: clearances_b,
             },
         )
     }
@@ -1825,6 +1846,8 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
         };
         let n_bodies = self.bodies.len();
         let loads = &mut out.body_loads[local * n_bodies..(local + 1) * n_bodies];
+        let clearances = &mut out.body_clearances[local * n_bodies..(local + 1) * n_bodies];
+        let id = self.ids[i];
         let mut overlap;
         if self.rotates {
             let slots = &mut out.wall_history[local * self.wall_slots..][..self.wall_slots];
@@ -1845,13 +1868,15 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
                 force += f;
                 overlap = o;
             }
-            for ((body, load), history) in self.bodies.iter().zip(loads).zip(body_history) {
+            let with_history = self.bodies.iter().zip(loads).zip(body_history);
+            for (((body, load), history), clearance) in with_history.zip(clearances) {
                 let (f, t, l, o) = body_force_and_torque(
                     body,
                     self.wall_law,
                     &particle,
                     owner.omega,
                     history,
+                    clearance.follow(id),
                     self.dt,
                 );
                 force += f;
@@ -1864,8 +1889,14 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
             let (f, o) = self.walls.force_on(self.wall_law, &particle, self.dt);
             force += f;
             overlap = o;
-            for (body, load) in self.bodies.iter().zip(loads) {
-                let (f, l, o) = body_force(body, self.wall_law, &particle, self.dt);
+            for ((body, load), clearance) in self.bodies.iter().zip(loads).zip(clearances) {
+                let (f, l, o) = body_force(
+                    body,
+                    self.wall_law,
+                    &particle,
+                    clearance.follow(id),
+                    self.dt,
+                );
                 force += f;
                 *load = l;
                 overlap = larger(overlap, o);

@@ -6,7 +6,7 @@ mod motion;
 mod particle_body;
 mod shape;
 
-pub use body::{Body, BodyLoad, BodySample, BodyState};
+pub use body::{Body, BodyLoad, BodySample, BodyState, Clearance};
 pub use motion::Motion;
 pub use particle_body::{fcc_sites_inside, KinematicParticles};
 pub use shape::{BodyShape, ShapeSample};

@@ -66,6 +66,17 @@ impl BodyShape {
         }
     }
 
+    /// A bound on how fast the sampled distance changes with the point, where a lookup is
+    /// worth skipping: a grid's ([`SdfGrid::lipschitz`]). None for the analytic shapes,
+    /// which are sampled without memory lookups.
+    #[inline(always)]
+    pub fn lipschitz(&self) -> Option<Real> {
+        match self {
+            BodyShape::Grid(grid) => Some(grid.lipschitz()),
+            _ => None,
+        }
+    }
+
     /// A box in the body frame outside which the shape is not seen (a grid's extent, or the
     /// solid's bounds).
     pub fn bounds(&self) -> Aabb {

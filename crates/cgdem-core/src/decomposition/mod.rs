@@ -158,6 +158,9 @@ pub struct Subdomain<H, WH> {
     /// The send lists this subdomain's ghosts come from, in ghost order: (subdomain, list).
     pub receives: Vec<(usize, usize)>,
     pub list: list::LocalList<H>,
+    /// Per owned particle, per body: where it needs no SDF lookup (as the world's; not
+    /// stored in restart files).
+    pub body_clearances: Vec<crate::bodies::Clearance>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
@@ -174,6 +177,7 @@ impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
             sends: Vec::new(),
             receives: Vec::new(),
             list: list::LocalList::default(),
+            body_clearances: Vec::new(),
         }
     }
 

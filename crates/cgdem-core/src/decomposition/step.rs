@@ -10,7 +10,7 @@ use super::list::LocalList;
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
-use crate::bodies::{Body, BodyLoad, KinematicParticles};
+use crate::bodies::{Body, BodyLoad, Clearance, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::{Domain, NO_IMAGE};
@@ -533,6 +533,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             m.particles += sub.n_owned;
             m.particle_bytes += sub.particles.array_bytes()
                 + bytes(&sub.wall_history)
+                + bytes(&sub.body_clearances)
                 + bytes(&sub.list.out_start)
                 + bytes(&sub.list.reference)
                 + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
@@ -800,8 +801,14 @@ fn forces<L: PairLaw, W: WallLaw>(
     }
     let mut deepest_wall: Real = 0.0;
     let walls = physics.walls;
-    let mut body_loads = vec![BodyLoad::default(); physics.bodies.len()];
+    let n_bodies = physics.bodies.len();
+    let mut body_loads = vec![BodyLoad::default(); n_bodies];
+    // Sized exactly, as the world's (the reported memory must not depend on the history).
+    if sub.body_clearances.len() != n * n_bodies {
+        sub.body_clearances = vec![Clearance::NONE; n * n_bodies];
+    }
     for i in 0..n {
+        let clearances = &mut sub.body_clearances[i * n_bodies..(i + 1) * n_bodies];
         let particle = WallParticle {
             species: state.species[i] as usize,
             position: state.position[i],
@@ -831,14 +838,15 @@ fn forces<L: PairLaw, W: WallLaw>(
                 f += wf;
                 overlap = o;
             }
-            let with_history = physics.bodies.iter().zip(body_history);
-            for ((body, history), load) in with_history.zip(&mut body_loads) {
+            let with_history = physics.bodies.iter().zip(body_history).zip(clearances);
+            for (((body, history), clearance), load) in with_history.zip(&mut body_loads) {
                 let (bf, bt, l, o) = body_force_and_torque(
                     body,
                     physics.wall_law,
                     &particle,
                     omega,
                     history,
+                    clearance.follow(id[i]),
                     physics.dt,
                 );
                 f += bf;
@@ -850,8 +858,15 @@ fn forces<L: PairLaw, W: WallLaw>(
             let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
             f += wf;
             overlap = o;
-            for (body, load) in physics.bodies.iter().zip(&mut body_loads) {
-                let (bf, l, o) = body_force(body, physics.wall_law, &particle, physics.dt);
+            let with_clearance = physics.bodies.iter().zip(clearances);
+            for ((body, clearance), load) in with_clearance.zip(&mut body_loads) {
+                let (bf, l, o) = body_force(
+                    body,
+                    physics.wall_law,
+                    &particle,
+                    clearance.follow(id[i]),
+                    physics.dt,
+                );
                 f += bf;
                 *load += l;
                 overlap = larger(overlap, o);

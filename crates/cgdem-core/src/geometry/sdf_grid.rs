@@ -48,6 +48,8 @@ pub struct SdfGrid {
     /// x fastest. f32 halves memory; its rounding (1e-7 relative) is far below the
     /// interpolation error of any usable cell size.
     values: Vec<f32>,
+    /// A bound on the interpolant's gradient ([`SdfGrid::lipschitz`]).
+    lipschitz: Real,
 }
 
 impl SdfGrid {
@@ -129,12 +131,7 @@ impl SdfGrid {
                     prev = Some((d_low, inside));
                 }
             });
-        Ok(SdfGrid {
-            origin,
-            cell_size,
-            dims,
-            values,
-        })
+        Ok(SdfGrid::new(origin, cell_size, dims, values))
     }
 
     /// Samples any SDF on the same layout (e.g. an analytic shape, for comparison).
@@ -163,12 +160,27 @@ impl SdfGrid {
                     *value = sdf.distance(p) as f32;
                 }
             });
-        Ok(SdfGrid {
+        Ok(SdfGrid::new(origin, cell_size, dims, values))
+    }
+
+    fn new(origin: Vec3, cell_size: Real, dims: [usize; 3], values: Vec<f32>) -> SdfGrid {
+        let lipschitz = lipschitz_bound(&values, dims) / cell_size;
+        SdfGrid {
             origin,
             cell_size,
             dims,
             values,
-        })
+            lipschitz,
+        }
+    }
+
+    /// A bound on the gradient of the interpolant, over the whole grid: its value at two
+    /// points of the grid differs by at most this times their distance, whatever the node
+    /// values (a true SDF sampled gives about 1 to 1.7; a sign error, more). A particle
+    /// that far beyond contact is known to be out of reach without a lookup
+    /// ([`crate::bodies::Clearance`]).
+    pub fn lipschitz(&self) -> Real {
+        self.lipschitz
     }
 
     pub fn origin(&self) -> Vec3 {
@@ -236,8 +248,9 @@ impl SdfGrid {
         for a in 0..3 {
             let last = (self.dims[a] - 1) as Real;
             let ua = u[a].clamp(0.0, last);
-            // Points on the far face use the last cell with t = 1.
-            let c = (ua.floor() as usize).min(self.dims[a] - 2);
+            // Points on the far face use the last cell with t = 1. `ua` is not negative
+            // here, so the cast truncates as `floor` would (without its libm call).
+            let c = (ua as usize).min(self.dims[a] - 2);
             cell[a] = c;
             t[a] = ua - c as Real;
         }
@@ -303,6 +316,40 @@ impl GridSample {
         let gz = c1 - c0;
         Vec3::new(gx, gy, gz).normalize_or_zero()
     }
+}
+
+/// The largest gradient of the trilinear interpolant in node units (times the cell size).
+/// Within a cell, the derivative along x is a weighted mean of the four x edges' differences
+/// (likewise y and z), so it is at most the largest of them; the interpolant is continuous
+/// across cells, so the largest bound over the cells holds along any segment in the grid.
+fn lipschitz_bound(values: &[f32], dims: [usize; 3]) -> Real {
+    let [nx, ny, nz] = dims;
+    let (sx, sy, sz) = (1, nx, nx * ny);
+    let v = |n: usize| values[n] as Real;
+    let slab = |k: usize| {
+        let mut most: Real = 0.0;
+        for j in 0..ny - 1 {
+            for i in 0..nx - 1 {
+                let n = i * sx + j * sy + k * sz;
+                let corners = [n, n + sy, n + sz, n + sy + sz];
+                let edge = |step: usize, from: [usize; 4]| {
+                    from.iter()
+                        .map(|&a| (v(a + step) - v(a)).abs())
+                        .fold(0.0, Real::max)
+                };
+                let gx = edge(sx, corners);
+                let gy = edge(sy, [n, n + sx, n + sz, n + sx + sz]);
+                let gz = edge(sz, [n, n + sx, n + sy, n + sx + sy]);
+                most = most.max((gx * gx + gy * gy + gz * gz).sqrt());
+            }
+        }
+        most
+    };
+    // A maximum: the same in any order.
+    (0..nz - 1)
+        .into_par_iter()
+        .map(slab)
+        .reduce(|| 0.0, Real::max)
 }
 
 #[inline(always)]
@@ -518,5 +565,31 @@ mod tests {
         assert!((8.99..9.5).contains(&d), "{d}");
         assert!(grid.normal(far).x > 0.9);
         assert!(grid.memory_bytes() >= 4 * grid.dims().iter().product::<usize>());
+    }
+
+    /// The bound holds between any two points of the grid, is near 1 for a sampled SDF, and
+    /// grows with a wrong node (a sign error of the winding number, say).
+    #[test]
+    fn the_lipschitz_bound_holds_between_any_two_points() {
+        let mut grid = SdfGrid::from_mesh(&sphere_mesh(1.0, 3), 0.1, 0.2).expect("valid grid");
+        let l = grid.lipschitz();
+        assert!((1.0..1.75).contains(&l), "{l}");
+        let b = grid.bounds();
+        let mut rng = seeded_rng(3);
+        for _ in 0..20_000 {
+            let (p, q) = (rng.vec_in_box(b), rng.vec_in_box(b));
+            let q = p + (q - p) * 0.05; // mostly short segments, where the bound is tight
+            let (dp, dq) = (grid.sample(p).unwrap(), grid.sample(q).unwrap());
+            let change = (dp.distance - dq.distance).abs();
+            assert!(
+                change <= l * p.distance(q) * (1.0 + 1e-9),
+                "{change} over {}",
+                p.distance(q)
+            );
+        }
+        let k = grid.values.len() / 2;
+        grid.values[k] = -grid.values[k] - 1.0;
+        let wrong = SdfGrid::new(grid.origin, grid.cell_size, grid.dims, grid.values.clone());
+        assert!(wrong.lipschitz() > 5.0, "{}", wrong.lipschitz());
     }
 }

@@ -16,6 +16,8 @@ const PAIR_BYTES: Real = 160.0;
 const PAIRS_PER_PARTICLE: Real = 6.0;
 /// Cell grid: at most 16 cells per particle (its cap), 8 bytes each.
 const CELL_BYTES_PER_PARTICLE: Real = 16.0 * 8.0;
+/// Per particle and body: its clearance (`bodies::Clearance`), not in the figures above.
+const CLEARANCE_BYTES: Real = std::mem::size_of::<crate::bodies::Clearance>() as Real;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct MemoryEstimate {
@@ -104,7 +106,10 @@ pub fn estimate(scene: &Scene, particles: Option<usize>) -> MemoryEstimate {
     let particles = particles.map_or_else(|| particle_count(scene), |n| n as Real);
     MemoryEstimate {
         particles,
-        particle_bytes: particles * (PARTICLE_BYTES + CELL_BYTES_PER_PARTICLE),
+        particle_bytes: particles
+            * (PARTICLE_BYTES
+                + CELL_BYTES_PER_PARTICLE
+                + scene.bodies.len() as Real * CLEARANCE_BYTES),
         pair_bytes: particles * PAIRS_PER_PARTICLE * PAIR_BYTES,
         sdf_bytes: sdf_bytes(scene),
     }
