@@ -796,10 +796,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             self.body_clearances = vec![Clearance::NONE; n * n_bodies];
         }
         let ForceView {
-            id,
             state,
             force,
             torque,
+            ..
         } = ParticleState::split(&mut self.particles);
         let pass = OwnerPass {
             law: &self.law,
@@ -812,7 +812,6 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             out_start: &self.list.out_start,
             walls: &self.walls,
             bodies: &self.bodies,
-            ids: id,
             gravity: self.gravity,
             rotates: Self::ROTATES,
             wall_slots,
@@ -1673,8 +1672,6 @@ struct OwnerPass<'a, L: PairLaw, W: WallLaw> {
     out_start: &'a [u32],
     walls: &'a WallSet,
     bodies: &'a [Body],
-    /// The particles' ids, which key their body clearances.
-    ids: &'a [u32],
     gravity: Vec3,
     /// Whether torques are summed and stored (a constant of the world's laws).
     rotates: bool,
@@ -1847,7 +1844,6 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
         let n_bodies = self.bodies.len();
         let loads = &mut out.body_loads[local * n_bodies..(local + 1) * n_bodies];
         let clearances = &mut out.body_clearances[local * n_bodies..(local + 1) * n_bodies];
-        let id = self.ids[i];
         let mut overlap;
         if self.rotates {
             let slots = &mut out.wall_history[local * self.wall_slots..][..self.wall_slots];
@@ -1876,7 +1872,7 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
                     &particle,
                     owner.omega,
                     history,
-                    clearance.follow(id),
+                    clearance,
                     self.dt,
                 );
                 force += f;
@@ -1890,13 +1886,7 @@ impl<L: PairLaw, W: WallLaw> OwnerPass<'_, L, W> {
             force += f;
             overlap = o;
             for ((body, load), clearance) in self.bodies.iter().zip(loads).zip(clearances) {
-                let (f, l, o) = body_force(
-                    body,
-                    self.wall_law,
-                    &particle,
-                    clearance.follow(id),
-                    self.dt,
-                );
+                let (f, l, o) = body_force(body, self.wall_law, &particle, clearance, self.dt);
                 force += f;
                 *load = l;
                 overlap = larger(overlap, o);

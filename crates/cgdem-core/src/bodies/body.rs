@@ -192,7 +192,11 @@ impl Body {
             return None;
         }
         let q = self.to_body(p);
-        if (q - clearance.at).length_squared() < clearance.free_squared {
+        // The ball was made for this `beyond`: any particle with the same one inside it is
+        // out of reach (entries are per array slot, and slots change hands at list builds).
+        if clearance.beyond == beyond
+            && (q - clearance.at).length_squared() < clearance.free_squared
+        {
             return None;
         }
         let Some(shape) = self.shape.sample(q) else {
@@ -200,6 +204,7 @@ impl Body {
             return None;
         };
         clearance.at = q;
+        clearance.beyond = beyond;
         clearance.free_squared = match self.shape.lipschitz() {
             // Rounding in the interpolation is far below the margin (1e-9 of `beyond`).
             Some(l) if shape.distance() > beyond * (1.0 + 1e-9) => {
@@ -245,37 +250,28 @@ impl Body {
     }
 }
 
-/// Per particle and body: a ball in the body's frame inside which the particle is out of
-/// the body's reach, so that it needs no SDF lookup ([`Body::sample_near`]). Grid lookups
-/// were about half of a screw feeder's step (8 scattered reads and a trilinear
-/// interpolation per particle and body); most particles sit between the flights, more
-/// than a few diameters from any surface, and a ball of radius (distance - reach) /
-/// lipschitz around their last lookup lets them skip it for many steps. Exact: a skip
-/// happens only where the lookup would have found the particle beyond contact.
+/// Per particle and body: a ball in the body's frame inside which a particle is out of the
+/// body's reach, so that it needs no SDF lookup ([`Body::sample_near`]). Grid lookups were
+/// about half of a screw feeder's step (8 scattered reads and a trilinear interpolation per
+/// particle and body); most particles sit between the flights, more than a few diameters
+/// from any surface, and a ball of radius (distance - beyond) / lipschitz around their last
+/// lookup lets them skip it for many steps. Exact: a skip happens only where the lookup
+/// would have found the particle beyond contact, whichever particle holds the slot.
 #[derive(Clone, Copy, Debug)]
 pub struct Clearance {
-    /// The particle whose clearance this is (arrays are reordered at list builds).
-    id: u32,
     at: Vec3,
     /// Radius squared; negative: none.
     free_squared: Real,
+    /// The distance beyond which the ball was made (a particle's reach or radius).
+    beyond: Real,
 }
 
 impl Clearance {
     pub const NONE: Clearance = Clearance {
-        id: u32::MAX,
         at: Vec3::ZERO,
         free_squared: -1.0,
+        beyond: Real::NAN,
     };
-
-    /// Makes the entry particle `id`'s: another particle's clearance is dropped.
-    #[inline(always)]
-    pub fn follow(&mut self, id: u32) -> &mut Clearance {
-        if self.id != id {
-            *self = Clearance { id, ..Self::NONE };
-        }
-        self
-    }
 }
 
 /// A body's signed distance at a world point, and its world normal there on demand.
@@ -361,7 +357,7 @@ mod tests {
             p += 0.002 * Vec3::new(next(), next(), next());
             p = p.clamp(Vec3::splat(-0.45), Vec3::splat(0.45));
             let exact = body.sample(p, reach).map(|s| s.distance());
-            match body.sample_near(p, reach, beyond, clearance.follow(7)) {
+            match body.sample_near(p, reach, beyond, &mut clearance) {
                 Some(s) => {
                     assert_eq!(Some(s.distance().to_bits()), exact.map(Real::to_bits));
                 }
@@ -381,8 +377,12 @@ mod tests {
             near > 100,
             "the walk stayed away from the blade ({near} steps near it)"
         );
-        // Another particle in the entry: its clearance is not used.
-        let c = clearance.follow(8);
-        assert!(c.free_squared < 0.0);
+        // A particle with another reach in the slot: the ball is not used.
+        let mut far = Clearance::NONE;
+        body.sample_near(Vec3::new(0.0, 0.3, 0.25), reach, beyond, &mut far);
+        assert!(far.free_squared > 0.0);
+        assert!(body
+            .sample_near(Vec3::new(0.0, 0.3, 0.25), reach, 0.2, &mut far)
+            .is_some_and(|s| s.distance() < 0.2));
     }
 }

@@ -846,7 +846,7 @@ fn forces<L: PairLaw, W: WallLaw>(
                     &particle,
                     omega,
                     history,
-                    clearance.follow(id[i]),
+                    clearance,
                     physics.dt,
                 );
                 f += bf;
@@ -860,13 +860,8 @@ fn forces<L: PairLaw, W: WallLaw>(
             overlap = o;
             let with_clearance = physics.bodies.iter().zip(clearances);
             for ((body, clearance), load) in with_clearance.zip(&mut body_loads) {
-                let (bf, l, o) = body_force(
-                    body,
-                    physics.wall_law,
-                    &particle,
-                    clearance.follow(id[i]),
-                    physics.dt,
-                );
+                let (bf, l, o) =
+                    body_force(body, physics.wall_law, &particle, clearance, physics.dt);
                 f += bf;
                 *load += l;
                 overlap = larger(overlap, o);
