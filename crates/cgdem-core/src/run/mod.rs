@@ -5,7 +5,6 @@
 //! walls; `driver` runs the stages and calls the `observers` that measure and write.
 
 mod driver;
-mod hertz;
 mod laws;
 pub mod memory;
 mod observers;
@@ -15,7 +14,7 @@ pub mod restart;
 mod setup;
 pub mod state_file;
 
-pub use hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
+pub use laws::hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
 pub use laws::{seed_laws, with_laws, LawVisitor};
 pub use progress::{Progress, ProgressReporter, RunProgress};
 pub use setup::{

@@ -1,6 +1,9 @@
 //! Which concrete laws a scene gets, chosen once: `with_laws` hands the scene's particle law
 //! and wall law to a [`LawVisitor`] (the run, the time step, the bodies), so the choice is
-//! written in one place and every force loop is compiled for its own combination.
+//! written in one place and every force loop is compiled for its own combination. The
+//! Hertz-Mindlin slots (`hertz`) are chosen below it.
+
+pub(super) mod hertz;
 
 use crate::contact::normal::WcaCoefficients;
 use crate::contact::{PairLaw, SeedModel};
@@ -8,7 +11,7 @@ use crate::math::Real;
 use crate::scene::{ContactSettings, Scene, WcaSettings};
 use crate::walls::{WallLaw, WcaWall};
 
-use super::{hertz, RunError};
+use super::RunError;
 
 /// Something done with a scene's concrete particle and wall laws.
 pub trait LawVisitor {
@@ -17,7 +20,7 @@ pub trait LawVisitor {
 }
 
 /// Calls `visitor` with the scene's laws; an uncompiled combination of Hertz slots is an
-/// error naming the supported ones ([`super::SUPPORTED`]).
+/// error naming the supported ones ([`hertz::SUPPORTED`]).
 pub fn with_laws<V: LawVisitor>(scene: &Scene, visitor: V) -> Result<V::Output, RunError> {
     match &scene.contact {
         ContactSettings::Wca(wca) => {

@@ -1,8 +1,7 @@
 //! Laws for `[contact] model = "hertz"`: each slot built from the scene's settings, and the
 //! short list of combinations that are compiled (each its own force loop).
 
-use super::laws::LawVisitor;
-use super::RunError;
+use super::LawVisitor;
 use crate::contact::cohesion::{vdw_reach, NoCohesion, VanDerWaals};
 use crate::contact::damping::{liggghts_damping_factor, HertzDamping, YangDamping};
 use crate::contact::normal::{Hertz, Material};
@@ -10,6 +9,7 @@ use crate::contact::rolling::{ConstantTorque, Epsd2, NoRolling};
 use crate::contact::tangential::{Mindlin, YangTangential};
 use crate::contact::{CohesionModel, ContactLaw, DampingModel, RollingModel, TangentialModel};
 use crate::math::Real;
+use crate::run::RunError;
 use crate::scene::{
     CohesionKind, HertzDampingKind, HertzSettings, RollingKind, Scene, TangentialKind,
 };
@@ -273,7 +273,7 @@ mod tests {
             keep_going: false,
             ..Default::default()
         };
-        let message = super::super::run(&scene, &options).unwrap_err().to_string();
+        let message = crate::run::run(&scene, &options).unwrap_err().to_string();
         assert!(
             message.contains("not compiled") && message.contains("yang/yang/constant_torque/vdw"),
             "{message}"
