@@ -191,9 +191,9 @@ enum Command {
         checkpoint_every: Option<f64>,
         /// Continue the run in DIR from its newest usable restart file: the case file and
         /// options (--lambda, --set, --grid, ...) are the ones the run stored, unless a scene
-        /// file is given, and the scene's digest must match the stored one. Outputs come out as those of an
-        /// uninterrupted run (with --grid: on the same grid, on any number of threads or MPI
-        /// ranks). `--grid` here continues a decomposed run on another grid, from the stored
+        /// file is given, and the scene's digest must match the stored one. Outputs come out
+        /// as those of an uninterrupted run (with --grid: on the same grid, on any number of
+        /// threads or MPI ranks). `--grid` here continues a decomposed run on another grid, from the stored
         /// particles (to rounding, not bitwise).
         #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "sweep", "set", "seed", "variant", "strict"])]
         resume: Option<PathBuf>,
