@@ -149,23 +149,29 @@ impl Body {
         self.motion.point + self.rotation.transpose() * (p - self.center)
     }
 
+    /// Whether `p` lies within `reach` of the body's box: outside it no lookup is made.
+    #[inline(always)]
+    fn within_reach(&self, p: Vec3, reach: Real) -> bool {
+        let b = &self.world_bounds;
+        !(p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any())
+    }
+
     /// Signed distance and world normal at world point `p`, if `p` lies within `reach` of the
     /// body's box and the shape has data there.
     #[inline(always)]
     pub fn query(&self, p: Vec3, reach: Real) -> Option<(Real, Vec3)> {
-        let b = &self.world_bounds;
-        if p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any() {
+        if !self.within_reach(p, reach) {
             return None;
         }
         let (distance, normal) = self.shape.query(self.to_body(p))?;
         Some((distance, self.rotation * normal))
     }
 
-    /// As [`Body::query`], the normal computed only when asked for ([`BodySample::normal`]).
-    #[inline(always)]
+    /// As [`Body::query`], the normal computed only when asked for ([`BodySample::normal`]):
+    /// the plain lookup that [`Body::sample_near`] spares (the force loop calls that one).
+    #[cfg(test)]
     pub fn sample(&self, p: Vec3, reach: Real) -> Option<BodySample<'_>> {
-        let b = &self.world_bounds;
-        if p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any() {
+        if !self.within_reach(p, reach) {
             return None;
         }
         Some(BodySample {
@@ -174,11 +180,11 @@ impl Body {
         })
     }
 
-    /// As [`Body::sample`] for a particle whose sample counts only below `beyond` (where
-    /// its force and overlap start), skipping the lookup while the particle's point in the
-    /// body frame stays inside its `clearance`: `None` then, as when out of reach. Each
-    /// lookup sets the clearance anew, so the answers that matter are those of
-    /// [`Body::sample`], bit for bit.
+    /// The distance (and the normal on demand) at world point `p` for a particle whose
+    /// sample counts only below `beyond` (where its force and overlap start), skipping the
+    /// lookup while the particle's point in the body frame stays inside its `clearance`:
+    /// `None` then, as when out of reach. Each lookup sets the clearance anew, so the
+    /// answers that matter are those of the plain lookup, bit for bit.
     #[inline(always)]
     pub fn sample_near(
         &self,
@@ -187,8 +193,7 @@ impl Body {
         beyond: Real,
         clearance: &mut Clearance,
     ) -> Option<BodySample<'_>> {
-        let b = &self.world_bounds;
-        if p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any() {
+        if !self.within_reach(p, reach) {
             return None;
         }
         let q = self.to_body(p);
@@ -205,14 +210,12 @@ impl Body {
         };
         clearance.at = q;
         clearance.beyond = beyond;
-        clearance.free_squared = match self.shape.lipschitz() {
-            // Rounding in the interpolation is far below the margin (1e-9 of `beyond`).
-            Some(l) if shape.distance() > beyond * (1.0 + 1e-9) => {
-                let free = (shape.distance() - beyond * (1.0 + 1e-9)) / l;
-                free * free
-            }
-            _ => -1.0,
-        };
+        // Rounding in the interpolation is far below this margin (1e-9 of `beyond`).
+        let free = self
+            .shape
+            .lipschitz()
+            .map_or(-1.0, |l| (shape.distance() - beyond * (1.0 + 1e-9)) / l);
+        clearance.free_squared = if free > 0.0 { free * free } else { -1.0 };
         Some(BodySample {
             shape,
             rotation: &self.rotation,
