@@ -228,8 +228,8 @@ enum Command {
         /// cgdem runs warn instead of stopping when a guard fires.
         #[arg(long)]
         keep_going: bool,
-        /// Runs of a case made at the same time, each with threads / jobs of the threads
-        /// (2 on 2 cores keeps both busy with small single-threaded runs).
+        /// Runs of a case, or of an accuracy sweep, made at the same time, each with threads /
+        /// jobs of the threads (2 on 2 cores keeps both busy with small single-threaded runs).
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: u16,
         /// Plant a fault in cgdem's runs only: a scene override (`contact.friction=0.3`)

@@ -1,7 +1,8 @@
 //! The stability suite's verdicts for cgdem: a 50 m/s impact with the seed's model runs to the
 //! end within its energy and overlap bounds (stable); a time step forced to 5x the stable
 //! limit is stopped by the energy guard before any particle is lost (detected). Both land in
-//! summary.json, stability.csv and the report's "Stability" section.
+//! summary.json, stability.csv and the report's "Stability" section. Also how `validate`
+//! makes cgdem's runs: decomposed (`--grid`), several at a time (`--jobs`).
 
 use std::process::Command;
 
@@ -118,5 +119,69 @@ fn validate_grid_decomposes_cgdem_runs_and_reuse_tells_them_apart() {
     validate(&["--reuse"]);
     assert!(summary_of(case_run)["decomposition"].is_null());
     assert!(summary_of(stability_run)["decomposition"].is_null());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `validate --jobs` on an accuracy sweep: its runs are made side by side, each on its share
+/// of the threads (summary.json says 1 thread under `--threads 2 --jobs 2`, where one run at
+/// a time would say 2), with the same outputs and the same points, in the same order, as one
+/// at a time on 1 thread.
+#[test]
+fn validate_jobs_runs_an_accuracy_sweep_side_by_side_with_the_same_points() {
+    let dir = std::env::temp_dir().join(format!("cgdem-accuracy-jobs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let validate = |out: &str, threads: &str, jobs: &str| -> serde_json::Value {
+        let out = dir.join(out);
+        let o = Command::new(env!("CARGO_BIN_EXE_cgdem"))
+            .args(["validate", "--quiet", "--suite"])
+            .arg("tests/data/tiny_accuracy_suite.toml")
+            .args(["--threads", threads, "--jobs", jobs, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+    };
+    let one = validate("one", "1", "1");
+    let two = validate("two", "2", "2");
+    let points = |s: &serde_json::Value| -> Vec<serde_json::Value> {
+        let points = s["accuracy"]["points"].as_array().unwrap().clone();
+        points
+            .into_iter()
+            .map(|mut p| {
+                // Where the run was made and how long it took differ by design.
+                for key in ["dir", "wall_s"] {
+                    p.as_object_mut().unwrap().remove(key);
+                }
+                p
+            })
+            .collect()
+    };
+    let (p1, p2) = (points(&one), points(&two));
+    assert_eq!(p1.len(), 4, "{one}");
+    assert!(p1.iter().all(|p| p["status"] == "ok"), "{one}");
+    assert_eq!(p1, p2);
+    let runs = dir.join("two/runs/tiny_hertz_collapse-short/accuracy");
+    for run in std::fs::read_dir(&runs).unwrap().flatten() {
+        let name = run.file_name();
+        let summary: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(run.path().join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(summary["threads"], 1, "{name:?}");
+        let series = |root: &str| {
+            std::fs::read(
+                dir.join(root)
+                    .join("runs/tiny_hertz_collapse-short/accuracy")
+                    .join(&name)
+                    .join("timeseries.csv"),
+            )
+            .unwrap()
+        };
+        assert!(
+            series("one") == series("two"),
+            "{name:?}: time series differ"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -23,7 +23,9 @@ use super::dynamics::FlowSeries;
 use crate::code::Code;
 use crate::csv_table::CsvTable;
 use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
-use crate::runs::{output_error, run_one, Outcome, ValidateError, ValidateOptions};
+use crate::runs::{
+    output_error, run_concurrently, run_one, Outcome, ValidateError, ValidateOptions,
+};
 use crate::suite_entry::{parse_codes, parse_variant, rule_names, SuiteError};
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::io::{write_atomic, CsvBuffer};
@@ -619,7 +621,8 @@ pub(super) fn run_sweeps(
 }
 
 /// Runs, seed by seed, the reference of every code, then each series point; codes alternate
-/// within each point so machine drift hits all alike.
+/// within each point so machine drift hits all alike. With `--jobs`, that many of these runs
+/// are made at a time, in the same order.
 fn run_sweep(
     sweep: &AccuracySweep,
     origin: &Path,
@@ -659,15 +662,24 @@ fn run_sweep(
             }
         }
     }
-    let mut points = Vec::new();
+    // Every run prepared first (scene, directory, labels), then made `--jobs` at a time:
+    // the seeds and levels of a sweep are independent runs.
+    struct PointRun {
+        scene: std::sync::Arc<Scene>,
+        lambda: u32,
+        code: Code,
+        rule: CoarseGrainRule,
+        seed: u64,
+        series: String,
+        setting: String,
+        value: f64,
+        dir: PathBuf,
+    }
+    let mut runs = Vec::new();
     for (series, knob, value, codes, rule, seed) in jobs {
         let mut knobs = sweep.reference.clone();
-        let (setting, value, name) = match series.as_str() {
-            "reference" => (
-                "reference".to_string(),
-                f64::NAN,
-                format!("reference-seed{seed}"),
-            ),
+        let (setting, name) = match series.as_str() {
+            "reference" => ("reference".to_string(), format!("reference-seed{seed}")),
             _ => {
                 knobs.insert(knob.clone(), value);
                 let (setting, rule_dir) = if rule == sweep.rule {
@@ -680,45 +692,58 @@ fn run_sweep(
                 };
                 (
                     setting,
-                    value,
                     format!("{}-{value}{rule_dir}-seed{seed}", knob.file_name()),
                 )
             }
         };
         let (scene, lambda) = sweep.scene(&knobs, origin).map_err(case_error)?;
+        let scene = std::sync::Arc::new(scene);
         for code in codes {
-            let dir = options
-                .out
-                .join("runs")
-                .join(&case)
-                .join("accuracy")
-                .join(format!("{}-{name}", code.name()));
-            let point = run_point(&scene, code, lambda, rule, seed, &dir, options);
-            let mut p = AccuracyPoint {
-                case: case.clone(),
+            runs.push(PointRun {
+                scene: scene.clone(),
+                lambda,
                 code,
+                rule,
+                seed,
                 series: series.clone(),
-                value,
                 setting: setting.clone(),
-                ..point
-            };
-            if p.value.is_nan() {
-                p.value = knobs[&knob];
-            }
-            if !options.quiet {
-                eprintln!(
-                    "{case} accuracy {} {} (seed {seed}): {}{}",
-                    code.name(),
-                    p.setting,
-                    p.status,
-                    p.reason
-                        .as_deref()
-                        .map_or(String::new(), |r| format!(" ({r})"))
-                );
-            }
-            points.push(p);
+                // The reference is plotted at its own value of the knob.
+                value: knobs[&knob],
+                dir: options
+                    .out
+                    .join("runs")
+                    .join(&case)
+                    .join("accuracy")
+                    .join(format!("{}-{name}", code.name())),
+            });
         }
     }
+    let points = run_concurrently(&runs, options.jobs, |run| {
+        let point = run_point(
+            &run.scene, run.code, run.lambda, run.rule, run.seed, &run.dir, options,
+        );
+        let p = AccuracyPoint {
+            case: case.clone(),
+            code: run.code,
+            series: run.series.clone(),
+            value: run.value,
+            setting: run.setting.clone(),
+            ..point
+        };
+        if !options.quiet {
+            eprintln!(
+                "{case} accuracy {} {} (seed {}): {}{}",
+                run.code.name(),
+                p.setting,
+                run.seed,
+                p.status,
+                p.reason
+                    .as_deref()
+                    .map_or(String::new(), |r| format!(" ({r})"))
+            );
+        }
+        p
+    });
     Ok(points)
 }
 

@@ -157,7 +157,8 @@ pub struct ValidateOptions {
     pub reuse: bool,
     /// cgdem's guards only warn instead of stopping a run (`--keep-going`).
     pub keep_going: bool,
-    /// Runs of a case made at the same time (`--jobs`), sharing the threads.
+    /// Runs of a case, or of an accuracy sweep, made at the same time (`--jobs`), sharing the
+    /// threads.
     pub jobs: usize,
     /// Raised on SIGINT/SIGTERM: runs in progress stop (cgdem at the end of a step, reference
     /// codes with their process tree) and record why; no further run starts.
