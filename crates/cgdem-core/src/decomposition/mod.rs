@@ -4,8 +4,8 @@
 //! skin thick. Four phases, one file each:
 //!
 //! - [`grid`]: the subdomain grid and its cut planes (by particle count);
-//! - [`balance`]: at a list rebuild, the cut planes move by count when the imbalance passes
-//!   a threshold (LAMMPS `fix balance ... shift`);
+//! - [`balance`] and [`rebalance`]: at a list rebuild, the cut planes move by count when
+//!   the imbalance passes a threshold (LAMMPS `fix balance ... shift`): when, and how;
 //! - [`exchange`]: at a list rebuild, particles that left their subdomain move to the new
 //!   owner with every per-particle array that must travel (wall history, contact history
 //!   rows);
@@ -26,6 +26,7 @@ pub mod exchange;
 pub mod forward;
 pub mod grid;
 pub mod list;
+pub mod rebalance;
 pub mod state;
 pub mod step;
 pub mod team;
