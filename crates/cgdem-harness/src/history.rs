@@ -15,7 +15,7 @@ use cgdem_core::io::write_atomic;
 /// One metric of one night.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metric {
-    /// What is measured and its unit, e.g. "repose angle [deg]"; the trend plots group by it.
+    /// What is measured and its unit, e.g. "repose angle \[deg\]"; the trend plots group by it.
     pub quantity: String,
     pub value: f64,
     /// A change from the previous night larger than this is flagged.

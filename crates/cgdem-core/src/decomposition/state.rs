@@ -29,7 +29,7 @@ pub struct DecomposedState {
     pub width: Real,
     pub extra: Real,
     pub skin: Real,
-    /// Per subdomain, a [`SubdomainState`] in bincode.
+    /// Per subdomain, a `SubdomainState` in bincode.
     pub subdomains: Vec<Vec<u8>>,
 }
 

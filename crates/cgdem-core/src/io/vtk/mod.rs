@@ -10,10 +10,10 @@
 //! Tube) and share the time axis. All files are `.vtu` (unstructured grids), which every VTK
 //! reader takes (meshio reads `.vtu` but not `.vtp`).
 //!
-//! Particle arrays (LIGGGHTS `dump custom/vtk` names in brackets): `id` [id], `species`
-//! (0-based, scene order) [type - 1], `radius` [radius], `velocity` [v], `force` (total,
-//! gravity included) [f], `coordination_number` (particles it interacts with; for Hertz those it
-//! overlaps) [`compute contact/atom`], and where the law rotates `omega` [omega] and `torque` [tq]. Body arrays:
+//! Particle arrays (LIGGGHTS `dump custom/vtk` names in brackets): `id` \[id\], `species`
+//! (0-based, scene order) \[type - 1\], `radius` \[radius\], `velocity` \[v\], `force` (total,
+//! gravity included) \[f\], `coordination_number` (particles it interacts with; for Hertz those it
+//! overlaps) [`compute contact/atom`], and where the law rotates `omega` \[omega\] and `torque` \[tq\]. Body arrays:
 //! `body` (index in scene order, per triangle) and `velocity` (of the body's surface, per
 //! vertex). Contact arrays (`dump local` of `compute pair/gran/local`): `id` (the two
 //! particles' ids), `normal_force` (N, positive pushes apart) and `overlap` (m), per line.
