@@ -354,6 +354,23 @@ enum Command {
         /// Print the answer as JSON.
         #[arg(long)]
         json: bool,
+        /// First make the case's points the matrix lacks: its sweeps in --suite run as
+        /// `cgdem validate --reuse` runs them, in MATRIX/runs (the runs already there are
+        /// taken), with the case's own report in MATRIX/advise/CASE/, which the answer then
+        /// reads; the matrix's report is left as it was (`cgdem validate --suite S --out
+        /// MATRIX --reuse` rebuilds it with the new points).
+        #[arg(long)]
+        run: bool,
+        /// With --run: the suite holding the case's sweeps, a name in validation/suites or a
+        /// path (default: the suite the matrix was made from, else cg_fidelity).
+        #[arg(long, requires = "run")]
+        suite: Option<String>,
+        /// With --run: worker threads (default: all cores).
+        #[arg(long, requires = "run")]
+        threads: Option<usize>,
+        /// With --run: runs made at the same time, as `cgdem validate --jobs`.
+        #[arg(long, default_value_t = 1, requires = "run", value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: u16,
     },
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).
@@ -690,11 +707,7 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            let suite_path = if suite.ends_with(".toml") || suite.contains('/') {
-                PathBuf::from(&suite)
-            } else {
-                PathBuf::from("validation/suites").join(format!("{suite}.toml"))
-            };
+            let suite_path = suite_path(&suite);
             let pool = match worker_pool(threads) {
                 Ok(pool) => pool,
                 Err(code) => return code,
@@ -718,6 +731,7 @@ fn main() -> ExitCode {
                     ranks,
                 },
                 checkpoint_every,
+                runs_dir: None,
             };
             let result = pool.install(|| cgdem_harness::validate::validate(&options));
             if let Some(code) = interrupted(&interrupt, &out) {
@@ -855,7 +869,18 @@ fn main() -> ExitCode {
             target,
             matrix,
             json,
-        } => advise(&case, &quantity, target, &matrix, json),
+            run,
+            suite,
+            threads,
+            jobs,
+        } => {
+            let run = run.then_some(AdviseRun {
+                suite,
+                threads,
+                jobs,
+            });
+            advise(&case, &quantity, target, &matrix, json, run)
+        }
         Command::History {
             dir,
             add,
@@ -1215,7 +1240,76 @@ fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, ExitCode> {
 }
 
 /// `cgdem advise`: the answer from the stored matrix, in words or as JSON.
-fn advise(case: &str, quantity: &str, target: f64, matrix: &Path, json: bool) -> ExitCode {
+/// `cgdem advise --run`'s settings.
+struct AdviseRun {
+    suite: Option<String>,
+    threads: Option<usize>,
+    jobs: u16,
+}
+
+/// The suite file a suite argument names: a path, or a name in validation/suites.
+fn suite_path(suite: &str) -> PathBuf {
+    if suite.ends_with(".toml") || suite.contains('/') {
+        PathBuf::from(suite)
+    } else {
+        PathBuf::from("validation/suites").join(format!("{suite}.toml"))
+    }
+}
+
+/// `advise --run`: the case's sweeps made into the matrix's runs; the directory of the
+/// case's own report, or the exit code of a failure (already reported).
+fn advise_run(case: &str, matrix: &Path, run: AdviseRun) -> Result<PathBuf, ExitCode> {
+    // The suite the matrix was made from, as its provenance names it.
+    let made_from = || -> Option<String> {
+        let file = if matrix.is_dir() {
+            matrix.join("summary.json")
+        } else {
+            matrix.to_path_buf()
+        };
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(file).ok()?).ok()?;
+        summary["provenance"]["suite file"]
+            .as_str()
+            .map(str::to_string)
+    };
+    let suite = run
+        .suite
+        .or_else(made_from)
+        .unwrap_or_else(|| "cg_fidelity".into());
+    let suite = match cgdem_harness::suite::Suite::load(&suite_path(&suite)) {
+        Ok(suite) => suite,
+        Err(e) => {
+            eprintln!("error: --suite: {e}");
+            return Err(ExitCode::FAILURE);
+        }
+    };
+    let pool = worker_pool(run.threads)?;
+    let interrupt = install_interrupt();
+    let options = cgdem_harness::validate::ValidateOptions {
+        progress: progress_bar::progress(false),
+        reference_timeout_s: 3600,
+        jobs: usize::from(run.jobs),
+        stop: interrupt.as_ref().map(|i| i.flag()),
+        ..Default::default()
+    };
+    let result = pool.install(|| cgdem_harness::advise::run_case(&suite, case, matrix, &options));
+    if let Some(code) = interrupted(&interrupt, matrix) {
+        return Err(code);
+    }
+    result.map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::FAILURE
+    })
+}
+
+fn advise(
+    case: &str,
+    quantity: &str,
+    target: f64,
+    matrix: &Path,
+    json: bool,
+    run: Option<AdviseRun>,
+) -> ExitCode {
     use cgdem_harness::accuracy::Measure;
     use cgdem_harness::advise;
     let Some(m) = Measure::from_quantity(quantity) else {
@@ -1244,7 +1338,14 @@ fn advise(case: &str, quantity: &str, target: f64, matrix: &Path, json: bool) ->
     } else {
         case.to_string()
     };
-    let answer = advise::read_matrix(matrix)
+    let matrix = match run {
+        Some(run) => match advise_run(&name, matrix, run) {
+            Ok(dir) => dir,
+            Err(code) => return code,
+        },
+        None => matrix.to_path_buf(),
+    };
+    let answer = advise::read_matrix(&matrix)
         .and_then(|(file, points)| advise::advise(&file, &points, &name, m, target));
     match answer {
         Ok(a) if json => match serde_json::to_string_pretty(&a) {

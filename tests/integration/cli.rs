@@ -385,3 +385,111 @@ fn a_closed_stdout_ends_the_command_quietly_not_with_a_panic() {
     const SIGPIPE: i32 = 13; // Linux; the tests do not link libc
     assert_eq!(out.status.signal(), Some(SIGPIPE), "{:?}", out.status);
 }
+
+/// `cgdem advise --run`: the case's missing points are made into the matrix's runs (those
+/// already there reused), its own report goes to MATRIX/advise/CASE/, the answer is read
+/// from it; the suite's other case is not run and the matrix's own report is not touched.
+#[test]
+fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
+    let matrix = std::env::temp_dir().join(format!("cgdem-advise-run-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&matrix);
+    std::fs::create_dir_all(&matrix).unwrap();
+    // A matrix report of another suite, which --run must leave as it is.
+    std::fs::write(matrix.join("index.html"), "the matrix's report").unwrap();
+    let advise = |case: &str| {
+        let out = cgdem()
+            .args([
+                "advise",
+                case,
+                "--quantity",
+                "repose_angle",
+                "--target",
+                "5",
+            ])
+            .args(["--run", "--suite", "tests/data/tiny_fidelity_suite.toml"])
+            .args(["--threads", "1", "--matrix"])
+            .arg(&matrix)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).to_string(),
+            stderr,
+        )
+    };
+    let case = "tiny_hertz_collapse-fidelity";
+    // The answer up to its savings: the wall time of a run made again differs.
+    let answer = |text: &str| {
+        text.split(" fewer particle-steps")
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    let (ok, first, stderr) = advise(case);
+    assert!(ok, "{stderr}");
+    assert!(
+        first.starts_with(&format!("{case}: repose_angle within")),
+        "{first}"
+    );
+    let runs = matrix.join("runs").join(case).join("accuracy");
+    let made: Vec<String> = std::fs::read_dir(&runs)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    assert_eq!(made.len(), 4, "{made:?}");
+    assert!(!matrix.join("runs/tiny_hertz_collapse-short").exists());
+    assert_eq!(
+        std::fs::read_to_string(matrix.join("index.html")).unwrap(),
+        "the matrix's report"
+    );
+    assert!(!matrix.join("summary.json").exists());
+    let report = matrix.join("advise").join(case);
+    assert!(report.join("index.html").is_file());
+
+    // One point lost: only it is made again, and the answer is the same.
+    std::fs::remove_dir_all(runs.join("cgdem-lambda-2-seed2")).unwrap();
+    let (ok, second, stderr) = advise(case);
+    assert!(ok, "{stderr}");
+    assert_eq!(answer(&first), answer(&second));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("summary.json")).unwrap())
+            .unwrap();
+    let made_again: Vec<&str> = summary["accuracy"]["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["reused"] == false)
+        .map(|p| p["setting"].as_str().unwrap())
+        .collect();
+    assert_eq!(made_again, ["lambda = 2"], "{summary}");
+    // Without --run the answer from the case's report is the same.
+    let out = cgdem()
+        .args([
+            "advise",
+            case,
+            "--quantity",
+            "repose_angle",
+            "--target",
+            "5",
+            "--matrix",
+        ])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert_eq!(String::from_utf8_lossy(&out.stdout), second);
+
+    // A case the suite has no sweep of, or a scene name two of its variants share, is an
+    // error naming the cases it has; nothing runs.
+    for asked in ["no_such_case", "tiny_hertz_collapse"] {
+        let (ok, _, stderr) = advise(asked);
+        assert!(
+            !ok && stderr.contains(&format!("`{asked}` is not one of its accuracy sweeps"))
+                && stderr.contains("tiny_hertz_collapse-fidelity, tiny_hertz_collapse-short"),
+            "{stderr}"
+        );
+    }
+    assert!(!matrix.join("runs/tiny_hertz_collapse-short").exists());
+    let _ = std::fs::remove_dir_all(&matrix);
+}

@@ -291,6 +291,11 @@ impl AccuracySweep {
         codes
     }
 
+    /// The name of the case the sweep reports (its reference scene's, variant included).
+    pub fn case_name(&self, origin: &Path) -> Result<String, String> {
+        Ok(self.scene(&self.reference, origin)?.0.name)
+    }
+
     /// The scene of the setting `knobs` (the reference with some knobs changed): the file
     /// with the shared overrides, then one override per scene knob; and its level.
     fn scene(&self, knobs: &BTreeMap<Knob, f64>, origin: &Path) -> Result<(Scene, u32), String> {
@@ -710,8 +715,7 @@ fn run_sweep(
                 // The reference is plotted at its own value of the knob.
                 value: knobs[&knob],
                 dir: options
-                    .out
-                    .join("runs")
+                    .runs_dir()
                     .join(&case)
                     .join("accuracy")
                     .join(format!("{}-{name}", code.name())),

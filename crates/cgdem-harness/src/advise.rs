@@ -15,6 +15,9 @@ use serde::Serialize;
 
 use super::accuracy::{settings, AccuracyPoint, Cost, Measure, SPREAD_STANDARD_ERRORS};
 use super::code::Code;
+use super::runs::{ValidateError, ValidateOptions};
+use super::suite::Suite;
+use super::validate::validate_suite;
 
 #[derive(Debug, thiserror::Error)]
 pub enum AdviseError {
@@ -28,7 +31,15 @@ pub enum AdviseError {
     },
     #[error("{file}: case `{case}` has no successful fine reference run to compare with")]
     NoReference { file: PathBuf, case: String },
-    #[error("case `{case}`: no run measured {quantity} (measured here: {measured})")]
+    #[error("{suite}: `{case}` is not one of its accuracy sweeps' cases, nor the one of them with a variant (its sweeps' cases: {known})")]
+    NoSweep {
+        suite: PathBuf,
+        case: String,
+        known: String,
+    },
+    #[error("{0}")]
+    Run(#[from] ValidateError),
+    #[error("case `{case}`: no coarse-grained run measured {quantity} (they measured: {measured}; a failed run measures nothing, the report says why)")]
     NotMeasured {
         case: String,
         quantity: String,
@@ -144,6 +155,87 @@ pub fn read_matrix(path: &Path) -> Result<(PathBuf, Vec<AccuracyPoint>), AdviseE
     Ok((file, points))
 }
 
+/// Which of `cases` the user's `case` names: itself, or the one case that is `case` with a
+/// variant (`aor_hertz` for `aor_hertz-fidelity`); None when none or several are.
+pub fn resolve_case<'a>(cases: &[&'a str], case: &str) -> Option<&'a str> {
+    if let Some(exact) = cases.iter().find(|&&c| c == case) {
+        return Some(exact);
+    }
+    let mut variants: Vec<&str> = cases
+        .iter()
+        .copied()
+        .filter(|c| c.strip_prefix(case).is_some_and(|v| v.starts_with('-')))
+        .collect();
+    variants.dedup();
+    (variants.len() == 1).then(|| variants[0])
+}
+
+/// `cgdem advise --run`: makes the accuracy sweeps of `case` in `suite` as `cgdem validate
+/// --reuse` would, with the runs in `MATRIX/runs` (those already there are taken, the
+/// missing ones made) and the report of this case alone in `MATRIX/advise/<case>/`, so the
+/// matrix's own report and its other cases are left as they were. `options` carries the
+/// threads, jobs and interrupt flag; its output and runs directories are set here. Returns
+/// the case's report directory, to read the matrix from.
+pub fn run_case(
+    suite: &Suite,
+    case: &str,
+    matrix: &Path,
+    options: &ValidateOptions,
+) -> Result<PathBuf, AdviseError> {
+    let mut names = Vec::new();
+    for sweep in &suite.accuracy {
+        let name = sweep
+            .case_name(&suite.source)
+            .map_err(|message| ValidateError::Case {
+                file: sweep.file.clone(),
+                message,
+            })?;
+        names.push(name);
+    }
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let Some(name) = resolve_case(&refs, case).map(str::to_string) else {
+        let mut known = names.clone();
+        known.sort();
+        known.dedup();
+        return Err(AdviseError::NoSweep {
+            suite: suite.source.clone(),
+            case: case.to_string(),
+            known: if known.is_empty() {
+                "none".into()
+            } else {
+                known.join(", ")
+            },
+        });
+    };
+    let mine = Suite {
+        cases: Vec::new(),
+        stability: Vec::new(),
+        accuracy: suite
+            .accuracy
+            .iter()
+            .zip(&names)
+            .filter(|(_, n)| **n == name)
+            .map(|(s, _)| s.clone())
+            .collect(),
+        ..suite.clone()
+    };
+    let matrix_dir = if matrix.is_file() {
+        matrix.parent().unwrap_or(Path::new(".")).to_path_buf()
+    } else {
+        matrix.to_path_buf()
+    };
+    let out = matrix_dir.join("advise").join(&name);
+    let options = ValidateOptions {
+        suite: suite.source.clone(),
+        out: out.clone(),
+        runs_dir: Some(matrix_dir.join("runs")),
+        reuse: true,
+        ..options.clone()
+    };
+    validate_suite(&mine, &options)?;
+    Ok(out)
+}
+
 /// The advice for `case` (a case name as in the report, e.g. `aor_hertz-fidelity`, or its
 /// scene name without the variant when only one variant has points).
 pub fn advise(
@@ -156,16 +248,7 @@ pub fn advise(
     let mut cases: Vec<&str> = points.iter().map(|p| p.case.as_str()).collect();
     cases.sort();
     cases.dedup();
-    let prefixed: Vec<&str> = cases
-        .iter()
-        .copied()
-        .filter(|c| c.strip_prefix(case).is_some_and(|v| v.starts_with('-')))
-        .collect();
-    let name = if cases.contains(&case) {
-        case
-    } else if prefixed.len() == 1 {
-        prefixed[0]
-    } else {
+    let Some(name) = resolve_case(&cases, case) else {
         return Err(AdviseError::NoCase {
             file: file.to_path_buf(),
             case: case.to_string(),
@@ -184,9 +267,13 @@ pub fn advise(
             case: name.to_string(),
         });
     };
+    // What the coarse-grained runs measured, for the error when they did not measure `m`.
     let measured: Vec<&str> = Measure::ALL
         .into_iter()
-        .filter(|q| mine.iter().any(|p| q.of(p).is_some()))
+        .filter(|q| {
+            mine.iter()
+                .any(|p| p.series.starts_with("lambda") && q.of(p).is_some())
+        })
         .map(Measure::quantity)
         .collect();
     let mean_wall = |runs: &[&AccuracyPoint]| {

@@ -141,7 +141,7 @@ pub(super) fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateEr
     }
 }
 
-#[derive(Clone)]
+#[derive(Clone, Default)]
 pub struct ValidateOptions {
     pub suite: PathBuf,
     pub out: PathBuf,
@@ -175,6 +175,19 @@ pub struct ValidateOptions {
     /// `--checkpoint-every`: cgdem's case and accuracy runs write restart files this many
     /// simulated seconds apart; with `reuse`, a run that was killed goes on from its last one.
     pub checkpoint_every: Option<Real>,
+    /// Where the runs live; None: `OUT/runs`. `cgdem advise --run` keeps them in the
+    /// matrix's directory (where `--reuse` finds those already made) while the report of the
+    /// one case it ran is written beside, leaving the matrix's own report as it was.
+    pub runs_dir: Option<PathBuf>,
+}
+
+impl ValidateOptions {
+    /// The directory that holds the runs: `runs_dir`, or `OUT/runs`.
+    pub fn runs_dir(&self) -> PathBuf {
+        self.runs_dir
+            .clone()
+            .unwrap_or_else(|| self.out.join("runs"))
+    }
 }
 
 /// `validate --grid` and `--balance`: every cgdem run of the suite (cases, accuracy sweeps,

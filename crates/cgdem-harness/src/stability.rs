@@ -26,7 +26,7 @@ use crate::code::Code;
 use crate::csv_table::CsvTable;
 use crate::ranks::run_scene;
 use crate::report::{Cell, Report, Table};
-use crate::runs::CgdemDecomposition;
+use crate::runs::{CgdemDecomposition, ValidateOptions};
 use crate::suite_entry::{load_variant, parse_codes, parse_variant, SuiteError};
 use cgdem_core::coarse_graining::coarse_grain;
 use cgdem_core::guard::overlap_fraction;
@@ -214,21 +214,21 @@ pub struct StabilityRecord {
     pub evidence: Option<Evidence>,
 }
 
-/// Runs every stability case of a suite in its codes under `out/runs/stability/`, adds the
-/// "Stability" section to `report` and writes `out/stability.csv` (none of it for a suite
-/// without stability cases).
+/// Runs every stability case of a suite in its codes under `RUNS/stability/` (the options'
+/// runs directory), adds the "Stability" section to `report` and writes
+/// `OUT/stability.csv` (none of it for a suite without stability cases).
 pub fn run_stability(
     cases: &[StabilityCase],
-    out: &Path,
-    quiet: bool,
-    keep_going: bool,
-    reference_timeout_s: u64,
-    decomposition: &CgdemDecomposition,
+    options: &ValidateOptions,
     report: &mut Report,
 ) -> Result<Vec<StabilityRecord>, String> {
     if cases.is_empty() {
         return Ok(Vec::new());
     }
+    let (out, runs) = (&options.out, options.runs_dir());
+    let (quiet, keep_going) = (options.quiet, options.keep_going);
+    let (reference_timeout_s, decomposition) =
+        (options.reference_timeout_s, &options.decomposition);
     let mut records = Vec::new();
     let mut described = Vec::new();
     for case in cases {
@@ -274,11 +274,7 @@ pub fn run_stability(
             }
         };
         for &code in &case.codes {
-            let dir = out
-                .join("runs")
-                .join("stability")
-                .join(&scene.name)
-                .join(code.name());
+            let dir = runs.join("stability").join(&scene.name).join(code.name());
             let _ = std::fs::remove_dir_all(&dir);
             let record = match code {
                 Code::Cgdem => run_cgdem(&scene, case, &dir, keep_going, decomposition),
@@ -1007,16 +1003,12 @@ mod tests {
     fn a_suite_without_stability_cases_adds_no_section_and_no_csv() {
         let dir = std::env::temp_dir().join(format!("cgdem-stability-none-{}", std::process::id()));
         let mut report = Report::new("t");
-        let records = run_stability(
-            &[],
-            &dir,
-            true,
-            false,
-            1,
-            &CgdemDecomposition::default(),
-            &mut report,
-        )
-        .unwrap();
+        let options = ValidateOptions {
+            out: dir.clone(),
+            quiet: true,
+            ..Default::default()
+        };
+        let records = run_stability(&[], &options, &mut report).unwrap();
         assert!(records.is_empty());
         assert!(!dir.join("stability.csv").exists());
         assert!(!report.render(&dir).contains("Stability"));

@@ -95,12 +95,20 @@ pub struct ValidationSummary {
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
 /// recorded with its reason and the suite goes on.
 pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, ValidateError> {
-    let suite = Suite::load(&options.suite)?;
+    validate_suite(&Suite::load(&options.suite)?, options)
+}
+
+/// As [`validate`], for a suite already loaded (`options.suite` names its file in the
+/// provenance): `cgdem advise --run` hands it the sweeps of one case.
+pub fn validate_suite(
+    suite: &Suite,
+    options: &ValidateOptions,
+) -> Result<ValidationSummary, ValidateError> {
     std::fs::create_dir_all(&options.out).map_err(|e| output_error(&options.out, e))?;
     let mut runs = Vec::new();
     let mut comparisons = Vec::new();
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
-    let provenance = provenance(&suite, options);
+    let provenance = provenance(suite, options);
     // Cases of one scene (e.g. its two coarse-graining rules) are compared and reported
     // together: one section, one set of figures, judged by the first case's tolerances and
     // by the known differences any of them declares.
@@ -156,19 +164,11 @@ pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, Validate
     }
     let accuracy =
         super::accuracy::run_sweeps(&suite.accuracy, &suite.source, options, &mut report)?;
-    let stability = super::stability::run_stability(
-        &suite.stability,
-        &options.out,
-        options.quiet,
-        options.keep_going,
-        options.reference_timeout_s,
-        &options.decomposition,
-        &mut report,
-    )
-    .map_err(|message| ValidateError::Case {
-        file: suite.source.clone(),
-        message,
-    })?;
+    let stability = super::stability::run_stability(&suite.stability, options, &mut report)
+        .map_err(|message| ValidateError::Case {
+            file: suite.source.clone(),
+            message,
+        })?;
     let summary = ValidationSummary {
         suite: suite.name.clone(),
         provenance,
@@ -509,7 +509,7 @@ pub(crate) fn machine_provenance() -> BTreeMap<String, String> {
 }
 
 fn run_dir(
-    out: &Path,
+    runs: &Path,
     scene: &Scene,
     code: Code,
     lambda: u32,
@@ -520,9 +520,7 @@ fn run_dir(
     if rule != CoarseGrainRule::Seed {
         name += &format!("-{}", rule_name(rule));
     }
-    out.join("runs")
-        .join(&scene.name)
-        .join(format!("{name}-seed{seed}"))
+    runs.join(&scene.name).join(format!("{name}-seed{seed}"))
 }
 
 fn run_case(
@@ -577,7 +575,7 @@ fn run_case(
                 (Some(f), Code::Cgdem) => f,
                 _ => scene,
             };
-            let mut dir = run_dir(&options.out, scene, code, lambda, rule, seed);
+            let mut dir = run_dir(&options.runs_dir(), scene, code, lambda, rule, seed);
             let at_speed;
             let scene = match (rpm, &scene.conveying) {
                 (Some(rpm), Some(c)) => {
