@@ -1239,7 +1239,6 @@ fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, ExitCode> {
         })
 }
 
-/// `cgdem advise`: the answer from the stored matrix, in words or as JSON.
 /// `cgdem advise --run`'s settings.
 struct AdviseRun {
     suite: Option<String>,
@@ -1302,6 +1301,8 @@ fn advise_run(case: &str, matrix: &Path, run: AdviseRun) -> Result<PathBuf, Exit
     })
 }
 
+/// `cgdem advise`: the answer from the stored matrix (with `--run`, after making the case's
+/// missing points), in words or as JSON.
 fn advise(
     case: &str,
     quantity: &str,

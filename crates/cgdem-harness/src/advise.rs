@@ -166,6 +166,7 @@ pub fn resolve_case<'a>(cases: &[&'a str], case: &str) -> Option<&'a str> {
         .copied()
         .filter(|c| c.strip_prefix(case).is_some_and(|v| v.starts_with('-')))
         .collect();
+    variants.sort();
     variants.dedup();
     (variants.len() == 1).then(|| variants[0])
 }
