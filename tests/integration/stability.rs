@@ -134,7 +134,7 @@ fn validate_jobs_runs_an_accuracy_sweep_side_by_side_with_the_same_points() {
         let out = dir.join(out);
         let o = Command::new(env!("CARGO_BIN_EXE_cgdem"))
             .args(["validate", "--quiet", "--suite"])
-            .arg("tests/data/tiny_accuracy_suite.toml")
+            .arg("tests/data/tiny_fidelity_suite.toml")
             .args(["--threads", threads, "--jobs", jobs, "--out"])
             .arg(&out)
             .output()
@@ -158,30 +158,25 @@ fn validate_jobs_runs_an_accuracy_sweep_side_by_side_with_the_same_points() {
             .collect()
     };
     let (p1, p2) = (points(&one), points(&two));
-    assert_eq!(p1.len(), 4, "{one}");
+    assert_eq!(p1.len(), 6, "{one}");
     assert!(p1.iter().all(|p| p["status"] == "ok"), "{one}");
     assert_eq!(p1, p2);
-    let runs = dir.join("two/runs/tiny_hertz_collapse-short/accuracy");
-    for run in std::fs::read_dir(&runs).unwrap().flatten() {
-        let name = run.file_name();
-        let summary: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(run.path().join("summary.json")).unwrap(),
-        )
-        .unwrap();
-        assert_eq!(summary["threads"], 1, "{name:?}");
-        let series = |root: &str| {
-            std::fs::read(
-                dir.join(root)
-                    .join("runs/tiny_hertz_collapse-short/accuracy")
-                    .join(&name)
-                    .join("timeseries.csv"),
+    for case in ["tiny_hertz_collapse-fidelity", "tiny_hertz_collapse-short"] {
+        let runs = |root: &str| dir.join(root).join("runs").join(case).join("accuracy");
+        for run in std::fs::read_dir(runs("two")).unwrap().flatten() {
+            let name = run.file_name();
+            let summary: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(run.path().join("summary.json")).unwrap(),
             )
-            .unwrap()
-        };
-        assert!(
-            series("one") == series("two"),
-            "{name:?}: time series differ"
-        );
+            .unwrap();
+            assert_eq!(summary["threads"], 1, "{name:?}");
+            let series =
+                |root: &str| std::fs::read(runs(root).join(&name).join("timeseries.csv")).unwrap();
+            assert!(
+                series("one") == series("two"),
+                "{name:?}: time series differ"
+            );
+        }
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
