@@ -220,7 +220,8 @@ pub fn run_case(
             .collect(),
         ..suite.clone()
     };
-    let matrix_dir = if matrix.is_file() {
+    // The matrix as a directory or as its summary.json (which need not exist yet).
+    let matrix_dir = if matrix.is_file() || matrix.extension().is_some_and(|e| e == "json") {
         matrix.parent().unwrap_or(Path::new(".")).to_path_buf()
     } else {
         matrix.to_path_buf()
