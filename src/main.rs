@@ -341,8 +341,8 @@ enum Command {
         /// The case: its scene file (e.g. validation/cases/aor_hertz.toml) or its name in the
         /// report (e.g. aor_hertz-fidelity).
         case: String,
-        /// repose_angle (deg), profile, mass_flow, mass_flow_eq7, t_half (relative) or
-        /// porosity (absolute).
+        /// repose_angle (deg), profile, mass_flow, mass_flow_eq7, t_half, front_history,
+        /// pore_size (relative) or porosity (absolute).
         #[arg(long)]
         quantity: String,
         /// The largest error allowed, in the quantity's unit (e.g. 2 for 2 deg, 0.05 for 5%).

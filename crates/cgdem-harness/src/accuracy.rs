@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::dynamics::FlowSeries;
+use super::dynamics::{flow_difference, FlowSeries, FLOW_GRID_S};
 use crate::code::Code;
 use crate::csv_table::CsvTable;
 use crate::report::{write_figure, Cell, Figure, Report, Section, Series, SeriesStyle, Table};
@@ -100,6 +100,9 @@ pub struct Targets {
     pub mass_flow: f64,
     /// Relative error of the collapse's characteristic time t_half.
     pub t_half: f64,
+    /// Front history: largest gap over the flow in the fraction of its run-out each front
+    /// has covered.
+    pub front: f64,
     /// Absolute porosity difference.
     pub porosity: f64,
     /// Relative difference of the mean pore diameter in particle diameters.
@@ -137,6 +140,7 @@ pub(super) struct RawSweep {
     profile_target: Option<f64>,
     mass_flow_target: Option<f64>,
     t_half_target: Option<f64>,
+    front_target: Option<f64>,
     porosity_target: Option<f64>,
     pore_size_target: Option<f64>,
 }
@@ -277,6 +281,7 @@ impl AccuracySweep {
                 profile: target("profile_target", raw.profile_target, 0.05)?,
                 mass_flow: target("mass_flow_target", raw.mass_flow_target, 0.05)?,
                 t_half: target("t_half_target", raw.t_half_target, 0.1)?,
+                front: target("front_target", raw.front_target, 0.1)?,
                 porosity: target("porosity_target", raw.porosity_target, 0.02)?,
                 pore_size: target("pore_size_target", raw.pore_size_target, 0.1)?,
             },
@@ -371,6 +376,13 @@ pub struct AccuracyPoint {
     /// |pore_diameter_d / the reference run's - 1|.
     #[serde(default)]
     pub pore_size_error: Option<f64>,
+    /// The stage whose flow (front, wall height) the run measured (the repose stage).
+    #[serde(default)]
+    pub flow_stage: Option<String>,
+    /// Largest gap, over the flow, between the fractions of their run-outs the run's front
+    /// and the reference run's (same seed) have covered ([`front_history_gap`]).
+    #[serde(default)]
+    pub front_error: Option<f64>,
 }
 
 /// The cheapest point within a target error, per case, code and error measure.
@@ -409,17 +421,19 @@ pub enum Measure {
     MassFlow,
     Eq7,
     THalf,
+    Front,
     Porosity,
     PoreSize,
 }
 
 impl Measure {
-    pub const ALL: [Measure; 7] = [
+    pub const ALL: [Measure; 8] = [
         Measure::Angle,
         Measure::Profile,
         Measure::MassFlow,
         Measure::Eq7,
         Measure::THalf,
+        Measure::Front,
         Measure::Porosity,
         Measure::PoreSize,
     ];
@@ -432,6 +446,7 @@ impl Measure {
             Measure::MassFlow => p.mass_flow_error,
             Measure::Eq7 => p.eq7_error,
             Measure::THalf => p.t_half_error,
+            Measure::Front => p.front_error,
             Measure::Porosity => p.porosity_error,
             Measure::PoreSize => p.pore_size_error,
         }
@@ -445,6 +460,7 @@ impl Measure {
             Measure::MassFlow => "mass_flow",
             Measure::Eq7 => "mass_flow_eq7",
             Measure::THalf => "t_half",
+            Measure::Front => "front_history",
             Measure::Porosity => "porosity",
             Measure::PoreSize => "pore_size",
         }
@@ -461,6 +477,7 @@ impl Measure {
             Measure::MassFlow => "mass flow vs reference",
             Measure::Eq7 => "mass flow vs Eq. (7)",
             Measure::THalf => "t_half vs reference",
+            Measure::Front => "front history vs reference",
             Measure::Porosity => "porosity vs reference",
             Measure::PoreSize => "pore size (in diameters) vs reference",
         }
@@ -473,6 +490,7 @@ impl Measure {
             Measure::MassFlow => "mass_flow_error",
             Measure::Eq7 => "eq7_error",
             Measure::THalf => "t_half_error",
+            Measure::Front => "front_error",
             Measure::Porosity => "porosity_error",
             Measure::PoreSize => "pore_size_error",
         }
@@ -485,6 +503,7 @@ impl Measure {
             Measure::MassFlow => "|Q / Q_reference - 1| [-]",
             Measure::Eq7 => "|Q / Q_Eq.(7) - 1| [-]",
             Measure::THalf => "|t_half / t_half,reference - 1| [-]",
+            Measure::Front => "largest gap in run-out covered [-]",
             Measure::Porosity => "|porosity - reference| [-]",
             Measure::PoreSize => "|pore diameter / d over the reference's - 1| [-]",
         }
@@ -496,6 +515,7 @@ impl Measure {
             Measure::Profile => t.profile,
             Measure::MassFlow | Measure::Eq7 => t.mass_flow,
             Measure::THalf => t.t_half,
+            Measure::Front => t.front,
             Measure::Porosity => t.porosity,
             Measure::PoreSize => t.pore_size,
         }
@@ -822,6 +842,12 @@ fn run_point(
             .filter(|_| ok)
             .and_then(|r| FlowSeries::read(dir, &r.stage)?.t_half()),
         t_half_error: None,
+        flow_stage: scene
+            .repose
+            .as_ref()
+            .filter(|_| ok)
+            .map(|r| r.stage.clone()),
+        front_error: None,
         porosity: summary["packing"]["porosity"]
             .as_f64()
             .filter(|v| ok && v.is_finite()),
@@ -864,9 +890,30 @@ pub(crate) fn measure(points: &mut [AccuracyPoint]) {
         p.profile_distance = difference(Measure::Profile, p, r);
         p.mass_flow_error = difference(Measure::MassFlow, p, r);
         p.t_half_error = difference(Measure::THalf, p, r);
+        p.front_error = difference(Measure::Front, p, r);
         p.porosity_error = difference(Measure::Porosity, p, r);
         p.pore_size_error = difference(Measure::PoreSize, p, r);
     }
+}
+
+/// The front history's gap: each run's front as the fraction of its own largest advance it
+/// has covered, and the largest difference of the two fractions over the flow (on a common
+/// time grid; the run that ended first holds its last value). 0.1 means "a tenth of the
+/// run-out apart at worst". How far the fronts get is the heap's (angle, profile); this is
+/// how they get there. Each run's own advance also takes out the front's definition in
+/// particle diameters (where the deposit is two diameters deep), which puts a coarser
+/// level's front further back by about two diameters over the toe's slope. None when a
+/// front never advanced.
+pub fn front_history_gap(reference: &FlowSeries, other: &FlowSeries) -> Option<f64> {
+    let covered = |flow: &FlowSeries| -> Option<FlowSeries> {
+        let start = *flow.front_m.first()?;
+        let advance = flow.front_m.iter().map(|x| x - start).fold(0.0, f64::max);
+        (advance > 0.0).then(|| FlowSeries {
+            front_m: flow.front_m.iter().map(|x| (x - start) / advance).collect(),
+            ..flow.clone()
+        })
+    };
+    Some(flow_difference(&covered(reference)?, &covered(other)?, 1.0, FLOW_GRID_S)?.front_max)
 }
 
 /// How far run `p` is from run `r` under measure `m` (None where either measured nothing).
@@ -882,6 +929,10 @@ fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
         Measure::MassFlow => finite((p.mass_flow_kg_s? / r.mass_flow_kg_s? - 1.0).abs()),
         Measure::Eq7 => finite((p.eq7_error? - r.eq7_error?).abs()),
         Measure::THalf => finite((p.t_half_s? / r.t_half_s? - 1.0).abs()),
+        Measure::Front => {
+            let flow = |q: &AccuracyPoint| FlowSeries::read(&q.dir, q.flow_stage.as_deref()?);
+            finite(front_history_gap(&flow(r)?, &flow(p)?)?)
+        }
         Measure::Porosity => finite((p.porosity? - r.porosity?).abs()),
         Measure::PoreSize => finite((p.pore_diameter_d? / r.pore_diameter_d? - 1.0).abs()),
     }
@@ -1054,6 +1105,7 @@ fn write_sweep_section(
         "porosity_error",
         "pore_diameter_d",
         "pore_size_error",
+        "front_error",
     ]);
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
@@ -1120,6 +1172,7 @@ fn write_sweep_section(
             o(p.porosity_error),
             o(p.pore_diameter_d),
             o(p.pore_size_error),
+            o(p.front_error),
         ]);
     }
     std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
@@ -1592,6 +1645,8 @@ pub(crate) mod tests {
             porosity_error: None,
             pore_diameter_d: None,
             pore_size_error: None,
+            flow_stage: None,
+            front_error: None,
         }
     }
 
@@ -1648,6 +1703,7 @@ pub(crate) mod tests {
             profile: 0.05,
             mass_flow: 0.05,
             t_half: 0.1,
+            front: 0.1,
             porosity: 0.02,
             pore_size: 0.1,
         };
@@ -1691,6 +1747,42 @@ pub(crate) mod tests {
         let coarse: Vec<(f64, f64)> = heap.iter().step_by(2).copied().collect();
         assert!(profile_distance(&heap, &coarse).unwrap() < 0.05);
         assert_eq!(profile_distance(&[], &heap), None);
+    }
+
+    /// A front 0.1 s behind the reference's has covered a tenth of its run-out less at worst;
+    /// equal fronts, or the same shape shorter and offset, are 0 apart; a front that stops
+    /// halfway at the same pace has covered all of its run-out when the reference has
+    /// covered half: 0.5 apart.
+    #[test]
+    fn front_history_gap_compares_the_fraction_of_run_out_covered() {
+        let flow = |front: &dyn Fn(f64) -> f64| {
+            let time_s: Vec<f64> = (0..=200).map(|k| 0.01 * k as f64).collect();
+            FlowSeries {
+                front_m: time_s.iter().map(|&t| front(t)).collect(),
+                wall_height_m: vec![0.3; time_s.len()],
+                kinetic_energy_per_mass: vec![1.0; time_s.len()],
+                time_s,
+            }
+        };
+        // 0.2 m to 0.6 m at 0.4 m/s over the first second, then at rest.
+        let reference = flow(&|t: f64| 0.2 + 0.4 * t.min(1.0));
+        assert_eq!(front_history_gap(&reference, &reference), Some(0.0));
+        let late = flow(&|t: f64| 0.2 + 0.4 * (t - 0.1).clamp(0.0, 1.0));
+        let gap = front_history_gap(&reference, &late).unwrap();
+        assert!((gap - 0.1).abs() < 1e-9, "{gap}");
+        // Half the run-out at the same pace: done at 0.5 s, when the reference has covered
+        // half of its own.
+        let halfway = flow(&|t: f64| 0.2 + 0.4 * t.min(0.5));
+        let gap = front_history_gap(&reference, &halfway).unwrap();
+        assert!((gap - 0.5).abs() < 1e-9, "{gap}");
+        // The same shape, shorter and offset (a coarser front's definition): no gap.
+        let shorter = flow(&|t: f64| 0.15 + 0.3 * t.min(1.0));
+        let gap = front_history_gap(&reference, &shorter).unwrap();
+        assert!(gap < 1e-9, "{gap}");
+        // A front that never moved has no run-out to measure against.
+        let still = flow(&|_| 0.2);
+        assert_eq!(front_history_gap(&still, &reference), None);
+        assert_eq!(front_history_gap(&reference, &still), None);
     }
 
     #[test]

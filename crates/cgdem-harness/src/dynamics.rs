@@ -7,6 +7,9 @@ use std::path::Path;
 
 use crate::csv_table::CsvTable;
 
+/// Spacing of the common time grid on which flow histories are averaged and compared.
+pub const FLOW_GRID_S: f64 = 0.01;
+
 /// One run's (or a mean over seeds') flow during the measured stage, time from its start.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FlowSeries {

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::dynamics::{flow_difference, flow_noise, FlowSeries};
+use super::dynamics::{flow_difference, flow_noise, FlowSeries, FLOW_GRID_S};
 use super::suite::{Code, Suite, SuiteCase};
 use super::verdict::{combined_standard_error, mean_sd, Criterion, Verdict};
 use crate::csv_table::CsvTable;
@@ -853,9 +853,6 @@ fn compare_flows(
         criteria,
     ))
 }
-
-/// Spacing of the common time grid on which flow histories are averaged and compared.
-const FLOW_GRID_S: f64 = 0.01;
 
 /// Every successful run's flow during the measured stage, per group.
 fn flows_by_group(scene: &Scene, runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<FlowSeries>> {
