@@ -1286,7 +1286,6 @@ fn advise_run(case: &str, matrix: &Path, run: AdviseRun) -> Result<PathBuf, Exit
     let interrupt = install_interrupt();
     let options = cgdem_harness::validate::ValidateOptions {
         progress: progress_bar::progress(false),
-        reference_timeout_s: 3600,
         jobs: usize::from(run.jobs),
         stop: interrupt.as_ref().map(|i| i.flag()),
         ..Default::default()

@@ -446,7 +446,12 @@ fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
     );
     assert!(!matrix.join("summary.json").exists());
     let report = matrix.join("advise").join(case);
-    assert!(report.join("index.html").is_file());
+    // The case's report says where its runs are.
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(
+        html.contains(&format!("under {}", matrix.join("runs").display())),
+        "{html}"
+    );
 
     // One point lost: only it is made again, and the answer is the same.
     std::fs::remove_dir_all(runs.join("cgdem-lambda-2-seed2")).unwrap();

@@ -141,7 +141,7 @@ pub(super) fn output_error(path: &Path, e: impl std::fmt::Display) -> ValidateEr
     }
 }
 
-#[derive(Clone, Default)]
+#[derive(Clone)]
 pub struct ValidateOptions {
     pub suite: PathBuf,
     pub out: PathBuf,
@@ -179,6 +179,29 @@ pub struct ValidateOptions {
     /// matrix's directory (where `--reuse` finds those already made) while the report of the
     /// one case it ran is written beside, leaving the matrix's own report as it was.
     pub runs_dir: Option<PathBuf>,
+}
+
+impl Default for ValidateOptions {
+    /// As `cgdem validate` with no options: the smoke suite into reports/latest, one run at
+    /// a time, an hour per reference-code run.
+    fn default() -> Self {
+        ValidateOptions {
+            suite: PathBuf::from("validation/suites/smoke.toml"),
+            out: PathBuf::from("reports/latest"),
+            quiet: false,
+            progress: None,
+            reference_timeout_s: 3600,
+            reuse: false,
+            keep_going: false,
+            jobs: 1,
+            stop: None,
+            cgdem_faults: Vec::new(),
+            history: None,
+            decomposition: CgdemDecomposition::default(),
+            checkpoint_every: None,
+            runs_dir: None,
+        }
+    }
 }
 
 impl ValidateOptions {

@@ -179,10 +179,13 @@ pub fn validate_suite(
     };
     let intro = report.intro();
     write_status(intro, &summary, options);
+    let runs_at = match &options.runs_dir {
+        None => "runs/".to_string(),
+        Some(dir) => dir.display().to_string(),
+    };
     intro.paragraph(format!(
-        "{} {}",
-        suite.description,
-        "Each run's files are under runs/; figures have their data as CSV beside them."
+        "{} Each run's files are under {runs_at}; figures have their data as CSV beside them.",
+        suite.description
     ));
     let table = criteria_table(&summary.comparisons);
     let mut run_table = Table::new([
