@@ -385,6 +385,23 @@ pub struct AccuracyPoint {
     pub front_error: Option<f64>,
 }
 
+impl AccuracyPoint {
+    /// The run with none of its errors against a reference (`measure` sets them).
+    fn without_errors(&self) -> AccuracyPoint {
+        AccuracyPoint {
+            angle_error_deg: None,
+            profile_distance: None,
+            mass_flow_error: None,
+            eq7_error: None,
+            t_half_error: None,
+            porosity_error: None,
+            pore_size_error: None,
+            front_error: None,
+            ..self.clone()
+        }
+    }
+}
+
 /// The cheapest point within a target error, per case, code and error measure.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CheapestSetting {
@@ -638,11 +655,86 @@ pub(super) fn run_sweeps(
         measure(&mut points);
         let case = points.first().map(|p| p.case.clone()).unwrap_or_default();
         let dir = options.out.join("figures").join("accuracy").join(&case);
-        let cheapest = write_sweep_section(section, sweep, &case, &points, &dir)?;
+        let cheapest = write_sweep_section(section, sweep, &case, &points, &dir, None)?;
+        let own = own_rule_sweeps(sweep, &case, &points);
         summary.points.extend(points);
         summary.cheapest.extend(cheapest);
+        for (own_sweep, mut own_points) in own {
+            measure(&mut own_points);
+            let own_case = own_points[0].case.clone();
+            let dir = options.out.join("figures").join("accuracy").join(&own_case);
+            let note = format!(
+                "The {} rule's own matrix: its levels against its own lambda = {}, from the                  runs of case {case} (none made again).",
+                own_sweep.rule.name(),
+                own_sweep.reference[&Knob::Lambda]
+            );
+            let cheapest = write_sweep_section(
+                section,
+                &own_sweep,
+                &own_case,
+                &own_points,
+                &dir,
+                Some(&note),
+            )?;
+            summary.points.extend(own_points);
+            summary.cheapest.extend(cheapest);
+        }
     }
     Ok(Some(summary))
+}
+
+/// Each other rule's own matrix, from runs already made: a lambda series under another rule
+/// than the reference's that includes the reference's level is also a sweep of its own, with
+/// that level as its reference, reported as case `<case>-<rule>-rule`. "How far does lambda
+/// 16 move from lambda 8 under this rule" then needs no second set of runs (the scene name
+/// is part of a run's digest, so a second sweep of the same runs would make them again).
+fn own_rule_sweeps(
+    sweep: &AccuracySweep,
+    case: &str,
+    points: &[AccuracyPoint],
+) -> Vec<(AccuracySweep, Vec<AccuracyPoint>)> {
+    let Some(&level) = sweep.reference.get(&Knob::Lambda) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for s in sweep
+        .series
+        .iter()
+        .filter(|s| s.knob == Knob::Lambda && s.rule != sweep.rule && s.values.contains(&level))
+    {
+        let series = s.name(sweep.rule);
+        let own_case = format!("{case}-{}-rule", s.rule.name());
+        let own_points: Vec<AccuracyPoint> = points
+            .iter()
+            .filter(|p| p.series == series)
+            .map(|p| {
+                let (series, setting) = if p.value == level {
+                    ("reference".to_string(), "reference".to_string())
+                } else {
+                    let knob = Knob::Lambda.name();
+                    (knob.to_string(), format!("{knob} = {}", p.value))
+                };
+                AccuracyPoint {
+                    case: own_case.clone(),
+                    series,
+                    setting,
+                    ..p.without_errors()
+                }
+            })
+            .collect();
+        if own_points.iter().any(|p| p.series == "reference") {
+            let own_sweep = AccuracySweep {
+                rule: s.rule,
+                series: vec![KnobSeries {
+                    values: s.values.iter().copied().filter(|&v| v != level).collect(),
+                    ..s.clone()
+                }],
+                ..sweep.clone()
+            };
+            out.push((own_sweep, own_points));
+        }
+    }
+    out
 }
 
 /// Runs, seed by seed, the reference of every code, then each series point; codes alternate
@@ -1029,8 +1121,12 @@ fn write_sweep_section(
     case: &str,
     points: &[AccuracyPoint],
     dir: &Path,
+    note: Option<&str>,
 ) -> Result<Vec<CheapestSetting>, ValidateError> {
     let sub = section.subsection(format!("Case {case}"));
+    if let Some(note) = note {
+        sub.paragraph(note);
+    }
     let reference = sweep
         .reference
         .iter()
@@ -1045,7 +1141,7 @@ fn write_sweep_section(
         .join(", ");
     sub.paragraph(format!(
         "Scene file {} with the overrides of variant `{}` ({}); insertion seeds {}. \
-         Reference setting: {reference}.",
+         Reference setting: {reference}, {} rule.",
         sweep.file.display(),
         sweep.variant,
         if shared.is_empty() { "none" } else { &shared },
@@ -1054,7 +1150,8 @@ fn write_sweep_section(
             .iter()
             .map(|s| s.to_string())
             .collect::<Vec<_>>()
-            .join(", ")
+            .join(", "),
+        sweep.rule.name(),
     ));
     let measures: Vec<Measure> = Measure::ALL
         .into_iter()
@@ -1807,6 +1904,69 @@ pub(crate) mod tests {
                 }
             }
         }
+    }
+
+    /// A series under another rule that includes the reference's level is that rule's own
+    /// matrix too: its runs at the reference's level become the reference, the others keep
+    /// their errors to be measured against it; a series without that level adds nothing.
+    #[test]
+    fn a_rule_series_at_the_reference_level_is_also_its_own_matrix() {
+        crate::at_repo_root();
+        let suite = Suite::parse(
+            "name = \"a\"\n[[accuracy]]\nfile = \"validation/cases/aor_collapse.toml\"\n\
+             variant = \"f\"\nseeds = [1, 2]\n[accuracy.reference]\nlambda = 8\n\
+             [[accuracy.series]]\nknob = \"lambda\"\nvalues = [16]\n\
+             [[accuracy.series]]\nknob = \"lambda\"\nvalues = [8, 16]\ncg_rule = \"bulk-viscosity\"\n\
+             [[accuracy.series]]\nknob = \"lambda\"\nvalues = [32]\ncg_rule = \"bulk-viscosity\"\n",
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        let sweep = &suite.accuracy[0];
+        let point = |series: &str, lambda: u32, rule: CoarseGrainRule, seed: u64, angle: f64| {
+            let mut p = run(series, lambda as f64, seed, angle, 1e6 / lambda as f64);
+            p.lambda = lambda;
+            p.cg_rule = rule;
+            p.angle_error_deg = Some(99.0);
+            p
+        };
+        let (seed_rule, bv) = (CoarseGrainRule::Seed, CoarseGrainRule::BulkViscosity);
+        let mut points = Vec::new();
+        for seed in [1, 2] {
+            points.push(point("reference", 8, seed_rule, seed, 40.0));
+            points.push(point("lambda", 16, seed_rule, seed, 45.0));
+            points.push(point(
+                "lambda (bulk-viscosity)",
+                8,
+                bv,
+                seed,
+                20.0 + seed as f64,
+            ));
+            points.push(point(
+                "lambda (bulk-viscosity)",
+                16,
+                bv,
+                seed,
+                23.0 + seed as f64,
+            ));
+        }
+        let own = own_rule_sweeps(sweep, "c", &points);
+        assert_eq!(own.len(), 1, "the lambda-32-only series has no reference");
+        let (own_sweep, mut own_points) = own.into_iter().next().unwrap();
+        assert_eq!(own_sweep.rule, bv);
+        assert_eq!(own_sweep.series.len(), 1);
+        assert_eq!(own_sweep.series[0].values, vec![16.0]);
+        assert_eq!(own_points.len(), 4);
+        assert!(own_points.iter().all(|p| p.case == "c-bulk-viscosity-rule"));
+        assert!(own_points.iter().all(|p| p.angle_error_deg.is_none()));
+        let settings: Vec<&str> = own_points.iter().map(|p| p.setting.as_str()).collect();
+        assert_eq!(
+            settings,
+            ["reference", "lambda = 16", "reference", "lambda = 16"]
+        );
+        measure(&mut own_points);
+        // 24 - 21 and 25 - 22: 3 deg in each seed, against the rule's own lambda 8.
+        assert_eq!(own_points[1].angle_error_deg, Some(3.0));
+        assert_eq!(own_points[3].angle_error_deg, Some(3.0));
     }
 
     #[test]
