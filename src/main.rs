@@ -1260,11 +1260,7 @@ fn suite_path(suite: &str) -> PathBuf {
 fn advise_run(case: &str, matrix: &Path, run: AdviseRun) -> Result<PathBuf, ExitCode> {
     // The suite the matrix was made from, as its provenance names it.
     let made_from = || -> Option<String> {
-        let file = if matrix.is_dir() {
-            matrix.join("summary.json")
-        } else {
-            matrix.to_path_buf()
-        };
+        let (_, file) = cgdem_harness::advise::matrix_paths(matrix);
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(file).ok()?).ok()?;
         summary["provenance"]["suite file"]

@@ -396,16 +396,21 @@ fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
     std::fs::create_dir_all(&matrix).unwrap();
     // A matrix report of another suite, which --run must leave as it is.
     std::fs::write(matrix.join("index.html"), "the matrix's report").unwrap();
+    // The question every call asks, of one case.
+    let ask = |case: &str| {
+        let mut c = cgdem();
+        c.args([
+            "advise",
+            case,
+            "--quantity",
+            "repose_angle",
+            "--target",
+            "5",
+        ]);
+        c
+    };
     let advise = |case: &str| {
-        let out = cgdem()
-            .args([
-                "advise",
-                case,
-                "--quantity",
-                "repose_angle",
-                "--target",
-                "5",
-            ])
+        let out = ask(case)
             .args(["--run", "--suite", "tests/data/tiny_fidelity_suite.toml"])
             .args(["--threads", "1", "--matrix"])
             .arg(&matrix)
@@ -470,19 +475,7 @@ fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
         .collect();
     assert_eq!(made_again, ["lambda = 2"], "{summary}");
     // Without --run the answer from the case's report is the same.
-    let out = cgdem()
-        .args([
-            "advise",
-            case,
-            "--quantity",
-            "repose_angle",
-            "--target",
-            "5",
-            "--matrix",
-        ])
-        .arg(&report)
-        .output()
-        .unwrap();
+    let out = ask(case).arg("--matrix").arg(&report).output().unwrap();
     assert_eq!(String::from_utf8_lossy(&out.stdout), second);
 
     // A case the suite has no sweep of, or a scene name two of its variants share, is an

@@ -134,11 +134,7 @@ impl Advice {
 
 /// Reads the `accuracy` points of a report directory's (or file's) `summary.json`.
 pub fn read_matrix(path: &Path) -> Result<(PathBuf, Vec<AccuracyPoint>), AdviseError> {
-    let file = if path.is_dir() {
-        path.join("summary.json")
-    } else {
-        path.to_path_buf()
-    };
+    let (_, file) = matrix_paths(path);
     let fail = |reason: String| AdviseError::Matrix {
         file: file.clone(),
         reason,
@@ -153,6 +149,17 @@ pub fn read_matrix(path: &Path) -> Result<(PathBuf, Vec<AccuracyPoint>), AdviseE
     let points: Vec<AccuracyPoint> = serde_json::from_value(points.clone())
         .map_err(|e| fail(format!("`accuracy.points`: {e}")))?;
     Ok((file, points))
+}
+
+/// The matrix's directory and its summary.json, from `--matrix` naming either (a
+/// summary.json that `advise --run` has yet to write included).
+pub fn matrix_paths(matrix: &Path) -> (PathBuf, PathBuf) {
+    if matrix.is_file() || matrix.extension().is_some_and(|e| e == "json") {
+        let dir = matrix.parent().unwrap_or(Path::new("."));
+        (dir.to_path_buf(), matrix.to_path_buf())
+    } else {
+        (matrix.to_path_buf(), matrix.join("summary.json"))
+    }
 }
 
 /// Which of `cases` the user's `case` names: itself, or the one case that is `case` with a
@@ -220,12 +227,7 @@ pub fn run_case(
             .collect(),
         ..suite.clone()
     };
-    // The matrix as a directory or as its summary.json (which need not exist yet).
-    let matrix_dir = if matrix.is_file() || matrix.extension().is_some_and(|e| e == "json") {
-        matrix.parent().unwrap_or(Path::new(".")).to_path_buf()
-    } else {
-        matrix.to_path_buf()
-    };
+    let (matrix_dir, _) = matrix_paths(matrix);
     let out = matrix_dir.join("advise").join(&name);
     let options = ValidateOptions {
         suite: suite.source.clone(),
