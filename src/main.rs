@@ -124,7 +124,7 @@ enum Command {
         /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
         #[arg(long)]
         seed: Option<u64>,
-        /// Output directory (default: runs/<case>-lambda<N>).
+        /// Output directory (default: runs/CASE-lambdaN).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Worker threads for the force loop (default: all cores). Results are bitwise
@@ -176,7 +176,7 @@ enum Command {
         #[arg(long, requires = "set")]
         variant: Option<String>,
         /// A sweep, one run per value: `rpm=20,40,60` (screw speed of the `[conveying]` body;
-        /// OUT/rpm<N>/, OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7)) or
+        /// OUT/rpmN/, OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7)) or
         /// `diameter=1e-6,1e-5,1e-4` (m; a `[packing]` scene rescaled to each diameter with the
         /// material held; OUT/d<um>um/, OUT/porosity_vs_diameter.csv, pore_size_vs_diameter.csv
         /// and plots with the published points).
@@ -300,7 +300,7 @@ enum Command {
         #[arg(long, default_value_t = 1800)]
         reference_timeout: u64,
         /// Also time cgdem decomposed into these subdomains (`2x1x1`, as `run --grid`), as a
-        /// case `<case>-grid<G>` in the same alternation (ratio to the undecomposed run per
+        /// case CASE-gridG in the same alternation (ratio to the undecomposed run per
         /// repetition).
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
@@ -407,7 +407,7 @@ struct ReferenceArgs {
     /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
     #[arg(long)]
     seed: Option<u64>,
-    /// Output directory (default: runs/<case>-lambda<N>-<code>).
+    /// Output directory (default: runs/CASE-lambdaN-CODE).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Override a scene field before validation, e.g. `--set wall_contact.friction=0.0`
