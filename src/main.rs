@@ -178,7 +178,7 @@ enum Command {
         /// A sweep, one run per value: `rpm=20,40,60` (screw speed of the `[conveying]` body;
         /// OUT/rpmN/, OUT/mass_flow_vs_rpm.csv and a plot with Eq. (7)) or
         /// `diameter=1e-6,1e-5,1e-4` (m; a `[packing]` scene rescaled to each diameter with the
-        /// material held; OUT/d<um>um/, OUT/porosity_vs_diameter.csv, pore_size_vs_diameter.csv
+        /// material held; OUT/dUMum/, OUT/porosity_vs_diameter.csv, pore_size_vs_diameter.csv
         /// and plots with the published points).
         #[arg(long)]
         sweep: Option<String>,
