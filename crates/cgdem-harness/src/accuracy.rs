@@ -664,7 +664,7 @@ pub(super) fn run_sweeps(
             let own_case = own_points[0].case.clone();
             let dir = options.out.join("figures").join("accuracy").join(&own_case);
             let note = format!(
-                "The {} rule's own matrix: its levels against its own lambda = {}, from the                  runs of case {case} (none made again).",
+                "The {} rule's own matrix: its levels against its own lambda = {}, from the runs of case {case} (none made again).",
                 own_sweep.rule.name(),
                 own_sweep.reference[&Knob::Lambda]
             );
