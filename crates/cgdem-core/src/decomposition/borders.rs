@@ -122,6 +122,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::decomposition::exchange::exchange;
     use crate::domain::Domain;
+    use crate::neighbor::{brute_force_pairs, PairList};
     use rand::{Rng, SeedableRng};
 
     /// `n` particles spread over `domain`, dealt into the subdomains of `counts` by exchange.
@@ -218,6 +219,96 @@ pub(crate) mod tests {
                     sub.index
                 );
             }
+        }
+    }
+
+    /// Every pair of the whole system is found by the subdomains' lists: once where both
+    /// particles are owned by one subdomain, on both sides (newton off) where one is a ghost.
+    #[test]
+    fn owned_and_ghost_pairs_of_all_subdomains_equal_the_global_pair_list() {
+        let cases = [
+            ([true, false, true], [2, 2, 1]),
+            ([true; 3], [1, 2, 2]),
+            ([false; 3], [3, 1, 1]),
+            ([false, true, false], [2, 1, 1]),
+        ];
+        for (periodic, counts) in cases {
+            let domain = Domain {
+                lo: Vec3::new(-0.2, 0.1, 0.0),
+                hi: Vec3::new(0.8, 0.9, 0.9),
+                periodic,
+            };
+            let skin = 0.01;
+            let (mut p, grid, mut subs) = decomposed(&domain, counts, 700, 9);
+            // A few frozen particles: two frozen ones are never a pair.
+            for k in (0..p.len()).step_by(5) {
+                p.freeze(k);
+            }
+            for sub in subs.iter_mut() {
+                for k in 0..sub.n_owned {
+                    if sub.particles.id[k] % 5 == 0 {
+                        sub.particles.freeze(k);
+                    }
+                }
+            }
+            let width = 2.0 * 0.03 + skin;
+            borders(
+                &mut subs,
+                &grid,
+                width,
+                &crate::decomposition::Comm::local(),
+            );
+            // Global pairs by id: (lower id, higher id, image offset of the higher seen from
+            // the lower), found once when both are owned by one subdomain, twice otherwise.
+            let key = |a: u32, b: u32, xa: Vec3, xb: Vec3| {
+                let d = xb - xa;
+                let image = ((d - (domain.wrap(xb) - domain.wrap(xa))) / domain.length())
+                    .round()
+                    .to_array()
+                    .map(|v| v as i32);
+                if a < b {
+                    (a, b, image)
+                } else {
+                    (b, a, image.map(|v| -v))
+                }
+            };
+            let mut expected: Vec<_> = brute_force_pairs(&p, &domain, skin)
+                .iter()
+                .map(|pair| {
+                    let (i, j) = (pair.i as usize, pair.j as usize);
+                    let xi = domain.wrap(p.position[i]);
+                    let xj = domain.wrap(p.position[j]) + domain.image_shift(pair.image);
+                    key(p.id[i], p.id[j], xi, xj)
+                })
+                .collect();
+            expected.sort_unstable();
+            let mut found = Vec::new();
+            for sub in &subs {
+                let list =
+                    PairList::<()>::build(&sub.particles, sub.n_owned, &sub.rows, skin, width);
+                let q = &sub.particles;
+                for &[i, j] in &list.pairs {
+                    let (i, j) = (i as usize, j as usize);
+                    let both_owned = j < sub.n_owned;
+                    found.push((
+                        key(q.id[i], q.id[j], q.position[i], q.position[j]),
+                        both_owned,
+                    ));
+                }
+            }
+            found.sort_unstable();
+            let mut counted = Vec::new();
+            let mut k = 0;
+            while k < found.len() {
+                let (pair, both_owned) = found[k];
+                let copies = found[k..].iter().take_while(|f| f.0 == pair).count();
+                let wanted = if both_owned { 1 } else { 2 };
+                assert_eq!(copies, wanted, "{periodic:?} {counts:?} pair {pair:?}");
+                assert!(found[k..k + copies].iter().all(|f| f.1 == both_owned));
+                counted.push(pair);
+                k += copies;
+            }
+            assert_eq!(counted, expected, "{periodic:?} {counts:?}");
         }
     }
 }

@@ -11,11 +11,11 @@ use serde::{Deserialize, Serialize};
 use super::balance::Balance;
 use super::borders::SendList;
 use super::forward::States;
-use super::list::LocalList;
 use super::step::Decomposition;
 use super::{Comm, Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
 use crate::math::Real;
+use crate::neighbor::PairList;
 use crate::particles::Particles;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -42,7 +42,7 @@ struct SubdomainOut<'a, H: Serialize, WH: Serialize> {
     wall_history: &'a [WH],
     sends: &'a [SendList],
     receives: &'a [(usize, usize)],
-    list: &'a LocalList<H>,
+    list: &'a PairList<H>,
     capacities: Vec<usize>,
     /// The subdomain's forward buffers (one per send list).
     buffers: Vec<usize>,
@@ -56,7 +56,7 @@ struct SubdomainState<H, WH> {
     wall_history: Vec<WH>,
     sends: Vec<SendList>,
     receives: Vec<(usize, usize)>,
-    list: LocalList<H>,
+    list: PairList<H>,
     capacities: Vec<usize>,
     buffers: Vec<usize>,
 }
@@ -224,7 +224,6 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             total,
             bytes_sent,
             balance,
-            kinematic_loads: Vec::new(),
             buffers,
             forward_counts: None,
         })
