@@ -7,7 +7,7 @@ use crate::contact::{Contact, PairLaw, PairResult};
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
-use crate::walls::{WallContact, WallLaw, WallParticle, WallSet};
+use crate::walls::{WallContact, WallLaw, WallMask, WallParticle, WallSet};
 
 /// The particle arrays the owner pass reads.
 #[derive(Clone, Copy)]
@@ -21,10 +21,9 @@ pub(crate) struct ParticleState<'a> {
     pub(crate) species: &'a [u16],
 }
 
-/// What a force pass borrows from the particles at once: the state it reads, the force and
-/// torque arrays it writes (torque empty without rotation), and the ids.
+/// What a force pass borrows from the particles at once: the state it reads and the force
+/// and torque arrays it writes (torque empty without rotation).
 pub(crate) struct ForceView<'a> {
-    pub(crate) id: &'a [u32],
     pub(crate) state: ParticleState<'a>,
     pub(crate) force: &'a mut [Vec3],
     pub(crate) torque: &'a mut [Vec3],
@@ -47,7 +46,6 @@ impl<'a> ParticleState<'a> {
     /// `p` split into the state a force pass reads and the arrays it writes.
     pub(crate) fn split(p: &'a mut Particles) -> ForceView<'a> {
         let Particles {
-            id,
             position,
             velocity,
             force,
@@ -56,13 +54,13 @@ impl<'a> ParticleState<'a> {
             inv_mass,
             species,
             angular,
+            ..
         } = p;
         let (omega, torque) = match angular.as_mut() {
             Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
             None => (None, &mut [][..]),
         };
         ForceView {
-            id,
             state: ParticleState {
                 position,
                 velocity,
@@ -163,10 +161,11 @@ pub(crate) struct Surroundings<'a, W> {
     pub(crate) dt: Real,
 }
 
-/// One particle's slots in the arrays its surroundings keep: its contact histories (one per
-/// planar wall, then one per body; empty when particles do not spin) and its clearance per
-/// body.
+/// One particle's slots in the arrays its surroundings keep: the walls it may reach before
+/// the next list build, its contact histories (one per planar wall, then one per body;
+/// empty when particles do not spin) and its clearance per body.
 pub(crate) struct AloneSlots<'s, WH> {
+    pub(crate) near: WallMask,
     pub(crate) history: &'s mut [WH],
     pub(crate) clearances: &'s mut [Clearance],
 }
@@ -195,14 +194,19 @@ impl<W: WallLaw> Surroundings<'_, W> {
         if rotates {
             let (wall_history, body_history) = slots.history.split_at_mut(self.walls.walls.len());
             if W::NEEDS_ROTATION {
-                let (f, t, o) =
-                    self.walls
-                        .force_and_torque_on(law, particle, omega, wall_history, dt);
+                let (f, t, o) = self.walls.force_and_torque_on(
+                    law,
+                    particle,
+                    slots.near,
+                    omega,
+                    wall_history,
+                    dt,
+                );
                 *force += f;
                 *torque += t;
                 overlap = o;
             } else {
-                let (f, o) = self.walls.force_on(law, particle, dt);
+                let (f, o) = self.walls.force_on(law, particle, slots.near, dt);
                 *force += f;
                 overlap = o;
             }
@@ -215,7 +219,7 @@ impl<W: WallLaw> Surroundings<'_, W> {
                 overlap = larger(overlap, o);
             }
         } else {
-            let (f, o) = self.walls.force_on(law, particle, dt);
+            let (f, o) = self.walls.force_on(law, particle, slots.near, dt);
             *force += f;
             overlap = o;
             for ((body, clearance), load) in bodies {

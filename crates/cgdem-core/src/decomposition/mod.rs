@@ -103,6 +103,10 @@ pub struct Subdomain<H, WH> {
     /// Per owned particle, per body: where it needs no SDF lookup (as the world's; not
     /// stored in restart files).
     pub body_clearances: Vec<crate::bodies::Clearance>,
+    /// Per owned particle, the walls it may reach before the next list build; made by the
+    /// first force pass after a build (not stored in restart files: any pass makes them
+    /// right, they only spare looking at walls out of reach).
+    pub near_walls: Vec<crate::walls::WallMask>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
@@ -120,6 +124,7 @@ impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
             receives: Vec::new(),
             list: PairList::default(),
             body_clearances: Vec::new(),
+            near_walls: Vec::new(),
         }
     }
 

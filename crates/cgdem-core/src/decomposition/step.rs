@@ -199,6 +199,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         self.comm.each_owned(&mut self.subdomains, |sub| {
             sub.list = PairList::build(&sub.particles, sub.n_owned, &sub.rows, extra, width);
             sub.rows = HistoryRows::default();
+            sub.near_walls.clear();
         });
         self.builds += 1;
     }
@@ -447,12 +448,12 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         unpack_ghosts: bool,
     ) -> ForceSums {
         let count = self.subdomains.len();
-        let (comm, buffers) = (&self.comm, &self.buffers);
+        let (comm, buffers, skin) = (&self.comm, &self.buffers, self.skin);
         let mine: Vec<Option<ForceSums>> = comm.each_owned(&mut self.subdomains, |sub| {
             if unpack_ghosts {
                 unpack(sub, buffers);
             }
-            forces_and_closing(sub, physics, closing)
+            forces_and_closing(sub, physics, closing, skin)
         });
         let in_order = |all: Vec<ForceSums>| {
             all.into_iter()
@@ -520,9 +521,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                     sub.list
                         .pairs
                         .iter()
-                        .filter(|&&[i, j]| {
-                            (j as usize) < sub.n_owned || p.id[i as usize] < p.id[j as usize]
-                        })
+                        .filter(|&&[a, _]| (a as usize) < sub.n_owned)
                         .map(|&[i, j]| {
                             let (i, j) = (i as usize, j as usize);
                             let distance = (p.position[i] - p.position[j]).length();
@@ -546,10 +545,9 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 let sub = &self.subdomains[s];
                 let id = &sub.particles.id;
                 let (mut ids, mut histories) = (Vec::new(), Vec::new());
-                for (&[i, j], &h) in sub.list.pairs.iter().zip(&sub.list.history) {
-                    let (a, b) = (id[i as usize], id[j as usize]);
-                    if (j as usize) < sub.n_owned || a < b {
-                        ids.extend_from_slice(&[a.min(b) as Real, a.max(b) as Real]);
+                for (&[a, b], &h) in sub.list.pairs.iter().zip(&sub.list.history) {
+                    if (a as usize) < sub.n_owned {
+                        ids.extend_from_slice(&[id[a as usize] as Real, id[b as usize] as Real]);
                         histories.push(h);
                     }
                 }
@@ -703,6 +701,7 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
     closing: Option<Integrator>,
+    skin: Real,
 ) -> ForceSums {
     let n = sub.n_owned;
     // PCVV's F0 and T0: the forces of the last step, which travel with their particles in
@@ -712,7 +711,7 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
         let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
         (p.force[..n].to_vec(), torque)
     });
-    let mut sums = forces(sub, physics);
+    let mut sums = forces(sub, physics, skin);
     let (p, gravity) = (&sub.particles, physics.surroundings.gravity);
     sums.kinematic_loads = physics
         .kinematic
@@ -762,13 +761,14 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
 fn forces<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
+    skin: Real,
 ) -> ForceSums {
     let n = sub.n_owned;
     let ForceView {
-        id,
         state,
         force,
         torque,
+        ..
     } = ParticleState::split(&mut sub.particles);
     let rotates = physics.rotates;
     let dt = physics.surroundings.dt;
@@ -778,12 +778,8 @@ fn forces<L: PairLaw, W: WallLaw>(
     }
     let mut deepest_pair: Real = 0.0;
     let list = &mut sub.list;
-    for (k, &[i, j]) in list.pairs.iter().enumerate() {
-        let (a, b) = if id[i as usize] < id[j as usize] {
-            (i as usize, j as usize)
-        } else {
-            (j as usize, i as usize)
-        };
+    for (k, &[a, b]) in list.pairs.iter().enumerate() {
+        let (a, b) = (a as usize, b as usize);
         let owner = Owner {
             position: state.position[a],
             velocity: state.velocity[a],
@@ -825,15 +821,35 @@ fn forces<L: PairLaw, W: WallLaw>(
         sub.body_clearances = vec![Clearance::NONE; n * n_bodies];
     }
     let slots = if rotates { physics.wall_slots } else { 0 };
+    let particle = |i: usize| WallParticle {
+        species: state.species[i] as usize,
+        position: state.position[i],
+        velocity: state.velocity[i],
+        radius: state.radius[i],
+        mass: state.mass[i],
+    };
+    if sub.near_walls.len() != n {
+        // After a list build: the walls each particle may reach before the next one; the
+        // histories of the others are at rest (a pass over all walls would reset them now).
+        let walls = physics.surroundings.walls;
+        sub.near_walls = (0..n)
+            .map(|i| walls.near(physics.surroundings.wall_law, &particle(i), skin))
+            .collect();
+        if rotates {
+            for (i, near) in sub.near_walls.iter().enumerate() {
+                let history = &mut sub.wall_history[i * slots..][..walls.walls.len()];
+                for (k, h) in history.iter_mut().enumerate() {
+                    if !near.has(k) {
+                        *h = Default::default();
+                    }
+                }
+            }
+        }
+    }
     for i in 0..n {
-        let particle = WallParticle {
-            species: state.species[i] as usize,
-            position: state.position[i],
-            velocity: state.velocity[i],
-            radius: state.radius[i],
-            mass: state.mass[i],
-        };
+        let particle = particle(i);
         let alone = AloneSlots {
+            near: sub.near_walls[i],
             history: &mut sub.wall_history[i * slots..(i + 1) * slots],
             clearances: &mut sub.body_clearances[i * n_bodies..(i + 1) * n_bodies],
         };

@@ -87,9 +87,12 @@ impl<H: PairHistory> HistoryRows<H> {
 
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct PairList<H> {
-    /// `[i, j]` with `i` owned and `j > i` (owned or ghost), grouped by `i`, `j` increasing.
+    /// Per pair its two particles in canonical orientation, the lower id first, so that
+    /// every subdomain that lists a pair evaluates it the same way round with no look-up;
+    /// grouped by the owned particle `i` that found it (with `j > i`, owned or ghost), `j`
+    /// increasing within a group.
     pub pairs: Vec<[u32; 2]>,
-    /// Pairs of `i` are `pairs[out_start[i]..out_start[i + 1]]`.
+    /// Pairs found by owned particle `i` are `pairs[out_start[i]..out_start[i + 1]]`.
     pub out_start: Vec<u32>,
     /// Contact history per pair, in the pair's canonical orientation (lower id first).
     pub history: Vec<H>,
@@ -154,6 +157,11 @@ impl<H: PairHistory> PairList<H> {
             .iter()
             .map(|&[i, j]| rows.find(i as usize, p.id[j as usize]).unwrap_or_default())
             .collect();
+        for pair in &mut pairs {
+            if p.id[pair[0] as usize] > p.id[pair[1] as usize] {
+                pair.swap(0, 1);
+            }
+        }
         PairList {
             pairs,
             out_start,
@@ -170,13 +178,15 @@ impl<H: PairHistory> PairList<H> {
             return HistoryRows::from_entries(n_owned, Vec::new());
         }
         let mut entries = Vec::new();
-        for (&[i, j], &h) in self.pairs.iter().zip(&self.history) {
+        for (&[a, b], &h) in self.pairs.iter().zip(&self.history) {
             if h == H::default() {
                 continue;
             }
-            entries.push((i, ids[j as usize], h));
-            if (j as usize) < n_owned {
-                entries.push((j, ids[i as usize], h));
+            if (a as usize) < n_owned {
+                entries.push((a, ids[b as usize], h));
+            }
+            if (b as usize) < n_owned {
+                entries.push((b, ids[a as usize], h));
             }
         }
         HistoryRows::from_entries(n_owned, entries)
