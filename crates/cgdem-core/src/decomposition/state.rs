@@ -76,8 +76,9 @@ macro_rules! subdomain_arrays {
         $m!($s.wall_history);
         $m!($s.receives);
         $m!($s.list.pairs);
-        $m!($s.list.out_start);
         $m!($s.list.history);
+        $m!($s.list.image_pairs);
+        $m!($s.list.image_history);
         $m!($s.list.reference);
         if let Some(a) = $s.particles.angular.$angular() {
             $m!(a.omega);
@@ -287,14 +288,10 @@ fn check<H, WH>(
     }
     let l = &s.list;
     if l.reference.len() != owned
-        || l.out_start.len() != owned + 1
         || l.history.len() != l.pairs.len()
-        || l.out_start
-            .last()
-            .is_some_and(|&e| e as usize != l.pairs.len())
-        || l.pairs
-            .iter()
-            .any(|&[i, j]| i as usize >= n || j as usize >= n)
+        || l.image_history.len() != l.image_pairs.len()
+        || l.each()
+            .any(|([i, j], _, _)| i as usize >= n || j as usize >= n)
     {
         return bad("its pair list does not match its particles");
     }

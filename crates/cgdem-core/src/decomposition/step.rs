@@ -195,9 +195,10 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         }
         self.bytes_sent += borders(&mut self.subdomains, &self.grid, width, &self.comm);
         self.forward_counts = None;
-        let extra = self.extra;
+        let (extra, list_box) = (self.extra, self.grid.list_box());
         self.comm.each_owned(&mut self.subdomains, |sub| {
-            sub.list = PairList::build(&sub.particles, sub.n_owned, &sub.rows, extra, width);
+            let p = &sub.particles;
+            sub.list = PairList::build(p, sub.n_owned, &sub.rows, extra, width, &list_box);
             sub.rows = HistoryRows::default();
             sub.near_walls.clear();
         });
@@ -519,12 +520,11 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 out.push({
                     let p = &sub.particles;
                     sub.list
-                        .pairs
-                        .iter()
-                        .filter(|&&[a, _]| (a as usize) < sub.n_owned)
-                        .map(|&[i, j]| {
+                        .each()
+                        .filter(|&([a, _], _, _)| (a as usize) < sub.n_owned)
+                        .map(|([i, j], shift, _)| {
                             let (i, j) = (i as usize, j as usize);
-                            let distance = (p.position[i] - p.position[j]).length();
+                            let distance = (p.position[i] - (p.position[j] + shift)).length();
                             let species_pair =
                                 p.species[i] as usize * n_species + p.species[j] as usize;
                             law.elastic_energy(species_pair, p.radius[i], p.radius[j], distance)
@@ -545,7 +545,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 let sub = &self.subdomains[s];
                 let id = &sub.particles.id;
                 let (mut ids, mut histories) = (Vec::new(), Vec::new());
-                for (&[a, b], &h) in sub.list.pairs.iter().zip(&sub.list.history) {
+                for ([a, b], _, &h) in sub.list.each() {
                     if (a as usize) < sub.n_owned {
                         ids.extend_from_slice(&[id[a as usize] as Real, id[b as usize] as Real]);
                         histories.push(h);
@@ -588,13 +588,16 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             m.particle_bytes += sub.particles.array_bytes()
                 + bytes(&sub.wall_history)
                 + bytes(&sub.body_clearances)
-                + bytes(&sub.list.out_start)
                 + bytes(&sub.list.reference)
                 + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
                 + bytes(&sub.receives);
-            m.pairs += sub.list.pairs.len();
-            m.pair_bytes += bytes(&sub.list.pairs) + bytes(&sub.list.history);
-            m.history_entries += sub.list.history.len();
+            let l = &sub.list;
+            m.pairs += l.len();
+            m.pair_bytes += bytes(&l.pairs)
+                + bytes(&l.history)
+                + bytes(&l.image_pairs)
+                + bytes(&l.image_history);
+            m.history_entries += l.len();
         }
         m.particle_bytes += self
             .buffers
@@ -607,7 +610,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
 
     /// Pairs listed over all subdomains (a pair across a boundary twice).
     pub fn listed_pairs(&self) -> usize {
-        let here: usize = self.owned().map(|s| s.list.pairs.len()).sum();
+        let here: usize = self.owned().map(|s| s.list.len()).sum();
         self.comm.sum(here as u64) as usize
     }
 
@@ -777,41 +780,52 @@ fn forces<L: PairLaw, W: WallLaw>(
         torque[..n].fill(Vec3::ZERO);
     }
     let mut deepest_pair: Real = 0.0;
+    // One pair, `b` seen at `position_b`: its force added to whichever of the two are owned
+    // (a macro, written once for the direct pairs and those through an image, so that each
+    // loop keeps its sums in registers).
+    macro_rules! pair {
+        ($a:expr, $b:expr, $position_b:expr, $history:expr) => {{
+            let (a, b): (usize, usize) = ($a, $b);
+            let owner = Owner {
+                position: state.position[a],
+                velocity: state.velocity[a],
+                omega: state.omega.map_or(Vec3::ZERO, |w| w[a]),
+                radius: state.radius[a],
+                inv_mass: state.inv_mass[a],
+                species_row: state.species[a] as usize * physics.n_species,
+            };
+            let (result, overlap, smaller_radius) =
+                pair_force(physics.law, &state, &owner, b, $position_b, $history, dt);
+            if overlap > deepest_pair * smaller_radius {
+                deepest_pair = overlap / smaller_radius;
+            }
+            if a < n {
+                force[a] += result.force_on_i;
+                if rotates {
+                    torque[a] += result.torque_on_i;
+                }
+            }
+            if b < n {
+                force[b] -= result.force_on_i;
+                if rotates {
+                    torque[b] += result.torque_on_j;
+                }
+            }
+        }};
+    }
     let list = &mut sub.list;
-    for (k, &[a, b]) in list.pairs.iter().enumerate() {
-        let (a, b) = (a as usize, b as usize);
-        let owner = Owner {
-            position: state.position[a],
-            velocity: state.velocity[a],
-            omega: state.omega.map_or(Vec3::ZERO, |w| w[a]),
-            radius: state.radius[a],
-            inv_mass: state.inv_mass[a],
-            species_row: state.species[a] as usize * physics.n_species,
-        };
-        let (result, overlap, smaller_radius) = pair_force(
-            physics.law,
-            &state,
-            &owner,
+    for (&[a, b], history) in list.pairs.iter().zip(&mut list.history) {
+        let b = b as usize;
+        pair!(a as usize, b, state.position[b], history);
+    }
+    for (image, history) in list.image_pairs.iter().zip(&mut list.image_history) {
+        let b = image.pair[1] as usize;
+        pair!(
+            image.pair[0] as usize,
             b,
-            state.position[b],
-            &mut list.history[k],
-            dt,
+            state.position[b] + image.shift,
+            history
         );
-        if overlap > deepest_pair * smaller_radius {
-            deepest_pair = overlap / smaller_radius;
-        }
-        if a < n {
-            force[a] += result.force_on_i;
-            if rotates {
-                torque[a] += result.torque_on_i;
-            }
-        }
-        if b < n {
-            force[b] -= result.force_on_i;
-            if rotates {
-                torque[b] += result.torque_on_j;
-            }
-        }
     }
     let mut deepest_wall: Real = 0.0;
     let n_bodies = physics.surroundings.bodies.len();

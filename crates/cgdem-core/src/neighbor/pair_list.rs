@@ -1,14 +1,16 @@
 //! The pair list of a set of owned particles and their ghosts (a subdomain): a half list,
 //! built from a cell grid when a particle has moved more than half the skin, with the
 //! contact history of each pair. Pairs of two owned particles appear once, pairs of an owned
-//! particle and a ghost once here and once in the ghost's own subdomain (newton off); the
-//! ghosts are the periodic images, so the list has none of its own. Across a rebuild the
-//! histories travel as rows keyed by the partner's id ([`HistoryRows`]), with their
-//! particles.
+//! particle and a ghost once here and once in the ghost's own subdomain (newton off). Along
+//! a periodic axis the subdomain spans alone there are no ghosts: the cell grid wraps there,
+//! and a pair that meets across it is listed once with the shift of the image it meets
+//! (image pairs). Across a rebuild the histories travel as rows keyed by the partner's id
+//! ([`HistoryRows`]), with their particles.
 
+use super::pair_search::{neighbour_cell, NEIGHBOUR_OFFSETS};
 use super::CellGrid;
 use crate::contact::PairHistory;
-use crate::domain::Domain;
+use crate::domain::{Domain, NO_IMAGE};
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 
@@ -85,87 +87,131 @@ impl<H: PairHistory> HistoryRows<H> {
     }
 }
 
+/// A pair that meets across a periodic axis its subdomain spans alone: its particles in
+/// canonical orientation (the lower id first), the second seen at its position plus `shift`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ImagePair {
+    pub pair: [u32; 2],
+    pub shift: Vec3,
+}
+
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct PairList<H> {
     /// Per pair its two particles in canonical orientation, the lower id first, so that
     /// every subdomain that lists a pair evaluates it the same way round with no look-up;
-    /// grouped by the owned particle `i` that found it (with `j > i`, owned or ghost), `j`
-    /// increasing within a group.
+    /// in the order the owned particles found them (each with the later particles, owned or
+    /// ghost, in index order).
     pub pairs: Vec<[u32; 2]>,
-    /// Pairs found by owned particle `i` are `pairs[out_start[i]..out_start[i + 1]]`.
-    pub out_start: Vec<u32>,
     /// Contact history per pair, in the pair's canonical orientation (lower id first).
     pub history: Vec<H>,
+    /// Pairs that meet through a periodic image, and their histories.
+    pub image_pairs: Vec<ImagePair>,
+    pub image_history: Vec<H>,
     /// Owned positions at the build, for the displacement test.
     pub reference: Vec<Vec3>,
+}
+
+impl<H> PairList<H> {
+    /// Listed pairs, direct and through an image.
+    pub fn len(&self) -> usize {
+        self.pairs.len() + self.image_pairs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every pair with the shift its second particle is seen through (zero for a direct
+    /// pair) and its history.
+    pub fn each(&self) -> impl Iterator<Item = ([u32; 2], Vec3, &H)> {
+        let direct = self.pairs.iter().zip(&self.history);
+        let through = self.image_pairs.iter().zip(&self.image_history);
+        direct
+            .map(|(&pair, h)| (pair, Vec3::ZERO, h))
+            .chain(through.map(|(p, h)| (p.pair, p.shift, h)))
+    }
 }
 
 impl<H: PairHistory> PairList<H> {
     /// The pairs of the first `n_owned` of `p` (owned) with every later particle (owned or
     /// ghost) within `r_i + r_j + extra` (except two frozen particles), found in cells at
-    /// least `cell_size` wide, with each pair's history from its first particle's `rows`.
+    /// least `cell_size` wide, through the periodic images of `box_` along its periodic axes
+    /// (those the subdomain spans alone, where it has no ghosts; positions there lie in the
+    /// box), with each pair's history from its first particle's `rows`.
     pub fn build(
         p: &Particles,
         n_owned: usize,
         rows: &HistoryRows<H>,
         extra: Real,
         cell_size: Real,
+        box_: &Domain,
     ) -> Self {
-        let bounded = Domain {
-            lo: Vec3::ZERO,
-            hi: Vec3::ONE,
-            periodic: [false; 3],
-        };
-        let grid = CellGrid::build(&bounded, &p.position, cell_size);
-        let mut pairs = Vec::new();
-        let mut out_start = Vec::with_capacity(n_owned + 1);
-        out_start.push(0u32);
+        let grid = CellGrid::build(box_, &p.position, cell_size);
+        let mut found: Vec<(u32, u32, u8)> = Vec::new();
+        let (mut pairs, mut images) = (Vec::new(), Vec::new());
         for i in 0..n_owned {
-            let first = pairs.len();
             let home = grid.cell_coords(p.position[i]);
             let frozen_i = p.is_frozen(i);
-            for dz in -1i64..=1 {
-                for dy in -1i64..=1 {
-                    for dx in -1i64..=1 {
-                        let mut cell = [0usize; 3];
-                        let mut inside = true;
-                        for (a, d) in [dx, dy, dz].into_iter().enumerate() {
-                            let c = home[a] as i64 + d;
-                            inside &= c >= 0 && c < grid.counts[a] as i64;
-                            cell[a] = c.max(0) as usize;
-                        }
-                        if !inside {
-                            continue;
-                        }
-                        for &j in grid.particles_in(grid.linear(cell)) {
-                            let j = j as usize;
-                            if j <= i || (frozen_i && p.is_frozen(j)) {
-                                continue;
-                            }
-                            let reach = p.radius[i] + p.radius[j] + extra;
-                            if (p.position[j] - p.position[i]).length_squared() < reach * reach {
-                                pairs.push([i as u32, j as u32]);
-                            }
-                        }
+            found.clear();
+            for offset in NEIGHBOUR_OFFSETS {
+                let Some((cell, image)) = neighbour_cell(&grid, box_, home, offset) else {
+                    continue;
+                };
+                let shift = box_.image_shift(image);
+                for &j in grid.particles_in(cell) {
+                    let j = j as usize;
+                    if j <= i || (frozen_i && p.is_frozen(j)) {
+                        continue;
+                    }
+                    let reach = p.radius[i] + p.radius[j] + extra;
+                    let d = p.position[j] + shift - p.position[i];
+                    if d.length_squared() < reach * reach {
+                        found.push((i as u32, j as u32, image));
                     }
                 }
             }
-            pairs[first..].sort_unstable();
-            out_start.push(pairs.len() as u32);
+            found.sort_unstable();
+            for &(i, j, image) in &found {
+                if image == NO_IMAGE {
+                    pairs.push([i, j]);
+                } else {
+                    images.push((i, j, image));
+                }
+            }
         }
-        let history = pairs
-            .iter()
-            .map(|&[i, j]| rows.find(i as usize, p.id[j as usize]).unwrap_or_default())
-            .collect();
+        let history_of =
+            |i: u32, j: u32| rows.find(i as usize, p.id[j as usize]).unwrap_or_default();
+        let history = pairs.iter().map(|&[i, j]| history_of(i, j)).collect();
+        let image_history = images.iter().map(|&(i, j, _)| history_of(i, j)).collect();
+        let lower_first = |i: u32, j: u32| p.id[i as usize] < p.id[j as usize];
         for pair in &mut pairs {
-            if p.id[pair[0] as usize] > p.id[pair[1] as usize] {
+            if !lower_first(pair[0], pair[1]) {
                 pair.swap(0, 1);
             }
         }
+        let image_pairs = images
+            .into_iter()
+            .map(|(i, j, image)| {
+                let shift = box_.image_shift(image);
+                // Seen from the other side, the partner is behind the opposite image.
+                if lower_first(i, j) {
+                    ImagePair {
+                        pair: [i, j],
+                        shift,
+                    }
+                } else {
+                    ImagePair {
+                        pair: [j, i],
+                        shift: -shift,
+                    }
+                }
+            })
+            .collect();
         PairList {
             pairs,
-            out_start,
             history,
+            image_pairs,
+            image_history,
             reference: p.position[..n_owned].to_vec(),
         }
     }
@@ -178,7 +224,7 @@ impl<H: PairHistory> PairList<H> {
             return HistoryRows::from_entries(n_owned, Vec::new());
         }
         let mut entries = Vec::new();
-        for (&[a, b], &h) in self.pairs.iter().zip(&self.history) {
+        for ([a, b], _, &h) in self.each() {
             if h == H::default() {
                 continue;
             }

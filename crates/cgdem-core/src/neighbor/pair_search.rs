@@ -95,10 +95,25 @@ fn pairs_of(
     }
 }
 
+/// The 27 offsets from a cell to itself and its neighbours, z slowest.
+pub(super) const NEIGHBOUR_OFFSETS: [[i32; 3]; 27] = {
+    let mut offsets = [[0; 3]; 27];
+    let mut k = 0;
+    while k < 27 {
+        offsets[k] = [
+            (k % 3) as i32 - 1,
+            ((k / 3) % 3) as i32 - 1,
+            (k / 9) as i32 - 1,
+        ];
+        k += 1;
+    }
+    offsets
+};
+
 /// The cell at `home + offset` and the periodic image it is seen through, or None when the
 /// offset leaves a bounded axis. On a periodic axis with fewer than three cells the same cell
 /// is reached through different images, which is what a short box needs.
-fn neighbour_cell(
+pub(super) fn neighbour_cell(
     grid: &CellGrid,
     domain: &Domain,
     home: [usize; 3],
