@@ -51,6 +51,16 @@ impl std::fmt::Display for GridSpec {
 /// every subdomain face is a cut (the images cross it), on a bounded one the outer faces are
 /// not. Ties go to more cuts across x, then across y.
 pub fn choose_counts(count: usize, extent: Vec3, periodic: [bool; 3]) -> [usize; 3] {
+    choose_counts_uncut(count, extent, periodic, None)
+}
+
+/// [`choose_counts`] among the grids that do not cut axis `uncut` (if given).
+pub fn choose_counts_uncut(
+    count: usize,
+    extent: Vec3,
+    periodic: [bool; 3],
+    uncut: Option<usize>,
+) -> [usize; 3] {
     let mut best = ([count, 1, 1], Real::INFINITY);
     for nx in (1..=count).rev() {
         if !count.is_multiple_of(nx) {
@@ -61,6 +71,9 @@ pub fn choose_counts(count: usize, extent: Vec3, periodic: [bool; 3]) -> [usize;
                 continue;
             }
             let n = [nx, ny, count / nx / ny];
+            if uncut.is_some_and(|a| n[a] > 1) {
+                continue;
+            }
             let surface: Real = (0..3)
                 .map(|a| {
                     let cuts = if periodic[a] { n[a] } else { n[a] - 1 };

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use crate::bodies::KinematicParticles;
 use crate::contact::PairLaw;
+use crate::decomposition::placement::MAX_SUBDOMAINS;
 use crate::decomposition::GridSpec;
 use crate::geometry::Aabb;
 use crate::guard::{GuardKind, GuardSettings, GuardTrip};
@@ -67,6 +68,15 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         .or(stored.as_ref().map(|s| GridSpec::Given(s.grid())));
     let (mut world, mut n_inserted, mut n_body_particles) =
         build_world(scene, law, wall_law, dt, &scales, options, grid)?;
+    // A scene large enough for more subdomains than the default grid gives, on more
+    // threads than it has: say how to use them.
+    let subdomains: usize = world.grid().iter().product();
+    let workers = rayon::current_num_threads() * options.comm.size();
+    if grid.is_none() && subdomains == MAX_SUBDOMAINS && workers > subdomains {
+        warnings.push(format!(
+            "the grid chosen from the scene has {subdomains} subdomains (the most it chooses), fewer than the {workers} threads, which take whole subdomains: give --grid {workers} (or more) to keep them all busy"
+        ));
+    }
     // Under MPI only rank 0 writes into the run's directory: the others' outputs (in a
     // scratch directory) start afresh.
     let root = options.comm.is_root();

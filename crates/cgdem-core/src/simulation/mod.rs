@@ -166,6 +166,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             None => place_scene_grid(
                 &domain,
                 &particles.position,
+                setup.gravity,
                 widths.ghost,
                 widths.contact,
                 comm.size(),
