@@ -19,10 +19,10 @@ pub use state::WorldState;
 
 use crate::bodies::{Body, KinematicParticles};
 use crate::contact::PairLaw;
-use crate::decomposition::placement::{place, place_scene_grid};
-use crate::decomposition::removal::{RemovalRule, Removals};
-use crate::decomposition::step::{Decomposition, Drive, ForceSums, Physics};
 use crate::decomposition::{
+    placement::{place, place_scene_grid},
+    removal::{RemovalRule, Removals},
+    step::{Decomposition, Drive, ForceSums, Physics},
     BalanceSpec, Comm, DecomposedState, DecompositionSummary, Grid, GridSpec, HistoryRows,
 };
 use crate::domain::Domain;
