@@ -28,9 +28,7 @@ use cgdem_core::run::{hertz_history_wall, hertz_law};
 use cgdem_core::scene::{ContactSettings, Scene};
 use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::deck::Deck;
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem_harness::liggghts;
+use cgdem_harness::decks::{self, lammps, liggghts, Deck, RunStatus, RunnerOptions};
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -152,7 +150,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
     if let Err(reason) = found {
         println!(
             "{code:?} not run ({reason}): its stored numbers are used; install with `{}`",
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }
@@ -181,7 +179,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
         matches!(status, RunStatus::Completed { .. }),
         "{case} {code:?}: {status:?}"
     );
-    let frames = lammps::read_dump(&dir.join("traj.dump")).expect("dump");
+    let frames = decks::read_dump(&dir.join("traj.dump")).expect("dump");
     assert_eq!(frames.len() as u64, STEPS + 1, "{case}: one frame per step");
     Some(
         frames

@@ -13,7 +13,6 @@ mod diagnosis;
 pub(crate) mod network;
 mod state;
 
-pub use crate::domain::potential_origin;
 pub use network::{ContactNetwork, PairContact};
 pub use state::WorldState;
 
@@ -25,7 +24,7 @@ use crate::decomposition::{
     step::{Decomposition, Drive, ForceSums, Physics},
     BalanceSpec, Comm, DecomposedState, DecompositionSummary, Grid, GridSpec, HistoryRows,
 };
-use crate::domain::Domain;
+use crate::domain::{potential_origin, Domain};
 use crate::force::Surroundings;
 use crate::geometry::Aabb;
 use crate::guard::{GuardPeaks, GuardSettings, GuardState, GuardTrip};
