@@ -37,6 +37,7 @@ CASES = [
     "validation/cases/screw_feeder_hertz.toml@1",
     "validation/cases/screw_feeder_hertz_particles.toml@1",
     "validation/bench/heap.toml@1",
+    "validation/bench/heap_wca.toml@1",
 ]
 MPIRUN = ["mpirun", "--allow-run-as-root", "--oversubscribe", "--mca", "mpi_yield_when_idle", "1"]
 

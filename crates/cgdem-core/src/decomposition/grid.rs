@@ -231,8 +231,8 @@ impl Grid {
     /// bounded axes and is 0 along the periodic axes not cut (no ghosts there), except
     /// `(index, 0)`. Fixed order (z, y, x offsets increasing).
     /// Checks that a particle touches a partner through one periodic image at most: every
-    /// periodic axis at least twice `contact` (the largest contact distance) long, as the
-    /// undecomposed world's minimum image needs. On an axis shorter than two ghost layers a
+    /// periodic axis at least twice `contact` (the largest contact distance) long, as a
+    /// minimum image needs. On an axis shorter than two ghost layers a
     /// subdomain then lists a partner through both images, but the farther one never comes
     /// within contact: its pair gives no force and its history stays at rest.
     pub fn check_periodic_images(&self, contact: Real) -> Result<(), String> {
