@@ -712,7 +712,7 @@ fn main() -> ExitCode {
                 Err(code) => return code,
             };
             let interrupt = install_interrupt();
-            let options = cgdem_harness::validate::ValidateOptions {
+            let options = cgdem_harness::validation::ValidateOptions {
                 suite: suite_path,
                 out: out.clone(),
                 quiet,
@@ -732,7 +732,7 @@ fn main() -> ExitCode {
                 checkpoint_every,
                 runs_dir: None,
             };
-            let result = pool.install(|| cgdem_harness::validate::validate(&options));
+            let result = pool.install(|| cgdem_harness::validation::validate(&options));
             if let Some(code) = interrupted(&interrupt, &out) {
                 if let Err(e) = &result {
                     eprintln!("error: {e}");
@@ -750,7 +750,7 @@ fn main() -> ExitCode {
                     let runs_failed = summary
                         .runs
                         .iter()
-                        .filter(|r| r.status == cgdem_harness::validate::Outcome::Failed)
+                        .filter(|r| r.status == cgdem_harness::validation::Outcome::Failed)
                         .count();
                     let mut extra = String::new();
                     if let Some(accuracy) = &summary.accuracy {
@@ -779,7 +779,7 @@ fn main() -> ExitCode {
                         summary.suite,
                         summary.runs.len(),
                         runs_failed,
-                        summary.runs.iter().filter(|r| r.status == cgdem_harness::validate::Outcome::Skipped).count(),
+                        summary.runs.iter().filter(|r| r.status == cgdem_harness::validation::Outcome::Skipped).count(),
                         summary.comparisons.len(),
                         failed,
                         out.join("index.html").display()
@@ -1279,7 +1279,7 @@ fn advise_run(case: &str, matrix: &Path, run: AdviseRun) -> Result<PathBuf, Exit
     };
     let pool = worker_pool(run.threads)?;
     let interrupt = install_interrupt();
-    let options = cgdem_harness::validate::ValidateOptions {
+    let options = cgdem_harness::validation::ValidateOptions {
         progress: progress_bar::progress(false),
         jobs: usize::from(run.jobs),
         stop: interrupt.as_ref().map(|i| i.flag()),

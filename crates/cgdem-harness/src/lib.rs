@@ -19,7 +19,7 @@ pub mod stability;
 pub mod suite;
 pub mod suite_entry;
 pub mod sweep;
-pub mod validate;
+pub mod validation;
 pub mod verdict;
 
 /// Tests read the shipped cases and suites by their paths from the repository root, as the
