@@ -37,9 +37,8 @@ pub(super) struct BenchArgs {
     /// Time limit of one reference-code run, seconds.
     #[arg(long, default_value_t = 1800)]
     reference_timeout: u64,
-    /// Also time cgdem decomposed into these subdomains (`2x1x1`, as `run --grid`), as a
-    /// case CASE-gridG in the same alternation (ratio to the undecomposed run per
-    /// repetition).
+    /// Also time cgdem on this grid (`2x1x1`, as `run --grid`), as a case CASE-gridG in
+    /// the same alternation (ratio per repetition to the run on the scene's own grid).
     #[arg(long)]
     grid: Option<cgdem_core::decomposition::GridSpec>,
     /// MPI rank counts, comma-separated: cgdem also runs the `--grid` case as that many

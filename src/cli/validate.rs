@@ -51,13 +51,14 @@ pub(super) struct ValidateArgs {
     /// what moved since the last night recorded there.
     #[arg(long)]
     history: Option<PathBuf>,
-    /// Decompose cgdem's runs as `cgdem run --grid` does (`2x1x1`, or a count for the grid
-    /// with the least ghost surface per scene), stepped on --threads, to compare the
-    /// verdicts with the undecomposed suite's. The reference codes run as without it.
+    /// Run cgdem's runs on this grid (`2x1x1`, or a count for the grid with the least
+    /// ghost surface per scene) instead of the one each scene chooses, stepped on
+    /// --threads, to compare the verdicts with the default suite's. The reference codes
+    /// run as without it.
     #[arg(long)]
     grid: Option<GridSpec>,
-    /// With --grid: as `cgdem run --balance`.
-    #[arg(long, value_name = "THRESH|off", default_value_t, requires = "grid")]
+    /// As `cgdem run --balance`.
+    #[arg(long, value_name = "THRESH|off", default_value_t)]
     balance: BalanceSpec,
     /// With --grid: run each of cgdem's runs as N MPI ranks (`mpirun -np N cgdem run
     /// RUN/scene.json --grid G ...`, the scene the harness built written beside the
