@@ -5,17 +5,17 @@
 //!
 //! Every run, whatever the code, leaves the same files (`summary.json`, `timeseries.csv`,
 //! `profile.csv`, ...): cgdem writes them itself, the reference codes' dumps go through the
-//! core's analysis in [`decks::postprocess`]. Comparisons, verdicts and figures read only
+//! core's analysis in [`decks::postprocess()`]. Comparisons, verdicts and figures read only
 //! those files, so every code is measured the same way.
 //!
 //! The modules, in three groups:
 //!
-//! - **Commands**: [`validation`] (`cgdem validate`), [`bench`] (`cgdem bench`),
+//! - **Commands**: [`validation`] (`cgdem validate`), [`mod@bench`] (`cgdem bench`),
 //!   [`advise`] (`cgdem advise`), [`history`] (`cgdem history`), [`sweep`]
 //!   (`cgdem run --sweep`), [`decks::run_reference`] (`cgdem reference`).
 //! - **Suite kinds**, each a folder of its phases (`suite`, `runs`, `measurement`,
 //!   `report`): the cases of [`validation`], the error-against-run-time sweeps of
-//!   [`accuracy`], the stress cases of [`stability`], and [`bench`]'s timed runs.
+//!   [`accuracy`], the stress cases of [`stability`], and [`mod@bench`]'s timed runs.
 //! - **Building blocks**: [`suite`] and [`suite_entry`] (suite files), [`runs`] (one run of
 //!   any code, reuse, concurrency), [`decks`] (the reference codes: a LAMMPS and a LIGGGHTS
 //!   dialect, runner, dump parser, post-processing), [`ranks`] (cgdem as MPI ranks),
