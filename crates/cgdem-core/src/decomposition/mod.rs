@@ -107,6 +107,9 @@ pub struct Subdomain<H, WH> {
     /// first force pass after a build (not stored in restart files: any pass makes them
     /// right, they only spare looking at walls out of reach).
     pub near_walls: Vec<crate::walls::WallMask>,
+    /// Scratch of the force pass: the listed (direct) pairs within reach this step, by
+    /// index, sized as the list.
+    pub within_reach: Vec<u32>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
@@ -125,6 +128,7 @@ impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
             list: PairList::default(),
             body_clearances: Vec::new(),
             near_walls: Vec::new(),
+            within_reach: Vec::new(),
         }
     }
 
