@@ -51,7 +51,7 @@ PY
 # name | case (scene name) | comparison (start of its name) | overrides (space-separated).
 # A fault is caught when a part (final state or dynamics) of that comparison turns red, or
 # when cgdem's run is stopped by a guard (a failed run turns the night red; it is said so).
-# Measured and not caught at smoke size (README, "Proven able to fail"): Hertz friction
+# Measured and not caught at smoke size (reports/planted-faults/NOTE.md): Hertz friction
 # 0.5 -> 0.3, Hertz restitution 0.5 -> 0.25 and the seed model's time step at 0.2 of the
 # contact period.
 faults=(

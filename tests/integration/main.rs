@@ -15,5 +15,6 @@ mod physics;
 mod reference_screw;
 mod reference_stages;
 mod restart;
+mod scene_reference;
 mod scenes;
 mod stability;
