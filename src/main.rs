@@ -461,8 +461,7 @@ fn interrupted(
 
 fn reference_run(code: ReferenceCommand) -> Result<ExitCode, String> {
     use cgdem_harness::code::Code;
-    use cgdem_harness::lammps::{RunStatus, RunnerOptions};
-    use cgdem_harness::reference::{run_reference, ReferenceOptions};
+    use cgdem_harness::decks::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
     let (code, args) = match code {
         ReferenceCommand::Lammps(args) => (Code::Lammps, args),
         ReferenceCommand::Liggghts(args) => (Code::Liggghts, args),

@@ -28,9 +28,7 @@ use cgdem_core::run::{hertz_history_wall, hertz_law};
 use cgdem_core::scene::{ContactSettings, ContactTables, PairProperties, Scene};
 use cgdem_core::simulation::{NeighborSettings, World};
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::deck::Deck;
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem_harness::liggghts;
+use cgdem_harness::decks::{self, lammps, liggghts, Deck, RunStatus, RunnerOptions};
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -156,7 +154,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
     if let Err(reason) = found {
         println!(
             "{code:?} not run ({reason}): its stored numbers are used; install with `{}`",
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }
@@ -195,7 +193,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
         matches!(status, RunStatus::Completed { .. }),
         "{case} {code:?}: {status:?}"
     );
-    let frames = lammps::read_dump(&dir.join("traj.dump")).expect("dump");
+    let frames = decks::read_dump(&dir.join("traj.dump")).expect("dump");
     assert_eq!(frames.len() as u64, STEPS + 1, "{case}: one frame per step");
     Some(
         frames
@@ -353,7 +351,9 @@ fn liggghts_tables(scene: &Scene, t: &ContactTables, deck: &str) -> String {
 /// and `nu` as one material, so an unlike pair is given the one material with its `Y*` and
 /// `G*` (reference/MAPPING.md); its restitution, friction and rolling friction are its own.
 fn lammps_tables(scene: &Scene, t: &ContactTables, deck: &str) -> String {
-    use cgdem_harness::lammps::hertz::{rolling_stiffness, tangential_damping_ratio, tsuji_q};
+    use cgdem_harness::decks::lammps::hertz::{
+        rolling_stiffness, tangential_damping_ratio, tsuji_q,
+    };
     let ContactSettings::Hertz(h) = &scene.contact else {
         unreachable!()
     };

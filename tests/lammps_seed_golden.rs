@@ -17,7 +17,7 @@ use cgdem_core::particles::Particles;
 use cgdem_core::run;
 use cgdem_core::scene::{ContactSettings, Scene, StageEnd};
 use cgdem_core::simulation::{NeighborSettings, World};
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
+use cgdem_harness::decks::{self, lammps, RunStatus, RunnerOptions};
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -129,7 +129,7 @@ fn run_lammps(
     if let Err(reason) = lammps::find_lmp() {
         println!(
             "lmp not run ({reason}): its stored numbers are used; install with `{}`",
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }
@@ -148,7 +148,7 @@ fn run_lammps(
         matches!(status, RunStatus::Completed { .. }),
         "{name}: {status:?}"
     );
-    let frames = lammps::read_dump(&dir.join(lammps::deck::TRAJECTORY_FILE)).expect("dump");
+    let frames = decks::read_dump(&dir.join(decks::TRAJECTORY_FILE)).expect("dump");
     assert_eq!(frames.len() as u64, steps + 1, "{name}: one frame per step");
     Some(
         frames

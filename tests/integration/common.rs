@@ -9,9 +9,9 @@ use cgdem_core::scene::Scene;
 use cgdem_core::simulation::{NeighborSettings, World};
 use cgdem_core::walls::{WallSet, WcaWall};
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem_harness::liggghts;
-use cgdem_harness::reference::{run_reference, ReferenceOptions, ReferenceRun};
+use cgdem_harness::decks::{
+    self, lammps, liggghts, run_reference, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
+};
 
 /// The seed's coke parameters (paper A sec. 3), coarse-grained by `lambda`.
 pub struct Coke {
@@ -168,7 +168,7 @@ pub fn completed_reference_run(
         println!(
             "skipped {}: {reason}; install with `{}`",
             code.name(),
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }

@@ -13,7 +13,8 @@
 //!   `coarse_graining`, `insertion` (a scene transformed, particles placed from it).
 //! - world (physics only, no scene): `force`, `memory_use` (shared by the two below);
 //!   `decomposition`; `simulation` (the `World`).
-//! - outputs: `io` (files), then `analysis` (measurements written with it).
+//! - outputs: `io` (files), then `analysis` (measurements written with it), then
+//!   `output_format` (the files every code's run is written into: summary, time series, heap).
 //! - `run`: the stage driver, on top of everything.
 
 pub mod analysis;
@@ -32,6 +33,7 @@ pub mod lammps_data;
 pub mod math;
 pub mod memory_use;
 pub mod neighbor;
+pub mod output_format;
 pub mod particles;
 pub mod run;
 pub mod scene;

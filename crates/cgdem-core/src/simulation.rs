@@ -18,7 +18,7 @@ use crate::decomposition::HistoryRows;
 use crate::decomposition::{
     balance, choose_counts, BalanceSpec, Comm, DecompositionSummary, Grid, GridSpec,
 };
-use crate::domain::Domain;
+use crate::domain::{potential_origin, Domain};
 use crate::force::{
     body_force, body_force_and_torque, larger, pair_force, ForceView, Owner, ParticleState,
 };
@@ -1925,14 +1925,4 @@ impl Reactions<'_> {
             }
         }
     }
-}
-
-/// The corner of the box `lo..hi` lowest along `gravity`: gravitational energy `-m g.(x - o)`
-/// is counted from it (cgdem's energy guard, and the energy balance of every code's outputs).
-pub fn potential_origin(gravity: Vec3, lo: Vec3, hi: Vec3) -> Vec3 {
-    Vec3::new(
-        if gravity.x < 0.0 { lo.x } else { hi.x },
-        if gravity.y < 0.0 { lo.y } else { hi.y },
-        if gravity.z < 0.0 { lo.z } else { hi.z },
-    )
 }

@@ -26,10 +26,8 @@ use std::time::Duration;
 
 use serde::Serialize;
 
-use crate::lammps::postprocess::log_timing;
-use crate::lammps::runner::RunStatus;
-use crate::lammps::{self, read_dump, RunnerOptions};
-use crate::liggghts;
+use crate::decks::postprocess::log_timing;
+use crate::decks::{self, lammps, liggghts, read_dump, runner, RunStatus, RunnerOptions};
 use crate::report::plot::write_bar_chart;
 use crate::suite::Code;
 use cgdem_core::analysis::conical_heap::{conical_heap, ConicalHeap};
@@ -435,12 +433,12 @@ fn run_code(
             return (result, None);
         }
         Code::Liggghts => {
-            let deck = liggghts::deck::write_deck(scene, &case.state, case.dt);
+            let deck = liggghts::write_deck(scene, &case.state, case.dt);
             finish_reference(
                 deck,
                 dir,
-                |dir| liggghts::runner::run_deck(dir, &runner(threads, options)),
-                liggghts::deck::LOG_FILE,
+                |dir| liggghts::run_deck(dir, &runner(threads, options)),
+                liggghts::LOG_FILE,
                 &mut result,
             );
         }
@@ -450,7 +448,7 @@ fn run_code(
                 deck,
                 dir,
                 |dir| lammps::run_deck(dir, &runner(threads, options)),
-                lammps::runner::LOG_FILE,
+                lammps::LOG_FILE,
                 &mut result,
             );
         }
@@ -481,7 +479,7 @@ impl RunResult {
 }
 
 fn finish_reference(
-    deck: Result<lammps::Deck, lammps::DeckError>,
+    deck: Result<decks::Deck, decks::DeckError>,
     dir: &Path,
     run_deck: impl Fn(&Path) -> RunStatus,
     log_file: &str,
@@ -673,7 +671,7 @@ fn ranks_command(
         StageEnd::Duration(d) => d,
         StageEnd::Settled { max_duration, .. } => max_duration,
     };
-    let mut argv = lammps::runner::mpirun_argv(np as u32, cores);
+    let mut argv = runner::mpirun_argv(np as u32, cores);
     argv.extend([
         bin.display().to_string(),
         "run".into(),
@@ -712,13 +710,13 @@ fn ranks_run(
     let result = match std::fs::create_dir_all(&dir) {
         Err(e) => RunResult::failed(format!("cannot create {}: {e}", dir.display())),
         Ok(()) => {
-            let argv = ranks_command(case, bin, np, lammps::runner::cores(), &dir);
+            let argv = ranks_command(case, bin, np, runner::cores(), &dir);
             let runner = RunnerOptions {
                 np: None,
                 timeout: options.timeout,
                 stop: None,
             };
-            match lammps::runner::run_command(&argv, &dir, "stdout.txt", &runner) {
+            match runner::run_command(&argv, &dir, "stdout.txt", &runner) {
                 RunStatus::Completed { .. } => read_cgdem_summary(&dir),
                 other => not_completed(other),
             }
@@ -804,7 +802,7 @@ fn outcome_run(
             )
         }),
         (Code::Liggghts | Code::Lammps, _) if result.status == "completed" => {
-            let path = dir.join(lammps::deck::TRAJECTORY_FILE);
+            let path = dir.join(decks::TRAJECTORY_FILE);
             match read_dump(&path) {
                 Ok(frames) => frames.last().and_then(|f| {
                     let (x, y, z, r, t) = (

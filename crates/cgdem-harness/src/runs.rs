@@ -417,8 +417,7 @@ fn run_reference_code(
     dir: &Path,
     validate: &ValidateOptions,
 ) -> Result<bool, RunOutcome> {
-    use super::lammps::{RunStatus, RunnerOptions};
-    use super::reference::{run_reference, ReferenceOptions};
+    use super::decks::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
     let reference = match code {
         Code::Liggghts => Code::Liggghts,
         _ => Code::Lammps,

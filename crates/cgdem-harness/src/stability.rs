@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::lammps::runner::{log_tail_of, RunStatus, RunnerOptions};
+use super::decks::runner::{log_tail_of, RunStatus, RunnerOptions};
 use crate::code::Code;
 use crate::csv_table::CsvTable;
 use crate::ranks::run_scene;
@@ -397,7 +397,7 @@ pub(crate) fn run_reference(
     dir: &Path,
     timeout_s: u64,
 ) -> StabilityRecord {
-    use super::lammps::{postprocess, write_summary};
+    use super::decks::{self, postprocess, write_summary};
     let mut rec = record(scene, code, case, dir);
     if let Some(reason) = not_applicable(code, scene) {
         rec.message = reason;
@@ -408,11 +408,7 @@ pub(crate) fn run_reference(
         .and_then(|(dt, scales, _)| {
             let particles =
                 cgdem_core::run::initial_particles(scene, false, &[]).map_err(|e| e.to_string())?;
-            let deck = match code {
-                Code::Liggghts => super::liggghts::write_deck(scene, &particles, dt),
-                _ => super::lammps::write_deck(scene, &particles, dt),
-            }
-            .map_err(|e| e.to_string())?;
+            let deck = decks::write_deck(code, scene, &particles, dt).map_err(|e| e.to_string())?;
             Ok((scales, deck))
         });
     let (scales, mut deck) = match prepared {
@@ -433,10 +429,11 @@ pub(crate) fn run_reference(
         stop: None,
         timeout: std::time::Duration::from_secs(timeout_s),
     };
-    let status = match code {
-        Code::Liggghts => super::liggghts::run_deck(dir, &runner),
-        _ => super::lammps::run_deck(dir, &runner),
+    let Some(dialect) = decks::dialect(code) else {
+        rec.message = "cgdem is not a reference code".into();
+        return rec;
     };
+    let status = decks::run_deck(dialect, dir, &runner);
     let wall_s = match &status {
         RunStatus::Skipped {
             reason,
@@ -479,7 +476,7 @@ pub(crate) fn run_reference(
     }
     energy_evidence(scene, dir, &mut ev);
     ev.particles_lost = ev.particles_lost.max(log.lost_atoms);
-    let trajectory = dir.join(super::lammps::deck::TRAJECTORY_FILE);
+    let trajectory = dir.join(decks::TRAJECTORY_FILE);
     match frame_overlap(scene, &trajectory) {
         Ok(o) => ev.largest_overlap = o,
         Err(non_finite) => ev.non_finite |= non_finite,
@@ -690,8 +687,11 @@ fn energy_evidence(scene: &Scene, dir: &Path, ev: &mut Evidence) {
     let Ok(start) = cgdem_core::run::initial_particles(scene, false, &[]) else {
         return;
     };
-    let origin =
-        cgdem_core::simulation::potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
+    let origin = cgdem_core::output_format::potential_origin(
+        scene.gravity,
+        scene.domain.lo,
+        scene.domain.hi,
+    );
     let e0: Real = (0..start.len())
         .map(|k| {
             let m = start.mass[k];
@@ -795,7 +795,7 @@ fn min_image(mut d: Vec3, periodic: [bool; 3], length: Vec3) -> Vec3 {
 /// stage removes are left out).
 /// `Err(true)` when a frame holds non-finite values.
 fn frame_overlap(scene: &Scene, trajectory: &Path) -> Result<Option<Real>, bool> {
-    let frames = super::lammps::read_dump(trajectory).map_err(|_| false)?;
+    let frames = super::decks::read_dump(trajectory).map_err(|_| false)?;
     let periodic = scene.domain.periodic;
     let length = scene.domain.hi - scene.domain.lo;
     // Walls some stage removes are left out (their frames are not matched to stages here).
@@ -811,7 +811,7 @@ fn frame_overlap(scene: &Scene, trajectory: &Path) -> Result<Option<Real>, bool>
         .collect();
     let mut largest: Option<Real> = None;
     for frame in &frames {
-        let p = super::lammps::postprocess::frame_particles(frame, scene, trajectory)
+        let p = super::decks::postprocess::frame_particles(frame, scene, trajectory)
             .map_err(|_| false)?;
         if p.position.iter().any(|x| !x.is_finite()) {
             return Err(true);

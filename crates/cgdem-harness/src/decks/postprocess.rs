@@ -5,15 +5,15 @@
 
 use std::path::{Path, PathBuf};
 
-use super::deck::{DeckPlan, TRAJECTORY_FILE};
 use super::dump::{read_dump, DumpError, Frame};
+use super::{DeckPlan, TRAJECTORY_FILE};
 use cgdem_core::analysis::conveying::{self, ConveyingSample, ConveyingSummary};
 use cgdem_core::analysis::heap::HeapProfile;
 use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::math::{Real, Vec3};
-use cgdem_core::run::{
-    headline_sample, heap_profile, profile_csv, repose_csv, ReposeSample, RunSummary,
-    SampleTrigger, StageRecord, TIMESERIES_COLUMNS,
+use cgdem_core::output_format::{
+    headline_sample, heap_profile, potential_origin, profile_csv, repose_csv, ReposeSample,
+    RunSummary, SampleTrigger, StageRecord, TIMESERIES_COLUMNS,
 };
 use cgdem_core::scene::{ConveyingSettings, Scene};
 use cgdem_core::timestep::Timescales;
@@ -322,8 +322,7 @@ fn write_timeseries(
 ) -> Result<Option<(u64, FrameParticles)>, PostprocessError> {
     let max_diameter = scene.max_diameter();
     let mut csv = CsvBuffer::new(TIMESERIES_COLUMNS.iter().chain(&["mechanical_energy_j"]));
-    let origin =
-        cgdem_core::simulation::potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
+    let origin = potential_origin(scene.gravity, scene.domain.lo, scene.domain.hi);
     let mut last_state = None;
     for frame in frames.iter().filter(|f| f.step > 0) {
         let p = frame_particles(frame, scene, traj_path)?;

@@ -6,27 +6,23 @@
 //!
 //! LIGGGHTS needs `newton off`, `communicate single vel yes`, Young's modulus >= 5e6 Pa in SI
 //! units (it refuses softer materials), and an explicit dump format (default: 6 digits).
-//! Supported: what `lammps::hertz` supports; stages, wall removal (`unfix w_NAME`) and repose
-//! samples come from `lammps::deck::stage_lines`, the same lines as the LAMMPS decks (LIGGGHTS
+//! Supported: the Hertz settings of `decks::hertz`; stages, wall removal (`unfix w_NAME`) and
+//! repose samples come from `decks::stages`, the same lines as the LAMMPS decks (LIGGGHTS
 //! takes LAMMPS's loop, if, print and write_dump commands), so both go through one
 //! post-processing.
 
 use std::fmt::Write as _;
-use std::path::Path;
 
-use crate::code::Code;
-use crate::lammps::deck::{
-    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, stage_lines,
-    trajectory_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, StageHooks,
+use super::DIALECT;
+use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use crate::decks::lines::{
+    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
-use crate::lammps::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use crate::decks::stages::{stage_lines, trajectory_lines, StageHooks};
+use crate::decks::{Deck, DeckError, DeckPlan};
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
 use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
-
-pub const DECK_FILE: &str = "deck.in";
-pub const LOG_FILE: &str = "log.liggghts";
-pub const TRAJECTORY_FILE: &str = "traj.dump";
 
 /// LIGGGHTS 3.8 rejects a Young's modulus below this in SI units.
 pub const MIN_YOUNGS_MODULUS: Real = 5e6;
@@ -59,10 +55,10 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
     let data = data_file(scene, particles, &diameters, &densities, types.count());
 
-    let mut d = written_by(Code::Liggghts, scene);
+    let mut d = written_by(&DIALECT, scene);
     d += ").\n";
-    d += &preamble(Code::Liggghts, scene);
-    d += &neighbor_lines(Code::Liggghts, scene);
+    d += &preamble(&DIALECT, scene);
+    d += &neighbor_lines(&DIALECT, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
     let (materials, rolling) = material_lines(scene, h, &types);
@@ -108,8 +104,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         input: d,
         data,
         plan: DeckPlan {
-            code: "liggghts",
-            log_file: LOG_FILE,
+            code: DIALECT.code.name(),
+            log_file: DIALECT.log_file,
             notes: meshes.notes,
             dt,
             dump_every,
@@ -411,15 +407,11 @@ fn stage_start_lines(scene: &Scene, pieces: &[Vec<String>], stage: &str, dt: Rea
 /// Primes above 10000 for LIGGGHTS's random seeds.
 const PRIMES: [u64; 6] = [15485863, 32452843, 49979687, 67867967, 86028121, 104395301];
 
-/// The trajectory file of a run directory.
-pub fn trajectory(dir: &Path) -> std::path::PathBuf {
-    dir.join(TRAJECTORY_FILE)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::LOG_FILE;
     use super::*;
-    use crate::lammps::hertz::{at, collapse_scene_and_particle};
+    use crate::decks::hertz::{at, collapse_scene_and_particle};
 
     #[test]
     fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {

@@ -1,7 +1,9 @@
-//! Running `lmp` on a deck in its own directory, under a time limit.
+//! Running a reference code (or `mpirun` with cgdem's ranks) in its own directory, under a
+//! time limit.
 //!
-//! The binary is `$CGDEM_LMP` if set, else `lmp` on `PATH`. The run directory keeps the
-//! deck, `log.lammps`, `stdout.txt` and the exact command line (`command.txt`).
+//! The binary is found by the dialect (`$CGDEM_LMP`, else `lmp` on `PATH`; likewise
+//! `liggghts`). The run directory keeps the deck, the code's log, `stdout.txt` and the exact
+//! command line (`command.txt`).
 //!
 //! The child starts in a process group of its own. At the time limit or when the stop flag is
 //! raised (SIGINT/SIGTERM in the command), exactly that run is ended: SIGTERM to its group
@@ -14,9 +16,6 @@ use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-use super::deck::DECK_FILE;
-pub use super::deck::LOG_FILE;
 
 pub const INSTALL_HINT: &str = "bash scripts/install-references.sh";
 
@@ -58,7 +57,7 @@ pub enum RunStatus {
     Completed {
         wall_s: f64,
     },
-    /// LAMMPS is not installed: the comparison cannot run, which is not a failure of cgdem.
+    /// The code is not installed: the comparison cannot run, which is not a failure of cgdem.
     Skipped {
         reason: String,
         install_hint: String,
@@ -71,11 +70,6 @@ pub enum RunStatus {
         after_s: f64,
         log_tail: String,
     },
-}
-
-/// The `lmp` binary: `$CGDEM_LMP`, else `lmp` on `PATH`.
-pub fn find_lmp() -> Result<PathBuf, String> {
-    find_program("lmp", "CGDEM_LMP")
 }
 
 /// A reference binary: the file named by `$env_var` if set, else `name` on `PATH`.
@@ -95,11 +89,6 @@ pub fn find_program(name: &str, env_var: &str) -> Result<PathBuf, String> {
         .ok_or_else(|| format!("{name} not found on PATH (set {env_var} to its path)"))
 }
 
-/// Last `lines` lines of the run's log (or of stdout if there is no log).
-pub fn log_tail(dir: &Path, lines: usize) -> String {
-    log_tail_of(dir, LOG_FILE, lines)
-}
-
 /// Last `lines` lines of `dir/log_file` (or of stdout if there is no log).
 pub fn log_tail_of(dir: &Path, log_file: &str, lines: usize) -> String {
     // Lossy: LIGGGHTS's "Lost atoms" error writes stray bytes after its message.
@@ -111,17 +100,6 @@ pub fn log_tail_of(dir: &Path, log_file: &str, lines: usize) -> String {
         .unwrap_or_default();
     let all: Vec<&str> = text.lines().collect();
     all[all.len().saturating_sub(lines)..].join("\n")
-}
-
-/// Runs the deck in `dir` (which must hold it) and waits, killing LAMMPS at the time limit.
-pub fn run_deck(dir: &Path, options: &RunnerOptions) -> RunStatus {
-    match find_lmp() {
-        Ok(lmp) => run_program(&lmp, dir, DECK_FILE, LOG_FILE, options),
-        Err(reason) => RunStatus::Skipped {
-            reason,
-            install_hint: INSTALL_HINT.into(),
-        },
-    }
 }
 
 /// `mpirun` for `np` ranks as the harness starts every MPI run (root allowed, as in the

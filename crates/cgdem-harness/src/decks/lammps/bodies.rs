@@ -14,7 +14,8 @@
 
 use std::fmt::Write as _;
 
-use super::deck::{g, DeckError};
+use crate::decks::lines::g;
+use crate::decks::DeckError;
 use cgdem_core::geometry::screw_feeder::{hopper_inner_rect, ScrewFeederSpec};
 use cgdem_core::scene::{MeshSource, Scene};
 

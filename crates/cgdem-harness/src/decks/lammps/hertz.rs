@@ -12,28 +12,24 @@
 //! to give the particle-wall `Y_eff`, `G_eff` (see the wall lines below: the wall fix of this
 //! LAMMPS does not use `1 - nu^2`).
 //!
-//! Stages, wall removal (`unfix w_NAME`) and repose samples are written by `deck::stage_lines`,
-//! as for the seed's deck, so the run goes through the same post-processing.
+//! Stages, wall removal (`unfix w_NAME`) and repose samples are written by `decks::stages`,
+//! as for the seed's deck and LIGGGHTS's, so the run goes through the same post-processing.
 
 use std::fmt::Write as _;
 
-use super::deck::{
-    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, stage_lines,
-    trajectory_lines, unfix_wall, written_by, Deck, DeckError, DeckPlan, Periodic, StageHooks,
-    LOG_FILE,
+use super::bodies::body_lines;
+use super::{removal_pads, DIALECT};
+use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use crate::decks::lines::{
+    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
-use crate::code::Code;
+use crate::decks::stages::{stage_lines, trajectory_lines, Periodic, StageHooks};
+use crate::decks::{Deck, DeckError, DeckPlan};
 use cgdem_core::contact::damping::restitution_beta;
 use cgdem_core::contact::normal::{Hertz, Material};
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{
-    CohesionKind, ContactSettings, HertzDampingKind, HertzSettings, RollingKind, Scene,
-    TangentialKind, WallSettings,
-};
-
-/// Dump columns of the Hertz decks (LAMMPS and LIGGGHTS): with spins.
-pub(crate) const HERTZ_COLUMNS: &str = "id type x y z vx vy vz omegax omegay omegaz radius";
+use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
 
 /// LAMMPS's Tsuji polynomial `P(q)`: `damping tsuji q` gives `gamma_n = P(q) sqrt(m_eff k_n)`.
 pub fn tsuji_polynomial(q: Real) -> Real {
@@ -67,76 +63,6 @@ pub fn tangential_damping_ratio(y_eff: Real, g_eff: Real) -> Real {
     (4.0 * g_eff / y_eff).sqrt()
 }
 
-/// The Hertz settings a reference deck can express, or why not.
-/// `bodies`: the code's deck writes the scene's bodies (checked there), else it refuses them.
-pub(crate) fn hertz_settings<'a>(
-    scene: &'a Scene,
-    code: &str,
-    bodies: bool,
-) -> Result<&'a HertzSettings, DeckError> {
-    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
-    let ContactSettings::Hertz(h) = &scene.contact else {
-        return Err(unsupported(format!(
-            "the {code} Hertz deck needs model = \"hertz\""
-        )));
-    };
-    if h.damping != HertzDampingKind::Restitution
-        || h.tangential != TangentialKind::History
-        || h.cohesion != CohesionKind::None
-        || h.rolling == RollingKind::ConstantTorque
-    {
-        return Err(unsupported(format!(
-            "{code} decks are written for damping = \"hertz\", tangential = \"history\", rolling = \"none\" or \"epsd2\", cohesion = \"none\" only"
-        )));
-    }
-    if !bodies && !scene.bodies.is_empty() {
-        return Err(unsupported(format!(
-            "{code} Hertz decks take planar walls only (no [[body]])"
-        )));
-    }
-    if scene.gives_material_tables() {
-        return Err(unsupported(format!(
-            "{code} decks are written with the one material and coefficients of [contact] and [wall_contact] for now: this scene has materials per species or pair (their per-type tables come with issue 40's deck writers)"
-        )));
-    }
-    Ok(h)
-}
-
-/// Axis (0, 1, 2) of an axis-aligned wall and whether its normal points to +axis.
-pub(crate) fn wall_axis(scene: &Scene, w: &WallSettings) -> Result<(usize, bool), DeckError> {
-    let n = w.normal;
-    for (axis, c) in [n.x, n.y, n.z].into_iter().enumerate() {
-        if (c.abs() - 1.0).abs() < 1e-12 {
-            return Ok((axis, c > 0.0));
-        }
-    }
-    Err(DeckError::Unsupported {
-        file: scene.source.display().to_string(),
-        reason: format!(
-            "wall `{}`: only axis-aligned planes become primitive/zplane walls",
-            w.name
-        ),
-    })
-}
-
-pub(crate) fn material(h: &HertzSettings) -> Material {
-    Material {
-        youngs_modulus: h.youngs_modulus,
-        poisson_ratio: h.poisson_ratio,
-    }
-}
-
-/// The wall's material: `[wall_contact]`'s, else the particles'.
-pub(crate) fn wall_material(scene: &Scene, h: &HertzSettings) -> Material {
-    Material {
-        youngs_modulus: scene
-            .wall_contact
-            .youngs_modulus
-            .unwrap_or(h.youngs_modulus),
-        poisson_ratio: scene.wall_contact.poisson_ratio.unwrap_or(h.poisson_ratio),
-    }
-}
-
 /// `k_roll` for LAMMPS `rolling sds`: the Hertz tangential stiffness `8 G_eff sqrt(R delta)` at
 /// the largest overlap of an undamped impact at `v`.
 pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: Real) -> Real {
@@ -163,17 +89,17 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     );
 
     let mut files = Vec::new();
-    let mut d = written_by(Code::Lammps, scene);
+    let mut d = written_by(&DIALECT, scene);
     d += "): Hertz, reference/MAPPING.md.\n";
-    d += &preamble(Code::Lammps, scene);
+    d += &preamble(&DIALECT, scene);
     d += &pair_lines(scene, h, m)?;
-    d += &neighbor_lines(Code::Lammps, scene);
+    d += &neighbor_lines(&DIALECT, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
     d += &integration_lines(scene, integrated, dt);
     let wall_model = wall_model(scene, h, m)?;
     d += &wall_fix_lines(scene, &wall_model)?;
-    let bodies = super::bodies::body_lines(scene, integrated, &wall_model)?;
+    let bodies = body_lines(scene, integrated, &wall_model)?;
     d += &bodies.setup;
     // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
     // polynomial to its wall fixes' coefficient; the body region's fix is defined anew
@@ -188,7 +114,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
             d += motion;
         }
     }
-    d += &super::deck::removal_pads(scene, 1);
+    d += &removal_pads(scene, 1);
     d += &deletion_lines(scene, integrated, dump_every);
     let top_ups = top_up_lines(scene, integrated, dt, &mut files);
     d += &top_ups.setup;
@@ -236,8 +162,8 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         data,
         files,
         plan: DeckPlan {
-            code: "lammps",
-            log_file: LOG_FILE,
+            code: DIALECT.code.name(),
+            log_file: DIALECT.log_file,
             notes,
             dt,
             dump_every,
@@ -511,34 +437,10 @@ impl TopUps {
     }
 }
 
-/// The deck of `validation/cases/aor_hertz.toml` with one particle, for the deck tests of
-/// both codes.
-#[cfg(test)]
-pub(crate) fn collapse_scene_and_particle() -> (Scene, Particles) {
-    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-        .join("validation/cases/aor_hertz.toml");
-    let scene = Scene::load(&path).unwrap();
-    let mut particles = Particles::new(true);
-    let s = &scene.species[0];
-    particles.push(
-        0,
-        cgdem_core::math::Vec3::new(0.05, 0.025, 0.1),
-        s.radius(),
-        s.mass(),
-    );
-    (scene, particles)
-}
-
-/// Position of `needle` in `deck`, failing with the needle's text when it is absent.
-#[cfg(test)]
-pub(crate) fn at(deck: &str, needle: &str) -> usize {
-    deck.find(needle)
-        .unwrap_or_else(|| panic!("no `{needle}` in the deck:\n{deck}"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::decks::hertz::{at, collapse_scene_and_particle};
 
     #[test]
     fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {
@@ -579,78 +481,6 @@ mod tests {
         let times: Vec<Real> = deck.plan.repose_dumps.iter().map(|r| r.1).collect();
         assert_eq!(times, [0.25, 0.5, 1.0]);
         assert!(deck.plan.notes.iter().any(|n| n.contains("rolling sds")));
-    }
-
-    /// Spins given in a scene (insert omega, `[[particle]]`) reach both reference codes through
-    /// the data file's `Velocities` section (`wx wy wz`, which `read_data` takes for
-    /// atom_style sphere / granular), and the data file reads back as the same particles.
-    #[test]
-    fn decks_carry_the_initial_spins_and_their_data_file_reads_back() {
-        use cgdem_core::scene::{given_particles_from_data, Override};
-        crate::at_repo_root();
-        let path = std::path::Path::new("tests/data/tiny_hertz_collapse.toml");
-        let overrides: Vec<Override> = ["insert[0].omega=[0.0, 30.0, -2.5]"]
-            .iter()
-            .map(|o| Override::parse(o, path).unwrap())
-            .collect();
-        let mut scene = Scene::load_with_overrides(path, &overrides).unwrap();
-        scene.particles.push(cgdem_core::scene::GivenParticle {
-            species: 0,
-            position: cgdem_core::math::Vec3::new(0.1, 0.02, 0.05),
-            velocity: cgdem_core::math::Vec3::new(-1.0, 0.0, 0.0),
-            omega: cgdem_core::math::Vec3::new(0.0, 0.0, 7.0),
-        });
-        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
-        let omega = &particles.angular.as_ref().expect("Hertz: spins").omega;
-        assert_eq!(omega[0], cgdem_core::math::Vec3::new(0.0, 0.0, 7.0));
-        assert!(omega[1..]
-            .iter()
-            .all(|&w| w == cgdem_core::math::Vec3::new(0.0, 30.0, -2.5)));
-        for deck in [
-            write_hertz_deck(&scene, &particles, 1e-5).unwrap(),
-            crate::liggghts::write_deck(&scene, &particles, 1e-5).unwrap(),
-        ] {
-            let velocities = &deck.data[deck.data.find("Velocities").unwrap()..];
-            assert!(
-                velocities.contains(&format!(
-                    "\n1 {} {} {} {} {} {}\n",
-                    g(-1.0),
-                    g(0.0),
-                    g(0.0),
-                    g(0.0),
-                    g(0.0),
-                    g(7.0)
-                )),
-                "{velocities:.300}"
-            );
-            assert!(
-                velocities.contains(&format!(
-                    "\n2 {} {} {} {} {} {}\n",
-                    g(0.0),
-                    g(0.0),
-                    g(0.0),
-                    g(0.0),
-                    g(30.0),
-                    g(-2.5)
-                )),
-                "{velocities:.300}"
-            );
-            let back = given_particles_from_data(
-                &deck.data,
-                std::path::Path::new("particles.data"),
-                path,
-                &scene.species,
-                &scene.domain,
-                true,
-            )
-            .unwrap();
-            assert_eq!(back.len(), particles.len());
-            for (k, b) in back.iter().enumerate() {
-                assert_eq!(b.position, particles.position[k]);
-                assert_eq!(b.velocity, particles.velocity[k]);
-                assert_eq!(b.omega, omega[k]);
-            }
-        }
     }
 
     #[test]

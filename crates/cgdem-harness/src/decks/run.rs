@@ -1,13 +1,12 @@
 //! A reference run: the deck for a scene written, run by LAMMPS or LIGGGHTS, and its dumps
-//! post-processed into cgdem's output files. Above both codes' modules, which share the deck
-//! pieces, runner and post-processing of `lammps`.
+//! post-processed into cgdem's output files.
 
 use std::path::Path;
 
+use super::{dialect, postprocess, run_deck, write_deck, write_summary, DECK_FILE};
+use super::{RunStatus, RunnerOptions};
 use crate::code::Code;
-use crate::lammps::{self, postprocess, write_summary, RunStatus, RunnerOptions};
-use crate::liggghts;
-use cgdem_core::run::RunSummary;
+use cgdem_core::output_format::RunSummary;
 use cgdem_core::scene::Scene;
 
 /// How `run_reference` runs: the code, the runner's settings and the two choices a user makes.
@@ -60,14 +59,12 @@ pub fn run_reference(
         cgdem_core::run::time_step(scene, options.force_dt).map_err(|e| e.to_string())?;
     let particles =
         cgdem_core::run::initial_particles_clear_of_bodies(scene).map_err(|e| e.to_string())?;
-    let deck = match options.code {
-        Code::Lammps => lammps::write_deck(scene, &particles, dt),
-        Code::Liggghts => liggghts::write_deck(scene, &particles, dt),
-        Code::Cgdem => return Err("cgdem is not a reference code".into()),
-    }
-    .map_err(|e| e.to_string())?;
+    let Some(dialect) = dialect(options.code) else {
+        return Err("cgdem is not a reference code".into());
+    };
+    let deck = write_deck(options.code, scene, &particles, dt).map_err(|e| e.to_string())?;
     let status = if options.postprocess_only {
-        let path = out.join(lammps::deck::DECK_FILE);
+        let path = out.join(DECK_FILE);
         let previous = std::fs::read_to_string(&path)
             .map_err(|e| format!("--postprocess-only: cannot read {}: {e}", path.display()))?;
         if previous != deck.input {
@@ -80,10 +77,7 @@ pub fn run_reference(
     } else {
         deck.write_to(out)
             .map_err(|e| format!("cannot write the deck into {}: {e}", out.display()))?;
-        match options.code {
-            Code::Liggghts => liggghts::run_deck(out, &options.runner),
-            _ => lammps::run_deck(out, &options.runner),
-        }
+        run_deck(dialect, out, &options.runner)
     };
     let mut run = ReferenceRun {
         status,
