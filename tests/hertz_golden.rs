@@ -163,20 +163,17 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
         .join(case)
         .join(format!("{code:?}").to_lowercase());
     let _ = std::fs::remove_dir_all(&dir);
-    // The harness writes one material for now: the deck of the scene without its tables,
-    // whose material lines are then written per type from them.
-    let one_material = without_tables(scene);
+    // The LIGGGHTS deck writer takes the material tables; the LAMMPS one writes one material,
+    // so its deck is that of the scene without tables, with the pair and wall lines then
+    // written per type here (`lammps_tables`).
     let mut deck: Deck = match code {
-        Code::Liggghts => liggghts::write_deck(&one_material, initial, DT),
-        _ => lammps::write_hertz_deck(&one_material, initial, DT),
+        Code::Liggghts => liggghts::write_deck(scene, initial, DT),
+        _ => lammps::write_hertz_deck(&without_tables(scene), initial, DT),
     }
     .expect("deck");
-    if scene.gives_material_tables() {
+    if code == Code::Lammps && scene.gives_material_tables() {
         let tables = ContactTables::of(scene).unwrap();
-        deck.input = match code {
-            Code::Liggghts => liggghts_tables(scene, &tables, &deck.input),
-            _ => lammps_tables(scene, &tables, &deck.input),
-        };
+        deck.input = lammps_tables(scene, &tables, &deck.input);
     }
     assert_eq!(deck.plan.dump_every, 1);
     deck.write_to(&dir).expect("write deck");
@@ -249,101 +246,6 @@ fn wall_material(scene: &Scene) -> usize {
         "one wall material"
     );
     k
-}
-
-/// The LIGGGHTS deck with its `fix property/global` material tables written per atom type
-/// from the scene's tables (species 1..n, the walls' material n + 1), as LIGGGHTS users
-/// write them. The harness's deck writers give one material for all species until issue 40's
-/// second part; this is their per-type form, for the golden runs.
-fn liggghts_tables(scene: &Scene, t: &ContactTables, deck: &str) -> String {
-    let n = t.n_species();
-    let walls = !scene.walls.is_empty();
-    let wall = wall_material(scene);
-    let types = n + usize::from(walls);
-    let material = |a: usize| {
-        if a < n {
-            t.species[a]
-        } else {
-            t.wall_materials[wall]
-        }
-    };
-    let per_type =
-        |f: &dyn Fn(usize) -> Real| (0..types).map(|a| num(f(a))).collect::<Vec<_>>().join(" ");
-    let per_pair = |f: &dyn Fn(&PairProperties) -> Real| {
-        let mut v = Vec::new();
-        for a in 0..types {
-            for b in 0..types {
-                let p = match (a < n, b < n) {
-                    (true, true) => t.pair(a, b),
-                    (true, false) => t.wall_pair(a, wall),
-                    (false, true) => t.wall_pair(b, wall),
-                    // Walls never meet walls: any valid value.
-                    (false, false) => t.wall_pair(0, wall),
-                };
-                v.push(num(f(p)));
-            }
-        }
-        format!("{types} {}", v.join(" "))
-    };
-    let tables = [
-        (
-            "m1",
-            format!(
-                "youngsModulus peratomtype {}",
-                per_type(&|a| material(a).youngs_modulus)
-            ),
-        ),
-        (
-            "m2",
-            format!(
-                "poissonsRatio peratomtype {}",
-                per_type(&|a| material(a).poisson_ratio)
-            ),
-        ),
-        (
-            "m3",
-            format!(
-                "coefficientRestitution peratomtypepair {}",
-                per_pair(&|p| p.restitution)
-            ),
-        ),
-        (
-            "m4",
-            format!(
-                "coefficientFriction peratomtypepair {}",
-                per_pair(&|p| p.friction)
-            ),
-        ),
-        (
-            "m5",
-            format!(
-                "coefficientRollingFriction peratomtypepair {}",
-                per_pair(&|p| p.rolling_friction)
-            ),
-        ),
-    ];
-    let mut out = String::new();
-    let mut replaced = 0;
-    for line in deck.lines() {
-        let fix = tables.iter().find(|(fix, _)| {
-            line.starts_with(&format!("fix             {fix} all property/global"))
-        });
-        match fix {
-            Some((fix, table)) => {
-                out += &format!("fix             {fix} all property/global {table}\n");
-                replaced += 1;
-            }
-            None => {
-                out += line;
-                out += "\n";
-            }
-        }
-    }
-    assert!(
-        replaced >= 4,
-        "material lines not found in the LIGGGHTS deck"
-    );
-    out
 }
 
 /// The LAMMPS deck with one `pair_coeff I J` per species pair and the wall fixes for the

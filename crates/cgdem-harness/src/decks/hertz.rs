@@ -40,11 +40,6 @@ pub(crate) fn hertz_settings<'a>(
             "{code} Hertz decks take planar walls only (no [[body]])"
         )));
     }
-    if scene.gives_material_tables() {
-        return Err(unsupported(format!(
-            "{code} decks are written with the one material and coefficients of [contact] and [wall_contact] for now: this scene has materials per species or pair (their per-type tables come with issue 40's deck writers)"
-        )));
-    }
     Ok(h)
 }
 

@@ -75,6 +75,9 @@ pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: 
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
+    if scene.gives_material_tables() {
+        return Err(unsupported("LAMMPS decks are written with the one material and coefficients of [contact] and [wall_contact] for now: this scene has materials per species or pair (LIGGGHTS decks take them)".into()));
+    }
     let m = material(h);
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
 
