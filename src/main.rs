@@ -146,21 +146,24 @@ enum Command {
         /// number), naming the rule and the parameter, instead of warning.
         #[arg(long)]
         strict: bool,
-        /// Split the box into subdomains with ghost layers, each stepped on its own thread
-        /// (domain decomposition): `2x1x1` subdomains along x, y, z, or a count (`2`) for the
-        /// grid with the least ghost surface. Off by default. Results match the undecomposed
-        /// run to rounding, not bitwise. Under `mpirun -np N` (a build with `--features mpi`)
-        /// each rank steps a block of the subdomains; the outputs are bitwise those of the same
-        /// grid on threads. Not with --sweep (its runs are not decomposed).
+        /// The grid of subdomains the box is cut into (domain decomposition; each subdomain
+        /// owns its particles and keeps ghost layers of its neighbours'): `2x1x1` subdomains
+        /// along x, y, z, or a count (`2`) for the grid with the least ghost surface. Without
+        /// it, every run still is a grid, chosen from the scene alone (its particle count,
+        /// box, periodic axes and gravity: at most 4 subdomains of at least 400 particles,
+        /// with planes along gravity), so the outputs are bitwise the same on any number of
+        /// threads or ranks; summary.json says which grid and why. Threads and MPI ranks
+        /// (`mpirun -np N`, a build with `--features mpi`) take whole subdomains. Not with
+        /// --sweep (its runs take their scenes' grids).
         #[arg(long, conflicts_with = "sweep")]
         grid: Option<cgdem_core::decomposition::GridSpec>,
-        /// With --grid: at each list rebuild, when the imbalance (most particles in one
-        /// subdomain over the mean) passes this threshold, move the cut planes so that each
-        /// slab along each axis holds the same number of particles (LAMMPS `fix balance
-        /// ... shift`), never thinner than the ghost layer; `off` keeps the start's planes.
-        /// At least 1.0. summary.json's `decomposition` gives the shifts and the imbalance
-        /// the start's planes would give.
-        #[arg(long, value_name = "THRESH|off", default_value_t, requires = "grid")]
+        /// At each list rebuild, when the imbalance (most particles in one subdomain over
+        /// the mean) passes this threshold, move the cut planes so that each slab along each
+        /// axis holds the same number of particles (LAMMPS `fix balance ... shift`), never
+        /// thinner than the ghost layer; `off` keeps the start's planes. At least 1.0.
+        /// summary.json's `decomposition` gives the shifts and the imbalance the start's
+        /// planes would give.
+        #[arg(long, value_name = "THRESH|off", default_value_t)]
         balance: cgdem_core::decomposition::BalanceSpec,
         /// With `--sweep rpm=` or `screw_ratio=`: a run directory whose summary.json holds
         /// the same scene (digest) is not run again, so a sweep can be resumed or extended.
@@ -242,13 +245,14 @@ enum Command {
         /// what moved since the last night recorded there.
         #[arg(long)]
         history: Option<PathBuf>,
-        /// Decompose cgdem's runs as `cgdem run --grid` does (`2x1x1`, or a count for the grid
-        /// with the least ghost surface per scene), stepped on --threads, to compare the
-        /// verdicts with the undecomposed suite's. The reference codes run as without it.
+        /// Run cgdem's runs on this grid (`2x1x1`, or a count for the grid with the least
+        /// ghost surface per scene) instead of the one each scene chooses, stepped on
+        /// --threads, to compare the verdicts with the default suite's. The reference codes
+        /// run as without it.
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
-        /// With --grid: as `cgdem run --balance`.
-        #[arg(long, value_name = "THRESH|off", default_value_t, requires = "grid")]
+        /// As `cgdem run --balance`.
+        #[arg(long, value_name = "THRESH|off", default_value_t)]
         balance: cgdem_core::decomposition::BalanceSpec,
         /// With --grid: run each of cgdem's runs as N MPI ranks (`mpirun -np N cgdem run
         /// RUN/scene.json --grid G ...`, the scene the harness built written beside the
@@ -299,9 +303,8 @@ enum Command {
         /// Time limit of one reference-code run, seconds.
         #[arg(long, default_value_t = 1800)]
         reference_timeout: u64,
-        /// Also time cgdem decomposed into these subdomains (`2x1x1`, as `run --grid`), as a
-        /// case CASE-gridG in the same alternation (ratio to the undecomposed run per
-        /// repetition).
+        /// Also time cgdem on this grid (`2x1x1`, as `run --grid`), as a case CASE-gridG in
+        /// the same alternation (ratio per repetition to the run on the scene's own grid).
         #[arg(long)]
         grid: Option<cgdem_core::decomposition::GridSpec>,
         /// MPI rank counts, comma-separated: cgdem also runs the `--grid` case as that many
@@ -1037,10 +1040,10 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            if comm.is_distributed() && (grid.is_none() || sweep.is_some()) {
+            if comm.is_distributed() && sweep.is_some() {
                 if comm.is_root() {
                     eprintln!(
-                        "error: under mpirun ({} ranks) cgdem run needs --grid (at least one subdomain per rank) and no --sweep",
+                        "error: under mpirun ({} ranks) cgdem run takes no --sweep",
                         comm.size()
                     );
                 }

@@ -26,7 +26,7 @@ use cgdem_core::math::{Real, Vec3};
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{hertz_history_wall, hertz_law};
 use cgdem_core::scene::{ContactSettings, ContactTables, PairProperties, Scene};
-use cgdem_core::simulation::{NeighborSettings, World};
+use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use cgdem_harness::code::Code;
 use cgdem_harness::decks::{self, lammps, liggghts, Deck, RunStatus, RunnerOptions};
 
@@ -116,10 +116,9 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: 0,
     };
-    let mut world = World::new(
+    let mut setup = WorldSetup::new(
         initial.clone(),
         scene.domain.clone(),
-        cgdem_core::run::scene_walls(scene),
         law,
         hertz_history_wall(scene, h),
         scene.species.len(),
@@ -127,8 +126,10 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         DT,
         neighbor,
     );
-    let record = |world: &World<_, _>| {
-        let p = &world.particles;
+    setup.walls = cgdem_core::run::scene_walls(scene);
+    let mut world = World::new(setup, &Decompose::default()).expect("the case fits its box");
+    let record = |world: &mut World<_, _>| {
+        let p = world.synced_particles();
         let omega = &p.angular.as_ref().unwrap().omega;
         let mut state = vec![[Vec3::ZERO; 3]; p.len()];
         for k in 0..p.len() {
@@ -136,10 +137,10 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         }
         state
     };
-    let mut trajectory = vec![record(&world)];
+    let mut trajectory = vec![record(&mut world)];
     for _ in 0..STEPS {
         world.step();
-        trajectory.push(record(&world));
+        trajectory.push(record(&mut world));
     }
     trajectory
 }

@@ -19,7 +19,7 @@ use crate::domain::Domain;
 use crate::geometry::FinitePlane;
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
-use crate::simulation::{NeighborSettings, World};
+use crate::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use crate::walls::{HertzHistoryWall, HertzWall, Wall, WallLaw, WallSet};
 
 const RADIUS: Real = 1e-3;
@@ -125,7 +125,7 @@ fn impact<L: PairLaw, W: WallLaw>(
     let mut touched = false;
     for _ in 0..2_000_000 {
         w.step();
-        let p = &w.particles;
+        let p = w.synced_particles();
         let (f, n) = (p.force[0], normal(p));
         let f_n = f.dot(n);
         let mut f_t = (f - f_n * n).length();
@@ -151,8 +151,9 @@ fn impact<L: PairLaw, W: WallLaw>(
         }
     }
     assert!(touched, "no contact");
-    out.velocity = w.particles.velocity[0];
-    out.omega = w.particles.angular.as_ref().unwrap().omega[0];
+    let p = w.synced_particles();
+    out.velocity = p.velocity[0];
+    out.omega = p.angular.as_ref().unwrap().omega[0];
     out
 }
 
@@ -187,10 +188,9 @@ fn wall_impact<T: Law>(
         skin: 0.3 * RADIUS,
         resort_every: 0,
     };
-    let w = World::new(
+    let mut setup = WorldSetup::new(
         particles,
         domain,
-        walls,
         pair_law(m, restitution, tangential.clone()),
         wall_law(m, restitution, tangential),
         1,
@@ -198,6 +198,8 @@ fn wall_impact<T: Law>(
         dt,
         neighbor,
     );
+    setup.walls = walls;
+    let w = World::new(setup, &Decompose::default()).expect("fits");
     impact(w, friction, |_| Vec3::Z, |p| p.position[0].z < RADIUS)
 }
 
@@ -227,10 +229,9 @@ fn pair_impact<T: Law>(
         skin: 0.3 * RADIUS,
         resort_every: 0,
     };
-    let w = World::new(
+    let setup = WorldSetup::new(
         particles,
         domain,
-        WallSet::default(),
         pair_law(m, restitution, tangential.clone()),
         wall_law(m, restitution, tangential),
         1,
@@ -238,9 +239,10 @@ fn pair_impact<T: Law>(
         dt,
         neighbor,
     );
+    let mut w = World::new(setup, &Decompose::default()).expect("fits");
     let first = |p: &Particles| p.id.iter().position(|&id| id == 0).unwrap();
     assert_eq!(
-        first(&w.particles),
+        first(w.synced_particles()),
         0,
         "no re-sorting: particle 0 stays first"
     );

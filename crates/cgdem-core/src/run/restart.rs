@@ -24,8 +24,9 @@ pub const RESTART_FILE: &str = "restart.cgr";
 pub const PREVIOUS_RESTART_FILE: &str = "restart.prev.cgr";
 const MAGIC: &[u8; 8] = b"CGDEMRST";
 /// Bumped whenever the payload's layout changes; an older file is refused by name (2: the
-/// world state holds the subdomains of a `--grid` run; 3: the driver keeps the wall time).
-pub const FORMAT_VERSION: u32 = 3;
+/// world state holds the subdomains of a `--grid` run; 3: the driver keeps the wall time; 4: every
+/// run is a grid, the world state is its subdomains).
+pub const FORMAT_VERSION: u32 = 4;
 const HEADER_LEN: usize = 32;
 
 /// Where in the stage list a checkpoint was taken.
