@@ -468,18 +468,8 @@ fn relative_to(path: &Path, base: &Path) -> String {
         .unwrap_or_else(|_| p.display().to_string())
 }
 
-fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
-    let output = |file: &Path, e: &dyn std::fmt::Display| HistoryError::Output {
-        file: file.to_path_buf(),
-        message: e.to_string(),
-    };
-    let mut report = Report::new("cgdem nightly validation: history");
-    let intro = report.intro();
-    intro.paragraph(
-        "One row per night (newest last), with a link to its report; then the metrics that \
-         moved beyond their tolerance since the previous night, and the trends. Repose angles \
-         are judged by the suite's angle tolerance; throughput by 25% (the machine is shared).",
-    );
+/// One row per night: its report, runs, failures and flags.
+fn nights_table(nights: &[Night]) -> Table {
     let mut table = Table::new([
         "night",
         "date",
@@ -515,7 +505,22 @@ fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
             count(flagged),
         ]);
     }
-    intro.table(table);
+    table
+}
+
+fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
+    let output = |file: &Path, e: &dyn std::fmt::Display| HistoryError::Output {
+        file: file.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut report = Report::new("cgdem nightly validation: history");
+    let intro = report.intro();
+    intro.paragraph(
+        "One row per night (newest last), with a link to its report; then the metrics that \
+         moved beyond their tolerance since the previous night, and the trends. Repose angles \
+         are judged by the suite's angle tolerance; throughput by 25% (the machine is shared).",
+    );
+    intro.table(nights_table(nights));
     if let Some(guard) = nights.last().and_then(|n| n.speed_guard.as_ref()) {
         intro.paragraph(format!(
             "Speed of build {} against the previous night's {} ({} alternating pairs, \

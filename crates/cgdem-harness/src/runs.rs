@@ -571,4 +571,25 @@ mod tests {
         assert!(count.made(&split([1, 2, 2], Some(1.1))));
         assert!(!count.made(&split([2, 1, 1], Some(1.1))));
     }
+
+    #[test]
+    fn concurrent_runs_take_every_item_once_and_keep_the_order() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let items: Vec<u32> = (0..17).collect();
+        for jobs in [1, 2, 3, 40] {
+            let calls = AtomicUsize::new(0);
+            let out = run_concurrently(&items, jobs, |&k| {
+                calls.fetch_add(1, Ordering::Relaxed);
+                (k * k, rayon::current_num_threads())
+            });
+            assert_eq!(calls.load(Ordering::Relaxed), items.len(), "jobs {jobs}");
+            let squares: Vec<u32> = out.iter().map(|o| o.0).collect();
+            assert_eq!(squares, items.iter().map(|k| k * k).collect::<Vec<_>>());
+            if jobs > 1 {
+                // Each job's pool holds its share of the threads, at least one.
+                let share = (rayon::current_num_threads() / jobs).max(1);
+                assert!(out.iter().all(|o| o.1 == share), "jobs {jobs}: {out:?}");
+            }
+        }
+    }
 }

@@ -57,101 +57,141 @@ pub fn read_dump(path: &Path) -> Result<Vec<Frame>, DumpError> {
 
 /// Parses dump text; `path` is used in messages.
 pub fn parse_dump(text: &str, path: &Path) -> Result<Vec<Frame>, DumpError> {
-    let lines: Vec<&str> = text.lines().collect();
-    let mut at = 0usize;
-    let err = |line: usize, message: String| DumpError {
-        file: path.to_path_buf(),
-        line,
-        message,
-    };
-    // Returns the line at `*at` (advancing) or a truncation error naming what was expected.
-    // The line at `*at` (advancing), or a truncation error naming what was expected.
-    let next = |at: &mut usize, what: &str| -> Result<(usize, &str), DumpError> {
-        let k = *at;
-        *at += 1;
-        lines
-            .get(k)
-            .map(|l| (k + 1, *l))
-            .ok_or_else(|| err(k + 1, format!("file ends early: expected {what}")))
+    let mut cursor = Cursor {
+        lines: text.lines().collect(),
+        at: 0,
+        path,
     };
     let mut frames: Vec<Frame> = Vec::new();
-    while let Some(first) = lines.get(at) {
+    while let Some(first) = cursor.lines.get(cursor.at) {
         if first.trim().is_empty() {
-            at += 1;
+            cursor.at += 1;
             continue;
         }
-        let (n, l) = next(&mut at, "ITEM: TIMESTEP")?;
-        if l.trim() != "ITEM: TIMESTEP" {
-            return Err(err(n, format!("expected `ITEM: TIMESTEP`, found `{l}`")));
+        let frame = cursor.frame()?;
+        match frames.last() {
+            Some(last) if last.step == frame.step => {}
+            _ => frames.push(frame),
         }
-        let (n, l) = next(&mut at, "the time step")?;
+    }
+    Ok(frames)
+}
+
+/// The dump's lines and the next one to read.
+struct Cursor<'a> {
+    lines: Vec<&'a str>,
+    at: usize,
+    path: &'a Path,
+}
+
+impl<'a> Cursor<'a> {
+    fn err(&self, line: usize, message: String) -> DumpError {
+        DumpError {
+            file: self.path.to_path_buf(),
+            line,
+            message,
+        }
+    }
+
+    /// The line at `at` (advancing) with its 1-based number, or a truncation error naming
+    /// what was expected.
+    fn next(&mut self, what: &str) -> Result<(usize, &'a str), DumpError> {
+        let k = self.at;
+        self.at += 1;
+        match self.lines.get(k) {
+            Some(l) => Ok((k + 1, *l)),
+            None => Err(self.err(k + 1, format!("file ends early: expected {what}"))),
+        }
+    }
+
+    /// One frame, from its `ITEM: TIMESTEP` line to its last atom.
+    fn frame(&mut self) -> Result<Frame, DumpError> {
+        let (n, l) = self.next("ITEM: TIMESTEP")?;
+        if l.trim() != "ITEM: TIMESTEP" {
+            return Err(self.err(n, format!("expected `ITEM: TIMESTEP`, found `{l}`")));
+        }
+        let (n, l) = self.next("the time step")?;
         let step: u64 = l
             .trim()
             .parse()
-            .map_err(|_| err(n, format!("time step `{l}` is not a non-negative integer")))?;
-        let (n, l) = next(&mut at, "ITEM: NUMBER OF ATOMS")?;
+            .map_err(|_| self.err(n, format!("time step `{l}` is not a non-negative integer")))?;
+        let (n, l) = self.next("ITEM: NUMBER OF ATOMS")?;
         if l.trim() != "ITEM: NUMBER OF ATOMS" {
-            return Err(err(
-                n,
-                format!("expected `ITEM: NUMBER OF ATOMS`, found `{l}`"),
-            ));
+            return Err(self.err(n, format!("expected `ITEM: NUMBER OF ATOMS`, found `{l}`")));
         }
-        let (n, l) = next(&mut at, "the number of atoms")?;
+        let (n, l) = self.next("the number of atoms")?;
         let n_atoms: usize = l.trim().parse().map_err(|_| {
-            err(
+            self.err(
                 n,
                 format!("number of atoms `{l}` is not a non-negative integer"),
             )
         })?;
-        let (n, l) = next(&mut at, "ITEM: BOX BOUNDS")?;
+        let (boundary, bounds) = self.bounds()?;
+        let (n, l) = self.next("ITEM: ATOMS")?;
+        let Some(names) = l.trim().strip_prefix("ITEM: ATOMS") else {
+            return Err(self.err(n, format!("expected `ITEM: ATOMS <columns>`, found `{l}`")));
+        };
+        let columns: Vec<String> = names.split_whitespace().map(String::from).collect();
+        if columns.is_empty() {
+            return Err(self.err(n, "`ITEM: ATOMS` names no columns".into()));
+        }
+        let values = self.atoms(&columns, n_atoms, step)?;
+        Ok(Frame {
+            step,
+            boundary,
+            bounds,
+            columns,
+            values,
+        })
+    }
+
+    /// `ITEM: BOX BOUNDS <flags>` and its three lines: the flags and (lo, hi) per axis.
+    fn bounds(&mut self) -> Result<(String, [[Real; 2]; 3]), DumpError> {
+        let (n, l) = self.next("ITEM: BOX BOUNDS")?;
         let Some(boundary) = l.trim().strip_prefix("ITEM: BOX BOUNDS") else {
-            return Err(err(
-                n,
-                format!("expected `ITEM: BOX BOUNDS ...`, found `{l}`"),
-            ));
+            return Err(self.err(n, format!("expected `ITEM: BOX BOUNDS ...`, found `{l}`")));
         };
         let boundary = boundary.trim().to_string();
         let mut bounds = [[0.0; 2]; 3];
         for (axis, b) in bounds.iter_mut().enumerate() {
-            let (n, l) = next(&mut at, "a box bounds line")?;
+            let (n, l) = self.next("a box bounds line")?;
             let v: Vec<Real> = l
                 .split_whitespace()
                 .map(str::parse)
                 .collect::<Result<_, _>>()
                 .map_err(|_| {
-                    err(
+                    self.err(
                         n,
                         format!("box bounds of axis {axis}: `{l}` is not numbers"),
                     )
                 })?;
             if v.len() < 2 {
-                return Err(err(
+                return Err(self.err(
                     n,
                     format!("box bounds of axis {axis}: expected lo hi, found `{l}`"),
                 ));
             }
             *b = [v[0], v[1]];
         }
-        let (n, l) = next(&mut at, "ITEM: ATOMS")?;
-        let Some(names) = l.trim().strip_prefix("ITEM: ATOMS") else {
-            return Err(err(
-                n,
-                format!("expected `ITEM: ATOMS <columns>`, found `{l}`"),
-            ));
-        };
-        let columns: Vec<String> = names.split_whitespace().map(String::from).collect();
-        if columns.is_empty() {
-            return Err(err(n, "`ITEM: ATOMS` names no columns".into()));
-        }
+        Ok((boundary, bounds))
+    }
+
+    /// The `n_atoms` atom lines of a frame, as `values[column][atom]`.
+    fn atoms(
+        &mut self,
+        columns: &[String],
+        n_atoms: usize,
+        step: u64,
+    ) -> Result<Vec<Vec<Real>>, DumpError> {
         let mut values = vec![Vec::with_capacity(n_atoms); columns.len()];
         for atom in 0..n_atoms {
-            let (n, l) = next(
-                &mut at,
-                &format!("atom line {} of {n_atoms} (step {step})", atom + 1),
-            )?;
+            let (n, l) = self.next(&format!(
+                "atom line {} of {n_atoms} (step {step})",
+                atom + 1
+            ))?;
             let fields: Vec<&str> = l.split_whitespace().collect();
             if fields.len() != columns.len() {
-                return Err(err(
+                return Err(self.err(
                     n,
                     format!(
                         "atom line has {} values, the header names {} columns ({})",
@@ -163,24 +203,13 @@ pub fn parse_dump(text: &str, path: &Path) -> Result<Vec<Frame>, DumpError> {
             }
             for (c, f) in fields.iter().enumerate() {
                 let v: Real = f.parse().map_err(|_| {
-                    err(n, format!("column `{}`: `{f}` is not a number", columns[c]))
+                    self.err(n, format!("column `{}`: `{f}` is not a number", columns[c]))
                 })?;
                 values[c].push(v);
             }
         }
-        let frame = Frame {
-            step,
-            boundary,
-            bounds,
-            columns,
-            values,
-        };
-        match frames.last() {
-            Some(last) if last.step == step => {}
-            _ => frames.push(frame),
-        }
+        Ok(values)
     }
-    Ok(frames)
 }
 
 #[cfg(test)]

@@ -29,7 +29,7 @@ use crate::decks::stages::{stage_lines, trajectory_lines, StageHooks};
 use crate::decks::{Deck, DeckError, DeckPlan};
 use cgdem_core::math::{Real, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{ContactSettings, Scene};
+use cgdem_core::scene::{ContactSettings, Scene, WcaSettings};
 use cgdem_core::walls::restitution_damping_ratio;
 
 /// Dump columns of the WCA deck (no rotation).
@@ -38,39 +38,9 @@ const WCA_COLUMNS: &str = "id type x y z vx vy vz radius";
 /// The deck for `scene` starting from `particles` (positions and velocities), stepping `dt`:
 /// the seed's WCA model here, a Hertz scene by `hertz::write_hertz_deck`.
 pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
-    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
-    let ContactSettings::Wca(wca) = scene.contact else {
-        return Err(unsupported(
-            "not the seed's WCA model: Hertz scenes get `hertz::write_hertz_deck`".into(),
-        ));
-    };
-    if wca.gamma_n <= 0.0 {
-        return Err(unsupported(
-            "gamma_n = 0: LAMMPS sets gamma_t as a multiple of gamma_n".into(),
-        ));
-    }
-    if !dt.is_finite() || dt <= 0.0 {
-        return Err(unsupported(format!("time step {dt} s")));
-    }
-    // A deck without the scene's bodies or outlets would run another case under its name.
-    if !scene.bodies.is_empty() || !scene.deletions.is_empty() {
-        return Err(unsupported(
-            "LAMMPS seed-model decks take planar walls only (no [[body]], no [[delete]])".into(),
-        ));
-    }
+    let (wca, masses) = wca_settings(scene, dt)?;
     let rc = TWO_POW_ONE_SIXTH * wca.sigma;
-    let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
     let wall_mass = masses[0];
-    if !scene.walls.is_empty()
-        && masses
-            .iter()
-            .any(|&m| (m - wall_mass).abs() > 1e-12 * wall_mass)
-    {
-        return Err(unsupported(
-            "walls with species of different masses: fix wall/gran takes one gamma_w for all atoms"
-                .into(),
-        ));
-    }
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
 
     // Data file: cgdem's own particles, so both codes start from the same packing.
@@ -131,42 +101,7 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
     let _ = writeln!(d, "timestep        {}", g(dt));
 
     if !scene.walls.is_empty() {
-        let stiffness = 4.0 * 72.0 * wca.epsilon / (rc * rc);
-        let gamma_w = 2.0
-            * restitution_damping_ratio(scene.wall_contact.restitution)
-            * (stiffness * wall_mass).sqrt();
-        let x_t = wall_mass / (2.0 * dt * gamma_w);
-        let _ = writeln!(
-            d,
-            "# walls: mirror WCA + dashpot gamma_w = {} kg/s (restitution {}), friction {}",
-            g(gamma_w),
-            scene.wall_contact.restitution,
-            scene.wall_contact.friction
-        );
-        for w in &scene.walls {
-            let (p, n) = (w.point, w.normal);
-            let _ = writeln!(
-                d,
-                "region          w_{} plane {} {} {} {} {} {} side in units box",
-                w.name,
-                g(p.x),
-                g(p.y),
-                g(p.z),
-                g(n.x),
-                g(n.y),
-                g(n.z)
-            );
-            let _ = writeln!(
-                d,
-                "fix             wlj_{0} all wall/region w_{0} lj126 {1} {2} {3}",
-                w.name,
-                g(wca.epsilon),
-                g(0.5 * wca.sigma),
-                g(0.5 * rc)
-            );
-            let _ = writeln!(d, "fix             wgran_{0} all wall/gran/region granular hooke 0.0 {1} damping velocity tangential linear_nohistory {2} {3} region w_{0}", w.name, g(gamma_w), g(x_t), g(scene.wall_contact.friction));
-        }
-        d += &removal_pads(scene, 2);
+        wall_lines(&mut d, scene, &wca, wall_mass, dt);
     }
 
     let stages = trajectory_lines(
@@ -199,6 +134,86 @@ pub fn write_wca_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<
             repose_dumps,
         },
     })
+}
+
+/// The scene's WCA settings and its species' masses, or why LAMMPS cannot run the scene
+/// as cgdem does.
+fn wca_settings(scene: &Scene, dt: Real) -> Result<(WcaSettings, Vec<Real>), DeckError> {
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
+    let ContactSettings::Wca(wca) = scene.contact else {
+        return Err(unsupported(
+            "not the seed's WCA model: Hertz scenes get `hertz::write_hertz_deck`".into(),
+        ));
+    };
+    if wca.gamma_n <= 0.0 {
+        return Err(unsupported(
+            "gamma_n = 0: LAMMPS sets gamma_t as a multiple of gamma_n".into(),
+        ));
+    }
+    if !dt.is_finite() || dt <= 0.0 {
+        return Err(unsupported(format!("time step {dt} s")));
+    }
+    // A deck without the scene's bodies or outlets would run another case under its name.
+    if !scene.bodies.is_empty() || !scene.deletions.is_empty() {
+        return Err(unsupported(
+            "LAMMPS seed-model decks take planar walls only (no [[body]], no [[delete]])".into(),
+        ));
+    }
+    let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
+    let wall_mass = masses[0];
+    if !scene.walls.is_empty()
+        && masses
+            .iter()
+            .any(|&m| (m - wall_mass).abs() > 1e-12 * wall_mass)
+    {
+        return Err(unsupported(
+            "walls with species of different masses: fix wall/gran takes one gamma_w for all atoms"
+                .into(),
+        ));
+    }
+    Ok((wca, masses))
+}
+
+/// The walls: each a plane region with a mirror WCA and a dashpot with friction (removable
+/// by name), and the removal pads.
+fn wall_lines(d: &mut String, scene: &Scene, wca: &WcaSettings, wall_mass: Real, dt: Real) {
+    let rc = TWO_POW_ONE_SIXTH * wca.sigma;
+    let stiffness = 4.0 * 72.0 * wca.epsilon / (rc * rc);
+    let gamma_w = 2.0
+        * restitution_damping_ratio(scene.wall_contact.restitution)
+        * (stiffness * wall_mass).sqrt();
+    let x_t = wall_mass / (2.0 * dt * gamma_w);
+    let _ = writeln!(
+        d,
+        "# walls: mirror WCA + dashpot gamma_w = {} kg/s (restitution {}), friction {}",
+        g(gamma_w),
+        scene.wall_contact.restitution,
+        scene.wall_contact.friction
+    );
+    for w in &scene.walls {
+        let (p, n) = (w.point, w.normal);
+        let _ = writeln!(
+            d,
+            "region          w_{} plane {} {} {} {} {} {} side in units box",
+            w.name,
+            g(p.x),
+            g(p.y),
+            g(p.z),
+            g(n.x),
+            g(n.y),
+            g(n.z)
+        );
+        let _ = writeln!(
+            d,
+            "fix             wlj_{0} all wall/region w_{0} lj126 {1} {2} {3}",
+            w.name,
+            g(wca.epsilon),
+            g(0.5 * wca.sigma),
+            g(0.5 * rc)
+        );
+        let _ = writeln!(d, "fix             wgran_{0} all wall/gran/region granular hooke 0.0 {1} damping velocity tangential linear_nohistory {2} {3} region w_{0}", w.name, g(gamma_w), g(x_t), g(scene.wall_contact.friction));
+    }
+    *d += &removal_pads(scene, 2);
 }
 
 #[cfg(test)]
