@@ -1,9 +1,9 @@
 //! The step of the subdomains: each stepped on the thread (or rank) that owns it, with the
 //! four phases of communication between them. The world asks for the three parts of a step
-//! in turn: [`Decomposition::advance`] (the first half of the integrator), a
-//! [`Decomposition::rebuild`] when a particle moved past half the skin, and
-//! [`Decomposition::forces`] (then the second half). The owned particles of all subdomains
-//! side by side are what the outputs read ([`Decomposition::gathered`]).
+//! in turn: `Decomposition::advance` (the first half of the integrator), a
+//! `Decomposition::rebuild` when a particle moved past half the skin, and
+//! `Decomposition::forces` (then the second half). The owned particles of all subdomains
+//! side by side are what the outputs read (`Decomposition::gathered`).
 
 use super::balance::{imbalance, Balance};
 use super::borders::borders;

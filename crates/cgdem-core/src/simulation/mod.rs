@@ -2,9 +2,9 @@
 //! guards, and the subdomains that hold the particles and step them.
 //!
 //! Every world is a grid of subdomains (`decomposition`), one subdomain for a small scene.
-//! A step asks them for its three parts in turn: [`Decomposition::advance`] (the first half
-//! of the integrator), a [`Decomposition::rebuild`] when a particle moved past half the skin
-//! (the removals it makes are accounted here), and [`Decomposition::forces`] (the forces,
+//! A step asks them for its three parts in turn: `Decomposition::advance` (the first half
+//! of the integrator), a `Decomposition::rebuild` when a particle moved past half the skin
+//! (the removals it makes are accounted here), and `Decomposition::forces` (the forces,
 //! then the second half). The world is generic over the pair law and the wall law, fixed
 //! when the scene is built, so the compiler sees one concrete force loop per scene: the
 //! seed's WCA scene has no rotation, no history and no cohesion in it.
