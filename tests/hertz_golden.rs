@@ -25,7 +25,7 @@ use cgdem_core::contact::tangential::Mindlin;
 use cgdem_core::math::{Real, Vec3};
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{hertz_history_wall, hertz_law};
-use cgdem_core::scene::{ContactSettings, ContactTables, PairProperties, Scene};
+use cgdem_core::scene::{ContactSettings, Scene};
 use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use cgdem_harness::code::Code;
 use cgdem_harness::decks::{self, lammps, liggghts, Deck, RunStatus, RunnerOptions};
@@ -164,18 +164,12 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
         .join(case)
         .join(format!("{code:?}").to_lowercase());
     let _ = std::fs::remove_dir_all(&dir);
-    // The LIGGGHTS deck writer takes the material tables; the LAMMPS one writes one material,
-    // so its deck is that of the scene without tables, with the pair and wall lines then
-    // written per type here (`lammps_tables`).
-    let mut deck: Deck = match code {
+    // Both deck writers take the scene's material tables (reference/MAPPING.md).
+    let deck: Deck = match code {
         Code::Liggghts => liggghts::write_deck(scene, initial, DT),
-        _ => lammps::write_hertz_deck(&without_tables(scene), initial, DT),
+        _ => lammps::write_hertz_deck(scene, initial, DT),
     }
     .expect("deck");
-    if code == Code::Lammps && scene.gives_material_tables() {
-        let tables = ContactTables::of(scene).unwrap();
-        deck.input = lammps_tables(scene, &tables, &deck.input);
-    }
     assert_eq!(deck.plan.dump_every, 1);
     deck.write_to(&dir).expect("write deck");
     let options = RunnerOptions {
@@ -214,125 +208,6 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
             })
             .collect(),
     )
-}
-
-/// `scene` without its material tables: [contact]'s material and coefficients for all.
-fn without_tables(scene: &Scene) -> Scene {
-    let mut s = scene.clone();
-    for species in &mut s.species {
-        species.youngs_modulus = None;
-        species.poisson_ratio = None;
-    }
-    if let ContactSettings::Hertz(h) = &mut s.contact {
-        h.pairs.clear();
-    }
-    s.wall_contact.materials.clear();
-    s.wall_contact.pairs.clear();
-    for wall in &mut s.walls {
-        wall.material = 0;
-    }
-    s
-}
-
-/// `%.17e`, as the decks write numbers.
-fn num(x: Real) -> String {
-    format!("{x:.17e}")
-}
-
-/// The wall material of the scene's walls (the golden scenes give them one).
-fn wall_material(scene: &Scene) -> usize {
-    let k = scene.walls.first().map_or(0, |w| w.material);
-    assert!(
-        scene.walls.iter().all(|w| w.material == k),
-        "one wall material"
-    );
-    k
-}
-
-/// The LAMMPS deck with one `pair_coeff I J` per species pair and the wall fixes for the
-/// walls' material against the scene's one mobile species. `hertz/material E e nu` takes `E`
-/// and `nu` as one material, so an unlike pair is given the one material with its `Y*` and
-/// `G*` (reference/MAPPING.md); its restitution, friction and rolling friction are its own.
-fn lammps_tables(scene: &Scene, t: &ContactTables, deck: &str) -> String {
-    use cgdem_harness::decks::lammps::hertz::{
-        rolling_stiffness, tangential_damping_ratio, tsuji_q,
-    };
-    let ContactSettings::Hertz(h) = &scene.contact else {
-        unreachable!()
-    };
-    let n = t.n_species();
-    let rolling = |p: &PairProperties, y: Real, g: Real, r: Real, m: Real| {
-        format!(
-            " rolling sds {} 0.0 {}",
-            num(rolling_stiffness(y, g, r, m, h.characteristic_velocity)),
-            num(p.rolling_friction)
-        )
-    };
-    let mut pairs = String::new();
-    for a in 0..n {
-        for b in a..n {
-            let (y, g) = (t.y_eff(a, b), t.g_eff(a, b));
-            let r = g / y;
-            let nu = (1.0 - 4.0 * r) / (1.0 - 2.0 * r);
-            let e = 2.0 * (1.0 - nu * nu) * y;
-            let (sa, sb) = (&scene.species[a], &scene.species[b]);
-            let (r_eff, m_eff) = (
-                sa.radius() * sb.radius() / (sa.radius() + sb.radius()),
-                sa.mass() * sb.mass() / (sa.mass() + sb.mass()),
-            );
-            let p = t.pair(a, b);
-            pairs += &format!(
-                "pair_coeff      {} {} hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {}{}\n",
-                a + 1,
-                b + 1,
-                num(e),
-                num(tsuji_q(p.restitution).unwrap()),
-                num(nu),
-                num(tangential_damping_ratio(y, g)),
-                num(p.friction),
-                rolling(p, y, g, r_eff, m_eff)
-            );
-        }
-    }
-    let mobile: Vec<usize> = (0..n).filter(|&a| !scene.species[a].frozen).collect();
-    let wall = wall_material(scene);
-    let mut out = String::new();
-    for line in deck.lines() {
-        if line.starts_with("pair_coeff      * *") {
-            out += &pairs;
-        } else if let Some(rest) = line.strip_prefix("fix             w_") {
-            // `fix w_NAME all wall/gran granular <model> <axis>plane lo hi`: the model for
-            // the walls' material against the one species that meets them.
-            assert_eq!(
-                mobile.len(),
-                1,
-                "the golden wall cases have one mobile species"
-            );
-            let a = mobile[0];
-            let (s, nu) = (&scene.species[a], t.species[a].poisson_ratio);
-            let (y, g) = (t.wall_y_eff(a, wall), t.wall_g_eff(a, wall));
-            let p = t.wall_pair(a, wall);
-            let (name, _) = rest.split_once(' ').unwrap();
-            let plane = rest.split_whitespace().rev().take(3).collect::<Vec<_>>();
-            out += &format!(
-                "fix             w_{name} all wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {} {} {}\n",
-                num(2.0 * (1.0 - nu) * y),
-                num(tsuji_q(p.restitution).unwrap()),
-                num(nu),
-                num(8.0 * g),
-                num(tangential_damping_ratio(y, g)),
-                num(p.friction),
-                rolling(p, y, g, s.radius(), s.mass()),
-                plane[2],
-                plane[1],
-                plane[0]
-            );
-        } else {
-            out += line;
-            out += "\n";
-        }
-    }
-    out
 }
 
 /// Contact time from a distance series: first and last crossing of `reach`, interpolated.
