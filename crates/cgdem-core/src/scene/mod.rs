@@ -133,6 +133,17 @@ pub enum TangentialKind {
     Yang,
 }
 
+impl TangentialKind {
+    /// The scene file's word for the law.
+    pub fn name(self) -> &'static str {
+        match self {
+            TangentialKind::History => "history",
+            TangentialKind::Coulomb => "coulomb",
+            TangentialKind::Yang => "yang",
+        }
+    }
+}
+
 /// `rolling = "none" | "constant_torque" | "epsd2"`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum RollingKind {
