@@ -173,6 +173,7 @@ fn wall_rebounds_with_the_restitution_it_was_given() {
                 name: "floor".into(),
                 plane: FinitePlane::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0),
                 active: true,
+                material: 0,
             }],
         };
         let law = coke.wall_law(e, 0.0);
@@ -220,6 +221,7 @@ fn wall_friction_stops_a_sliding_particle_at_mu_g_without_chatter() {
             name: "floor".into(),
             plane: FinitePlane::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0),
             active: true,
+            material: 0,
         }],
     };
     let dt = coke.pair_period() / 50.0;
@@ -323,6 +325,7 @@ fn one_and_two_threads_give_bitwise_identical_positions() {
                 name: name.into(),
                 plane: FinitePlane::new(point, normal, 1.0, 1.0),
                 active: true,
+                material: 0,
             };
             let walls = WallSet {
                 walls: vec![

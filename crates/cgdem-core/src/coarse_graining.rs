@@ -51,8 +51,9 @@ pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
 }
 
 /// Hertz parameters under `rule` (reference/COARSE_GRAINING.md, "Hertz-Mindlin rules"). The
-/// elastic constants, restitution, friction and rolling friction are kept by every rule; they
-/// differ in Yang's `gamma_n` and in the van der Waals cohesion:
+/// elastic constants, restitution, friction and rolling friction are kept by every rule (each
+/// species' material and each pair's coefficients alike); they differ in Yang's `gamma_n` and
+/// in the van der Waals cohesion (the default Hamaker constant and each pair's own):
 ///
 /// | rule | `gamma_n` (Yang) | Hamaker constant | `h_min`, cut-off | vdW force at the scaled gap |
 /// |---|---|---|---|---|
@@ -85,6 +86,10 @@ pub fn coarse_grain_hertz_by(h: &HertzSettings, l: f64, rule: CoarseGrainRule) -
             h_min: h_min * l,
             cutoff: cutoff.map(|c| c * l),
         };
+        // Every species pair's own constant by the same rule.
+        for p in &mut out.pairs {
+            p.hamaker_constant = p.hamaker_constant.map(|a| a * l.powi(hamaker));
+        }
     }
     out
 }
@@ -383,6 +388,7 @@ mod hertz_tests {
                 cutoff: None,
             },
             characteristic_velocity: 1.0,
+            pairs: Vec::new(),
         }
     }
 

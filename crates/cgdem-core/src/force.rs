@@ -261,6 +261,7 @@ pub(crate) fn body_force<W: WallLaw>(
     let contact_point = particle.position - distance * normal;
     let contact = WallContact {
         species: particle.species,
+        material: body.material,
         normal,
         distance,
         relative_velocity: particle.velocity - body.surface_velocity(contact_point),
@@ -309,6 +310,7 @@ pub(crate) fn body_force_and_torque<W: WallLaw>(
     let contact_point = particle.position - distance * normal;
     let contact = WallContact {
         species: particle.species,
+        material: body.material,
         normal,
         distance,
         relative_velocity: particle.velocity - body.surface_velocity(contact_point),

@@ -15,6 +15,9 @@ mod fuzz_cases;
 use fuzz_cases::{config, counted};
 
 const SCENE: &str = include_str!("../../../tests/data/tiny_hertz_collapse.toml");
+/// The same with two materials: species' own, `[[contact.pair]]`, `[[wall_material]]`,
+/// `[[wall_contact.pair]]` and a wall naming its material.
+const MATERIALS_SCENE: &str = include_str!("../../../tests/data/tiny_two_material_collapse.toml");
 const SCENE_FILE: &str = "fuzz/scene.toml";
 const STL_FILE: &str = "fuzz/body.stl";
 
@@ -58,7 +61,12 @@ fn bad_value() -> impl Strategy<Value = String> {
 
 /// The tiny collapse scene with one value replaced, lines dropped or duplicated, or cut.
 fn mutated_scene() -> impl Strategy<Value = String> {
-    let lines: Vec<String> = SCENE.lines().map(str::to_string).collect();
+    mutated(SCENE)
+}
+
+/// `base` with one value replaced, lines dropped or duplicated, a line inserted, or cut.
+fn mutated(base: &'static str) -> impl Strategy<Value = String> {
+    let lines: Vec<String> = base.lines().map(str::to_string).collect();
     let n = lines.len();
     prop_oneof![
         (0..n, bad_value()).prop_map({
@@ -83,12 +91,12 @@ fn mutated_scene() -> impl Strategy<Value = String> {
                 l.join("\n")
             }
         }),
-        (0..SCENE.len()).prop_map(|cut| {
+        (0..base.len()).prop_map(move |cut| {
             let mut c = cut;
-            while !SCENE.is_char_boundary(c) {
+            while !base.is_char_boundary(c) {
                 c -= 1;
             }
-            SCENE[..c].to_string()
+            base[..c].to_string()
         }),
         (0..n, "[a-z_.]{1,12}", bad_value()).prop_map({
             let lines = lines.clone();
@@ -201,6 +209,165 @@ fn mutated_data() -> impl Strategy<Value = String> {
         (0..DATA.len()).prop_map(|cut| DATA[..cut].to_string()),
     ]
 }
+
+/// A valid Hertz scene with generated material tables: 1-3 species, each maybe with its own
+/// Young's modulus and Poisson's ratio; a subset of the species pairs (each once, in either
+/// order) with some coefficients; 0-2 wall materials named by the walls; a subset of the
+/// (species, wall material) pairs. Returned with what was given, to check the resolution.
+#[derive(Clone, Debug)]
+struct Tables {
+    species: Vec<(Option<f64>, Option<f64>)>,
+    pairs: Vec<GivenPair>,
+    wall_materials: Vec<(f64, f64)>,
+    wall_pairs: Vec<GivenWallPair>,
+    wall_material: Option<usize>,
+}
+
+/// (a, b, restitution, friction, rolling friction)
+type GivenPair = (usize, usize, Option<f64>, Option<f64>, Option<f64>);
+/// (species, material or None for the default, restitution, friction)
+type GivenWallPair = (usize, Option<usize>, Option<f64>, Option<f64>);
+
+fn tables() -> impl Strategy<Value = Tables> {
+    let modulus = prop_oneof![Just(None), (5e6f64..1e9).prop_map(Some)];
+    let poisson = prop_oneof![Just(None), (0.0f64..0.49).prop_map(Some)];
+    let coefficient = |lo: f64, hi: f64| prop_oneof![Just(None), (lo..hi).prop_map(Some)];
+    (1usize..=3, 0usize..=2).prop_flat_map(move |(n, n_wall)| {
+        let unordered: Vec<(usize, usize)> =
+            (0..n).flat_map(|a| (a..n).map(move |b| (a, b))).collect();
+        let wall_keys: Vec<(usize, Option<usize>)> = (0..n)
+            .flat_map(|a| std::iter::once((a, None)).chain((0..n_wall).map(move |k| (a, Some(k)))))
+            .collect();
+        (
+            proptest::collection::vec((modulus.clone(), poisson.clone()), n),
+            proptest::sample::subsequence(unordered.clone(), 0..=unordered.len()),
+            proptest::collection::vec(
+                (
+                    any::<bool>(),
+                    coefficient(0.05, 1.0),
+                    coefficient(0.0, 1.0),
+                    coefficient(0.0, 0.5),
+                ),
+                unordered.len(),
+            ),
+            proptest::collection::vec((5e6f64..1e11, 0.0f64..0.49), n_wall),
+            proptest::sample::subsequence(wall_keys.clone(), 0..=wall_keys.len()),
+            proptest::collection::vec(
+                (coefficient(0.05, 1.0), coefficient(0.0, 1.0)),
+                wall_keys.len(),
+            ),
+            prop_oneof![Just(None), (0..n_wall.max(1)).prop_map(Some)],
+        )
+            .prop_map(
+                move |(species, pairs, values, wall_materials, wall_keys, wall_values, wall)| {
+                    let pairs = pairs
+                        .into_iter()
+                        .zip(values)
+                        .map(|((a, b), (swap, e, mu, mu_r))| {
+                            let (a, b) = if swap { (b, a) } else { (a, b) };
+                            // At least one coefficient per pair.
+                            (a, b, e, mu.or(Some(0.25)), mu_r)
+                        })
+                        .collect();
+                    let wall_pairs = wall_keys
+                        .into_iter()
+                        .zip(wall_values)
+                        .map(|((a, k), (e, mu))| (a, k, e.or(Some(0.5)), mu))
+                        .collect();
+                    Tables {
+                        species,
+                        pairs,
+                        wall_material: wall.filter(|&k| k < wall_materials.len()),
+                        wall_materials,
+                        wall_pairs,
+                    }
+                },
+            )
+    })
+}
+
+/// The scene text of `t`: tiny_hertz_collapse's box, law and stages.
+fn tables_scene(t: &Tables) -> String {
+    let mut s = String::from(
+        "name = \"tables\"\n[domain]\nlo = [0.0, 0.0, 0.0]\nhi = [0.15, 0.04, 0.12]\n",
+    );
+    let opt = |name: &str, v: Option<f64>| v.map_or(String::new(), |v| format!("{name} = {v:e}\n"));
+    for (k, (e, nu)) in t.species.iter().enumerate() {
+        s += &format!("[[species]]\nname = \"s{k}\"\ndiameter = 1.0e-2\ndensity = 2500.0\n");
+        s += &opt("youngs_modulus", *e);
+        s += &opt("poisson_ratio", *nu);
+    }
+    s += "[contact]\nmodel = \"hertz\"\nyoungs_modulus = 5.0e6\npoisson_ratio = 0.3\nrestitution = 0.5\nfriction = 0.5\nrolling_friction = 0.1\nrolling = \"epsd2\"\n";
+    for (a, b, e, mu, mu_r) in &t.pairs {
+        s += &format!("[[contact.pair]]\nspecies = [\"s{a}\", \"s{b}\"]\n");
+        s += &opt("restitution", *e);
+        s += &opt("friction", *mu);
+        s += &opt("rolling_friction", *mu_r);
+    }
+    for (k, (e, nu)) in t.wall_materials.iter().enumerate() {
+        s += &format!(
+            "[[wall_material]]\nname = \"w{k}\"\nyoungs_modulus = {e:e}\npoisson_ratio = {nu:e}\n"
+        );
+    }
+    s += "[wall_contact]\nrestitution = 0.7\nfriction = 0.45\n";
+    for (a, k, e, mu) in &t.wall_pairs {
+        s += &format!("[[wall_contact.pair]]\nspecies = \"s{a}\"\n");
+        if let Some(k) = k {
+            s += &format!("material = \"w{k}\"\n");
+        }
+        s += &opt("restitution", *e);
+        s += &opt("friction", *mu);
+    }
+    s += "[[wall]]\nname = \"floor\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n";
+    if let Some(k) = t.wall_material {
+        s += &format!("material = \"w{k}\"\n");
+    }
+    s += "[time]\ndt_fraction = 0.05\n[[stage]]\nname = \"s\"\nduration = 0.1\n";
+    s
+}
+
+/// A generated valid scene parses, and every pair resolves to its own value, else the default.
+fn check_tables(t: &Tables) {
+    use cgdem_core::scene::ContactTables;
+    let scene = Scene::parse(&tables_scene(t), Path::new(SCENE_FILE))
+        .unwrap_or_else(|e| panic!("{e}\n{}", tables_scene(t)));
+    let r = ContactTables::of(&scene).unwrap();
+    let n = t.species.len();
+    for (k, (e, nu)) in t.species.iter().enumerate() {
+        assert_eq!(r.species[k].youngs_modulus, e.unwrap_or(5e6));
+        assert_eq!(r.species[k].poisson_ratio, nu.unwrap_or(0.3));
+    }
+    for a in 0..n {
+        for b in 0..n {
+            let given = t
+                .pairs
+                .iter()
+                .find(|p| (p.0, p.1) == (a, b) || (p.0, p.1) == (b, a));
+            let p = r.pair(a, b);
+            assert_eq!(p, r.pair(b, a));
+            assert_eq!(r.y_eff(a, b), r.y_eff(b, a));
+            assert_eq!(p.restitution, given.and_then(|g| g.2).unwrap_or(0.5));
+            assert_eq!(p.friction, given.and_then(|g| g.3).unwrap_or(0.5));
+            assert_eq!(p.rolling_friction, given.and_then(|g| g.4).unwrap_or(0.1));
+        }
+        for k in 0..=t.wall_materials.len() {
+            let given = t
+                .wall_pairs
+                .iter()
+                .find(|p| p.0 == a && p.1.map_or(0, |m| m + 1) == k);
+            let p = r.wall_pair(a, k);
+            assert_eq!(p.restitution, given.and_then(|g| g.2).unwrap_or(0.7));
+            assert_eq!(p.friction, given.and_then(|g| g.3).unwrap_or(0.45));
+        }
+    }
+    assert_eq!(
+        scene.walls[0].material,
+        t.wall_material.map_or(0, |k| k + 1)
+    );
+}
+
+static TABLES_VALID: AtomicU64 = AtomicU64::new(0);
+static TABLES_MUTATED: AtomicU64 = AtomicU64::new(0);
 
 static DATA_ANY: AtomicU64 = AtomicU64::new(0);
 static DATA_MUTATED: AtomicU64 = AtomicU64::new(0);
@@ -323,6 +490,18 @@ proptest! {
     }
 
     #[test]
+    fn generated_material_tables_resolve_each_pair_to_its_own_value(t in tables()) {
+        check_tables(&t);
+        counted(&TABLES_VALID, "scene material tables (generated, valid)");
+    }
+
+    #[test]
+    fn scene_parser_takes_mutated_material_scenes(text in mutated(MATERIALS_SCENE)) {
+        check_scene(&text);
+        counted(&TABLES_MUTATED, "scene (mutated tiny_two_material_collapse)");
+    }
+
+    #[test]
     fn data_file_reader_takes_any_text(text in any::<String>()) {
         check_data(&text);
         counted(&DATA_ANY, "read_data (any text)");
@@ -351,6 +530,14 @@ proptest! {
         check_stl(&bytes);
         counted(&STL_ASCII, "stl (ascii: numbers, keywords, cuts)");
     }
+}
+
+/// The materials scene the mutations start from is good, and has materials.
+#[test]
+fn the_fuzz_base_materials_scene_is_good() {
+    let scene = Scene::parse(MATERIALS_SCENE, Path::new(SCENE_FILE)).unwrap();
+    let t = cgdem_core::scene::ContactTables::of(&scene).unwrap();
+    assert!(!t.is_uniform() && t.n_wall_materials() == 2);
 }
 
 /// The fuzzers' base data file is read (so the mutations start from a good file).

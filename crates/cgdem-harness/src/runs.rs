@@ -15,7 +15,7 @@ use cgdem_core::decomposition::placement::FROM_THE_SCENE;
 use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_core::math::Real;
 use cgdem_core::run::{restart, CheckpointOptions, Progress, RunOptions, StageEnding};
-use cgdem_core::scene::Scene;
+use cgdem_core::scene::{ContactSettings, Scene};
 
 /// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -62,6 +62,9 @@ pub struct RunRecord {
     pub repose_angle_deg: Option<f64>,
     pub repose_fit_r2: Option<f64>,
     pub runout_m: Option<f64>,
+    /// The Hertz scene's tangential law (`history`, `coulomb`, `yang`); None for WCA.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tangential: Option<String>,
     /// The run was not repeated: its directory already held it (`--reuse`).
     pub reused: bool,
     /// The run stopped before its last stage ended (time limit, killed, stopped by a
@@ -112,6 +115,7 @@ impl RunRecord {
             repose_angle_deg: None,
             repose_fit_r2: None,
             runout_m: None,
+            tangential: None,
             reused: false,
             partial: false,
             rpm: None,
@@ -314,6 +318,9 @@ pub(super) fn run_one(
         seed,
         dir.to_path_buf(),
     );
+    if let ContactSettings::Hertz(h) = &scene.contact {
+        record.tangential = Some(h.tangential.name().into());
+    }
     let outcome = match code {
         Code::Cgdem => run_cgdem(scene, lambda, rule, seed, dir, options),
         Code::Lammps | Code::Liggghts => {

@@ -49,6 +49,8 @@ pub struct Body {
     world_bounds: Aabb,
     /// Load of the particles on the body at the last force evaluation.
     pub load: BodyLoad,
+    /// The surface's wall material (`walls::WallContact::material`); 0 the default.
+    pub material: usize,
 }
 
 impl Body {
@@ -65,6 +67,7 @@ impl Body {
                 max: Vec3::ZERO,
             },
             load: BodyLoad::default(),
+            material: 0,
         };
         body.set_time(0.0);
         body

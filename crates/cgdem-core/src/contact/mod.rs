@@ -93,6 +93,13 @@ pub trait TangentialModel: Send + Sync {
     type History: PairHistory;
     /// Whether the model needs particle spin (contact-point velocity, torques).
     const NEEDS_ROTATION: bool;
+    /// The normal load the law's Coulomb bounds take from the normal force `F_n` (elastic
+    /// plus dashpot), for its own cap and the rolling torque's: `|F_n|`, as LIGGGHTS, unless
+    /// the law says otherwise.
+    #[inline(always)]
+    fn cap_load(normal_force: Real) -> Real {
+        normal_force.abs()
+    }
     /// Tangential force on `i`; `normal_force` is the total normal force magnitude.
     fn force(
         &self,
@@ -252,7 +259,7 @@ where
         let arm_j = contact.normal * (contact.radius_j - 0.5 * contact.overlap);
         let rolling = self.rolling.torque(
             contact,
-            normal_force.abs(),
+            T::cap_load(normal_force),
             omega.0,
             omega.1,
             &mut history.1,
@@ -372,6 +379,8 @@ impl<N: NormalModel, D, T, R, C> ContactLaw<N, D, T, R, C> {
     }
 }
 
+#[cfg(test)]
+mod coulomb_tests;
 #[cfg(test)]
 mod physics_tests;
 

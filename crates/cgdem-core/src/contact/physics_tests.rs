@@ -74,6 +74,7 @@ fn floor(domain: &Domain) -> WallSet {
             name: "floor".into(),
             plane: FinitePlane::new(Vec3::new(0.0, 0.0, domain.lo.z), Vec3::Z, 1.0, 1.0),
             active: true,
+            material: 0,
         }],
     }
 }
@@ -622,7 +623,7 @@ impl WallLaw for LinearWall {
     fn force(&self, c: &WallContact, _: Real) -> Vec3 {
         (-self.k * (c.distance - self.h0) - self.c * c.relative_velocity.dot(c.normal)) * c.normal
     }
-    fn linearized(&self, _: usize, _: Real, _: Real) -> (Real, Real) {
+    fn linearized(&self, _: usize, _: usize, _: Real, _: Real) -> (Real, Real) {
         (self.k, self.c)
     }
 }
@@ -643,6 +644,7 @@ fn oscillator_error(integrator: Integrator, damping_ratio: Real, dt: Real) -> Re
             name: "floor".into(),
             plane: FinitePlane::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0),
             active: true,
+            material: 0,
         }],
     };
     let seed = super::SeedModel::seed(

@@ -14,7 +14,9 @@ pub mod restart;
 mod setup;
 pub mod state_file;
 
-pub use laws::hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
+pub use laws::hertz::{
+    hertz_coulomb_wall, hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED,
+};
 pub use laws::{seed_laws, with_laws, LawVisitor};
 pub use progress::{Progress, ProgressReporter, RunProgress};
 // The output format, where cgdem's runs (and the driver) have always found it.

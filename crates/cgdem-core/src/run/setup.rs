@@ -39,10 +39,21 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
                 mass: m_eff,
             });
         }
-        if !sa.frozen && (!scene.walls.is_empty() || !scene.bodies.is_empty()) {
-            let (k, gamma) = wall_law.linearized(a, sa.radius(), sa.mass());
+        if sa.frozen {
+            continue;
+        }
+        for material in wall_materials_in_use(scene) {
+            let (k, gamma) = wall_law.linearized(a, material, sa.radius(), sa.mass());
+            let label = match material {
+                0 => format!("{}-wall", sa.name),
+                k => format!(
+                    "{}-wall {}",
+                    sa.name,
+                    scene.wall_contact.materials[k - 1].name
+                ),
+            };
             contacts.push(LinearContact {
-                label: format!("{}-wall", sa.name),
+                label,
                 stiffness: k,
                 damping: gamma,
                 mass: sa.mass(),
@@ -50,6 +61,18 @@ pub fn linear_contacts<L: PairLaw, W: WallLaw>(
         }
     }
     contacts
+}
+
+/// The wall materials (0: the default) of the scene's walls and SDF bodies, each once, in
+/// order.
+fn wall_materials_in_use(scene: &Scene) -> Vec<usize> {
+    let walls = scene.walls.iter().map(|w| w.material);
+    // Bodies built of particles are material 0: they counted as walls before materials.
+    let bodies = scene.bodies.iter().map(|b| b.material);
+    let mut used: Vec<usize> = walls.chain(bodies).collect();
+    used.sort_unstable();
+    used.dedup();
+    used
 }
 
 /// The scene's particles as inserted, before any step (the reference codes start from them);
@@ -256,6 +279,7 @@ pub fn build_bodies<W: WallLaw>(
         let grid =
             SdfGrid::from_mesh(&mesh, b.cell_size, padding).map_err(|e| error(e.to_string()))?;
         let mut body = Body::new(b.name.clone(), BodyShape::Grid(grid), motion);
+        body.material = b.material;
         if b.start_stage.is_none() {
             body.start(0.0);
         }
@@ -322,6 +346,7 @@ pub fn scene_walls(scene: &Scene) -> WallSet {
                 name: w.name.clone(),
                 plane: FinitePlane::new(w.point, w.normal, half, half),
                 active: true,
+                material: w.material,
             })
             .collect(),
     }

@@ -2,12 +2,14 @@
 
 mod cg_rule;
 mod error;
+mod materials;
 mod overrides;
 mod raw;
 mod validate;
 
 pub use cg_rule::CoarseGrainRule;
 pub use error::SceneError;
+pub use materials::{ContactTables, PairProperties};
 pub use overrides::Override;
 pub use validate::given_particles_from_data;
 
@@ -18,7 +20,7 @@ use crate::integrate::Integrator;
 use crate::math::{Real, Vec3};
 use crate::timestep::TimeStepRequest;
 
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Species {
     pub name: String,
     pub diameter: Real,
@@ -27,6 +29,40 @@ pub struct Species {
     /// not integrated, act with infinite mass in their contacts, and pairs of two frozen
     /// particles are never listed.
     pub frozen: bool,
+    /// Hertz: the species' own material (LIGGGHTS `youngsModulus peratomtype`), Pa; None:
+    /// `[contact]`'s.
+    #[serde(default)]
+    pub youngs_modulus: Option<Real>,
+    /// Hertz: the species' own Poisson's ratio; None: `[contact]`'s.
+    #[serde(default)]
+    pub poisson_ratio: Option<Real>,
+}
+
+/// The fields as before materials per species, the material only when the species has its
+/// own: the scene digest (`Scene::digest`) of a one-material scene stays what it was.
+impl std::fmt::Debug for Species {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("Species");
+        s.field("name", &self.name)
+            .field("diameter", &self.diameter)
+            .field("density", &self.density)
+            .field("frozen", &self.frozen);
+        optional_field(&mut s, "youngs_modulus", &self.youngs_modulus);
+        optional_field(&mut s, "poisson_ratio", &self.poisson_ratio);
+        s.finish()
+    }
+}
+
+/// Adds `value` to a debug text unless it is the default (absent, empty, zero): fields added
+/// for materials leave the debug text, hence the digest, of scenes without them unchanged.
+fn optional_field<T: std::fmt::Debug + Default + PartialEq>(
+    s: &mut std::fmt::DebugStruct<'_, '_>,
+    name: &str,
+    value: &T,
+) {
+    if *value != T::default() {
+        s.field(name, value);
+    }
 }
 
 impl Species {
@@ -85,11 +121,27 @@ pub enum HertzDampingKind {
     Yang { gamma_n: Real },
 }
 
-/// `tangential = "history" | "yang"`.
+/// `tangential = "history" | "coulomb" | "yang"`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TangentialKind {
+    /// LIGGGHTS `tangential history`, to the last bit: the spring alone is capped at
+    /// `mu |F_n|`, the dashpot is added uncapped below the cap (reference/MAPPING.md).
     History,
+    /// The same spring and dashpot with Coulomb's bound on their sum, `mu max(F_n, 0)`
+    /// (`contact::tangential::CoulombMindlin`).
+    Coulomb,
     Yang,
+}
+
+impl TangentialKind {
+    /// The scene file's word for the law.
+    pub fn name(self) -> &'static str {
+        match self {
+            TangentialKind::History => "history",
+            TangentialKind::Coulomb => "coulomb",
+            TangentialKind::Yang => "yang",
+        }
+    }
 }
 
 /// `rolling = "none" | "constant_torque" | "epsd2"`.
@@ -113,12 +165,16 @@ pub enum CohesionKind {
     },
 }
 
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// `[contact] model = "hertz"`. The material and pair coefficients here are the defaults:
+/// a species may have its own material (`Species::youngs_modulus`), a species pair its own
+/// coefficients (`pairs`); [`ContactTables`] resolves them.
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HertzSettings {
     pub youngs_modulus: Real,
     pub poisson_ratio: Real,
     pub restitution: Real,
     pub friction: Real,
+    /// The default of the species pairs; 0 also when `[contact]` gives none.
     pub rolling_friction: Real,
     pub damping: HertzDampingKind,
     pub tangential: TangentialKind,
@@ -126,22 +182,119 @@ pub struct HertzSettings {
     pub cohesion: CohesionKind,
     /// Impact speed (m/s) at which Hertz contacts are linearized for the time step.
     pub characteristic_velocity: Real,
+    /// `[[contact.pair]]`: species pairs whose coefficients are not the defaults above (each
+    /// unordered pair at most once).
+    #[serde(default)]
+    pub pairs: Vec<SpeciesPair>,
 }
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+
+/// The derived text of the fields as before, `pairs` only when given (see `Species`).
+impl std::fmt::Debug for HertzSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("HertzSettings");
+        s.field("youngs_modulus", &self.youngs_modulus)
+            .field("poisson_ratio", &self.poisson_ratio)
+            .field("restitution", &self.restitution)
+            .field("friction", &self.friction)
+            .field("rolling_friction", &self.rolling_friction)
+            .field("damping", &self.damping)
+            .field("tangential", &self.tangential)
+            .field("rolling", &self.rolling)
+            .field("cohesion", &self.cohesion)
+            .field("characteristic_velocity", &self.characteristic_velocity);
+        optional_field(&mut s, "pairs", &self.pairs);
+        s.finish()
+    }
+}
+
+/// `[[contact.pair]] species = ["a", "b"]`: the coefficients of one species pair (LIGGGHTS
+/// `peratomtypepair` entries); None: the `[contact]` default.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SpeciesPair {
+    /// Indices into `Scene::species`, in the order given.
+    pub species: [usize; 2],
+    pub restitution: Option<Real>,
+    pub friction: Option<Real>,
+    pub rolling_friction: Option<Real>,
+    /// Van der Waals Hamaker constant, J (`cohesion = "vdw"` only).
+    pub hamaker_constant: Option<Real>,
+}
+
+/// `[wall_contact]`: the particle-wall contact of walls and bodies. Its material and
+/// coefficients are the defaults; `materials` are further wall materials that walls and
+/// bodies name (LIGGGHTS gives each its own atom type), `pairs` the coefficients of a species
+/// against a wall material that differ from the defaults.
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WallContactSettings {
     pub restitution: Real,
     pub friction: Real,
-    /// Hertz walls: the wall's material (None = the particles') and rolling friction.
+    /// Hertz walls: the default wall material (None = `[contact]`'s) and rolling friction.
     pub youngs_modulus: Option<Real>,
     pub poisson_ratio: Option<Real>,
     pub rolling_friction: Real,
+    /// `[[wall_material]]`: material `k + 1` (material 0 is the default above).
+    #[serde(default)]
+    pub materials: Vec<WallMaterial>,
+    /// `[[wall_contact.pair]]`, each (species, material) at most once.
+    #[serde(default)]
+    pub pairs: Vec<WallPair>,
 }
 
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// The derived text of the fields as before, the material tables only when given.
+impl std::fmt::Debug for WallContactSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("WallContactSettings");
+        s.field("restitution", &self.restitution)
+            .field("friction", &self.friction)
+            .field("youngs_modulus", &self.youngs_modulus)
+            .field("poisson_ratio", &self.poisson_ratio)
+            .field("rolling_friction", &self.rolling_friction);
+        optional_field(&mut s, "materials", &self.materials);
+        optional_field(&mut s, "pairs", &self.pairs);
+        s.finish()
+    }
+}
+
+/// `[[wall_material]]`: a material that walls and bodies name (`material = "steel"`).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WallMaterial {
+    pub name: String,
+    pub youngs_modulus: Real,
+    pub poisson_ratio: Real,
+}
+
+/// `[[wall_contact.pair]] species = "grain", material = "steel"`: the coefficients of one
+/// species against one wall material; None: the `[wall_contact]` default.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WallPair {
+    pub species: usize,
+    /// 0: the default material of `[wall_contact]`; k: `WallContactSettings::materials[k - 1]`.
+    pub material: usize,
+    pub restitution: Option<Real>,
+    pub friction: Option<Real>,
+    pub rolling_friction: Option<Real>,
+}
+
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WallSettings {
     pub name: String,
     pub point: Vec3,
     pub normal: Vec3,
+    /// 0: the default material of `[wall_contact]`; k: `WallContactSettings::materials[k - 1]`.
+    #[serde(default)]
+    pub material: usize,
+}
+
+/// The derived text of the fields as before, `material` only when not the default.
+impl std::fmt::Debug for WallSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("WallSettings");
+        s.field("name", &self.name)
+            .field("point", &self.point)
+            .field("normal", &self.normal);
+        optional_field(&mut s, "material", &self.material);
+        s.finish()
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -259,7 +412,7 @@ impl MeshSource {
 }
 
 /// A rigid body from a mesh, turned into an SDF grid, with prescribed motion.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BodySettings {
     pub name: String,
     pub mesh: MeshSource,
@@ -275,6 +428,28 @@ pub struct BodySettings {
     pub velocity: Vec3,
     /// The stage at whose start the motion begins; `None`: from the start of the run.
     pub start_stage: Option<String>,
+    /// The surface's material (an SDF body), as `WallSettings::material`.
+    #[serde(default)]
+    pub material: usize,
+}
+
+/// The derived text of the fields as before, `material` only when not the default.
+impl std::fmt::Debug for BodySettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("BodySettings");
+        s.field("name", &self.name)
+            .field("mesh", &self.mesh)
+            .field("cell_size", &self.cell_size)
+            .field("particles", &self.particles)
+            .field("padding", &self.padding)
+            .field("rpm", &self.rpm)
+            .field("axis", &self.axis)
+            .field("point", &self.point)
+            .field("velocity", &self.velocity)
+            .field("start_stage", &self.start_stage);
+        optional_field(&mut s, "material", &self.material);
+        s.finish()
+    }
 }
 
 /// Rule choosing the measurement region of a poured bed (lateral periodic, floor below, top
@@ -545,6 +720,21 @@ impl Scene {
         format!("{hash:016x}")
     }
 
+    /// Whether the scene gives materials or coefficients beyond `[contact]` and
+    /// `[wall_contact]`: a species' own material, `[[contact.pair]]`, `[[wall_material]]` or
+    /// `[[wall_contact.pair]]` (see [`ContactTables`]).
+    pub fn gives_material_tables(&self) -> bool {
+        let own = |s: &Species| s.youngs_modulus.is_some() || s.poisson_ratio.is_some();
+        let pairs = match &self.contact {
+            ContactSettings::Hertz(h) => !h.pairs.is_empty(),
+            ContactSettings::Wca(_) => false,
+        };
+        self.species.iter().any(own)
+            || pairs
+            || !self.wall_contact.materials.is_empty()
+            || !self.wall_contact.pairs.is_empty()
+    }
+
     pub fn max_diameter(&self) -> Real {
         self.species.iter().map(|s| s.diameter).fold(0.0, Real::max)
     }
@@ -566,5 +756,86 @@ mod tests {
             format!("{contact:?}"),
             "Wca { epsilon: 1.5, sigma: 0.002, gamma_n: 0.25, gamma_t: 0.125 }"
         );
+    }
+
+    /// The tables of materials appear in the debug text only when given, so a scene without
+    /// them keeps the digest it had before them (a finished run stays reusable).
+    #[test]
+    fn settings_without_materials_print_as_before_materials() {
+        let species = Species {
+            name: "bead".into(),
+            diameter: 0.01,
+            density: 2500.0,
+            frozen: false,
+            youngs_modulus: None,
+            poisson_ratio: None,
+        };
+        assert_eq!(
+            format!("{species:?}"),
+            "Species { name: \"bead\", diameter: 0.01, density: 2500.0, frozen: false }"
+        );
+        let wall = WallSettings {
+            name: "floor".into(),
+            point: Vec3::ZERO,
+            normal: Vec3::Z,
+            material: 0,
+        };
+        assert_eq!(
+            format!("{wall:?}"),
+            "WallSettings { name: \"floor\", point: DVec3(0.0, 0.0, 0.0), normal: DVec3(0.0, 0.0, 1.0) }"
+        );
+        let w = WallContactSettings {
+            restitution: 0.5,
+            friction: 0.25,
+            youngs_modulus: None,
+            poisson_ratio: Some(0.3),
+            rolling_friction: 0.0,
+            materials: Vec::new(),
+            pairs: Vec::new(),
+        };
+        assert_eq!(
+            format!("{w:?}"),
+            "WallContactSettings { restitution: 0.5, friction: 0.25, youngs_modulus: None, poisson_ratio: Some(0.3), rolling_friction: 0.0 }"
+        );
+        let h = HertzSettings {
+            youngs_modulus: 5e6,
+            poisson_ratio: 0.3,
+            restitution: 0.5,
+            friction: 0.5,
+            rolling_friction: 0.1,
+            damping: HertzDampingKind::Restitution,
+            tangential: TangentialKind::History,
+            rolling: RollingKind::Epsd2,
+            cohesion: CohesionKind::None,
+            characteristic_velocity: 1.0,
+            pairs: Vec::new(),
+        };
+        assert_eq!(
+            format!("{h:?}"),
+            "HertzSettings { youngs_modulus: 5000000.0, poisson_ratio: 0.3, restitution: 0.5, friction: 0.5, rolling_friction: 0.1, damping: Restitution, tangential: History, rolling: Epsd2, cohesion: None, characteristic_velocity: 1.0 }"
+        );
+        let body = BodySettings {
+            name: "screw".into(),
+            mesh: MeshSource::ScrewFeeder("screw".into()),
+            cell_size: 0.004,
+            particles: None,
+            padding: None,
+            rpm: 10.0,
+            axis: Vec3::X,
+            point: Vec3::ZERO,
+            velocity: Vec3::ZERO,
+            start_stage: None,
+            material: 0,
+        };
+        assert_eq!(
+            format!("{body:?}"),
+            "BodySettings { name: \"screw\", mesh: ScrewFeeder(\"screw\"), cell_size: 0.004, particles: None, padding: None, rpm: 10.0, axis: DVec3(1.0, 0.0, 0.0), point: DVec3(0.0, 0.0, 0.0), velocity: DVec3(0.0, 0.0, 0.0), start_stage: None }"
+        );
+        // Given, they are part of it.
+        let own = Species {
+            youngs_modulus: Some(1e7),
+            ..species
+        };
+        assert!(format!("{own:?}").ends_with("frozen: false, youngs_modulus: Some(10000000.0) }"));
     }
 }

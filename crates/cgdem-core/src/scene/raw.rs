@@ -15,6 +15,8 @@ pub struct RawScene {
     pub species: Vec<RawSpecies>,
     pub contact: RawContact,
     pub wall_contact: Option<RawWallContact>,
+    #[serde(default, rename = "wall_material")]
+    pub wall_materials: Vec<RawWallMaterial>,
     #[serde(default, rename = "wall")]
     pub walls: Vec<RawWall>,
     #[serde(default)]
@@ -67,6 +69,8 @@ pub struct RawBody {
     pub point: Option<[f64; 3]>,
     pub velocity: Option<[f64; 3]>,
     pub start_stage: Option<String>,
+    /// A `[[wall_material]]` name; default: `[wall_contact]`'s material.
+    pub material: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -112,6 +116,9 @@ pub struct RawSpecies {
     pub density: f64,
     #[serde(default)]
     pub frozen: bool,
+    /// Hertz: the species' own material; default: `[contact]`'s.
+    pub youngs_modulus: Option<f64>,
+    pub poisson_ratio: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -137,6 +144,20 @@ pub struct RawContact {
     pub h_min: Option<f64>,
     pub cohesion_cutoff: Option<f64>,
     pub characteristic_velocity: Option<f64>,
+    /// `[[contact.pair]]`: coefficients of one species pair.
+    #[serde(default, rename = "pair")]
+    pub pairs: Vec<RawContactPair>,
+}
+
+/// `[[contact.pair]] species = ["a", "b"]`: what differs from `[contact]` for one pair.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawContactPair {
+    pub species: Vec<String>,
+    pub restitution: Option<f64>,
+    pub friction: Option<f64>,
+    pub rolling_friction: Option<f64>,
+    pub hamaker_constant: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -148,6 +169,30 @@ pub struct RawWallContact {
     pub youngs_modulus: Option<f64>,
     pub poisson_ratio: Option<f64>,
     pub rolling_friction: Option<f64>,
+    /// `[[wall_contact.pair]]`: coefficients of one species against one wall material.
+    #[serde(default, rename = "pair")]
+    pub pairs: Vec<RawWallPair>,
+}
+
+/// `[[wall_contact.pair]] species = "a", material = "steel"`: what differs from
+/// `[wall_contact]` for one species against one wall material (default: `[wall_contact]`'s).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWallPair {
+    pub species: String,
+    pub material: Option<String>,
+    pub restitution: Option<f64>,
+    pub friction: Option<f64>,
+    pub rolling_friction: Option<f64>,
+}
+
+/// `[[wall_material]]`: a material walls and bodies name.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWallMaterial {
+    pub name: String,
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -156,6 +201,8 @@ pub struct RawWall {
     pub name: String,
     pub point: [f64; 3],
     pub normal: [f64; 3],
+    /// A `[[wall_material]]` name; default: `[wall_contact]`'s material.
+    pub material: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

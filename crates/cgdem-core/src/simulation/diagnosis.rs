@@ -130,6 +130,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     let force_at = |distance: Real| {
                         let contact = WallContact {
                             species: particle.species,
+                            material: wall.material,
                             normal: Vec3::Z,
                             distance,
                             relative_velocity: Vec3::ZERO,

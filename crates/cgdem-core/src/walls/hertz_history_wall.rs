@@ -20,27 +20,32 @@
 //! velocity taken against the body's surface velocity at the contact point. The stateless
 //! `force` (the normal force and kinetic Coulomb friction of `HertzWall`) serves the time
 //! step and particles that do not spin.
+//!
+//! The tangential slot is the pair law's: `Mindlin` (`tangential = "history"`, LIGGGHTS's) or
+//! `CoulombMindlin` (`"coulomb"`), whose bound on the rolling torque (`cap_load`) applies here
+//! too. All tables are by the particle's species and the wall's material
+//! (`WallContact::pair_index`).
 
 use super::{HertzWall, WallContact, WallLaw};
 use crate::contact::damping::liggghts_damping_factor;
 use crate::contact::normal_force;
-use crate::contact::tangential::Mindlin;
+use crate::contact::tangential::{Mindlin, MindlinSpring};
 use crate::contact::TangentialModel;
 use crate::math::{Real, Vec3};
 
 #[derive(Clone, Debug)]
-pub struct HertzHistoryWall {
+pub struct HertzHistoryWall<T = Mindlin> {
     /// The stateless law for bodies and the time step; its normal and damping slots give the
     /// normal force here too.
     pub stateless: HertzWall,
-    /// The pair's tangential slot, tables by the particle's species.
-    pub tangential: Mindlin,
+    /// The pair law's tangential slot.
+    pub tangential: T,
     /// epsd2's `mu_r`; 0 = no rolling spring.
-    pub rolling_friction: Real,
+    pub rolling_friction: Vec<Real>,
 }
 
-impl HertzHistoryWall {
-    /// Per species `(Y_eff, G_eff)` of the particle-wall pair.
+impl HertzHistoryWall<Mindlin> {
+    /// One wall material: per species `(Y_eff, G_eff)` of the particle-wall pair.
     pub fn new(
         moduli: &[(Real, Real)],
         restitution: Real,
@@ -56,12 +61,12 @@ impl HertzHistoryWall {
                 damping_factor: vec![liggghts_damping_factor(restitution); moduli.len()],
                 friction: vec![friction; moduli.len()],
             },
-            rolling_friction,
+            rolling_friction: vec![rolling_friction; moduli.len()],
         }
     }
 }
 
-impl WallLaw for HertzHistoryWall {
+impl<T: TangentialModel<History = Vec3> + MindlinSpring> WallLaw for HertzHistoryWall<T> {
     const NEEDS_ROTATION: bool = true;
     /// (shear displacement, stored rolling torque).
     type History = (Vec3, Vec3);
@@ -87,19 +92,21 @@ impl WallLaw for HertzHistoryWall {
         let normal_speed = c.relative_velocity.dot(n);
         let arm = c.radius - 0.5 * delta;
         let slip = c.relative_velocity - normal_speed * n + arm * n.cross(omega);
-        let contact = c.as_pair(c.relative_velocity, normal_speed, slip);
+        let pair = c.pair_index(self.stateless.materials);
+        let contact = c.as_pair(pair, c.relative_velocity, normal_speed, slip);
         let stateless = &self.stateless;
         let normal_force = normal_force(&stateless.normal, &stateless.damping, &contact);
         let tangential = self.tangential.force(&contact, normal_force, shear, dt);
         let mut torque = (-arm * n).cross(tangential);
 
-        if self.rolling_friction > 0.0 {
+        let rolling_friction = self.rolling_friction[pair];
+        if rolling_friction > 0.0 {
             let a = (c.radius * delta).sqrt();
-            let k_t = 8.0 * self.tangential.g_eff[c.species] * a;
+            let k_t = 8.0 * self.tangential.mindlin().g_eff[pair] * a;
             let w = omega * (arm / c.distance);
             let w_t = w - w.dot(n) * n;
             *rolling += k_t * c.radius * c.radius * dt * w_t;
-            let limit = self.rolling_friction * c.radius * normal_force.abs();
+            let limit = rolling_friction * c.radius * T::cap_load(normal_force);
             let size = rolling.length();
             if size > limit {
                 *rolling *= limit / size;
@@ -109,8 +116,14 @@ impl WallLaw for HertzHistoryWall {
         (normal_force * n + tangential, torque)
     }
 
-    fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real) {
-        self.stateless.linearized(species, radius, mass)
+    fn linearized(
+        &self,
+        species: usize,
+        material: usize,
+        radius: Real,
+        mass: Real,
+    ) -> (Real, Real) {
+        self.stateless.linearized(species, material, radius, mass)
     }
 }
 
@@ -121,6 +134,7 @@ mod tests {
     fn contact(delta: Real, v: Vec3) -> WallContact {
         WallContact {
             species: 0,
+            material: 0,
             normal: Vec3::Z,
             distance: 1e-3 - delta,
             relative_velocity: v,

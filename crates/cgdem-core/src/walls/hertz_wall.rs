@@ -26,20 +26,24 @@ use crate::contact::normal::Hertz;
 use crate::contact::{normal_force, DampingModel};
 use crate::math::{Real, Vec3};
 
-/// The normal and damping slots of the pair law (tables by the particle's species, the wall
-/// as a partner of infinite radius and mass), with the wall's friction laws beside them.
+/// The normal and damping slots of the pair law (tables by the particle's species and the
+/// wall's material, `WallContact::pair_index`; the wall a partner of infinite radius and
+/// mass), with the wall's friction laws beside them.
 #[derive(Clone, Debug)]
 pub struct HertzWall {
-    /// `Y_eff` of the particle-wall pair per species, and the impact speed at which the
-    /// contact is linearized for the time step.
+    /// Wall materials: the tables have one row per species and material.
+    pub materials: usize,
+    /// `Y_eff` of the particle-wall pair, and the impact speed at which the contact is
+    /// linearized for the time step.
     pub normal: Hertz,
-    /// `2 sqrt(5/6) |beta(e_w)|` per species.
+    /// `2 sqrt(5/6) |beta(e_w)|`.
     pub damping: HertzDamping,
-    pub friction: Real,
-    pub rolling_friction: Real,
+    pub friction: Vec<Real>,
+    pub rolling_friction: Vec<Real>,
 }
 
 impl HertzWall {
+    /// One wall material: `y_eff` per species, one restitution and friction for all.
     pub fn new(
         y_eff: &[Real],
         restitution: Real,
@@ -47,12 +51,33 @@ impl HertzWall {
         rolling_friction: Real,
         characteristic_velocity: Real,
     ) -> Self {
+        let n = y_eff.len();
+        HertzWall::from_tables(
+            1,
+            y_eff.to_vec(),
+            &vec![restitution; n],
+            vec![friction; n],
+            vec![rolling_friction; n],
+            characteristic_velocity,
+        )
+    }
+
+    /// `materials` wall materials; the tables by `species * materials + material`.
+    pub fn from_tables(
+        materials: usize,
+        y_eff: Vec<Real>,
+        restitution: &[Real],
+        friction: Vec<Real>,
+        rolling_friction: Vec<Real>,
+        characteristic_velocity: Real,
+    ) -> Self {
         HertzWall {
+            materials,
             normal: Hertz {
-                y_eff: y_eff.to_vec(),
+                y_eff,
                 characteristic_velocity,
             },
-            damping: HertzDamping::from_restitution(&vec![restitution; y_eff.len()]),
+            damping: HertzDamping::from_restitution(restitution),
             friction,
             rolling_friction,
         }
@@ -78,7 +103,8 @@ impl WallLaw for HertzWall {
         let v = c.relative_velocity + omega.cross(arm);
         let normal_speed = v.dot(n);
         let tangential_velocity = v - normal_speed * n;
-        let contact = c.as_pair(v, normal_speed, tangential_velocity);
+        let pair = c.pair_index(self.materials);
+        let contact = c.as_pair(pair, v, normal_speed, tangential_velocity);
         let normal_force = normal_force(&self.normal, &self.damping, &contact);
         let load = normal_force.max(0.0);
         let mut force = normal_force * n;
@@ -86,23 +112,32 @@ impl WallLaw for HertzWall {
         let slip = tangential_velocity.length();
         if slip > 0.0 {
             let no_reversal = (2.0 / 7.0) * c.mass * slip / (2.0 * dt);
-            let friction = -(self.friction * load).min(no_reversal) / slip * tangential_velocity;
+            let friction =
+                -(self.friction[pair] * load).min(no_reversal) / slip * tangential_velocity;
             force += friction;
             torque += arm.cross(friction);
         }
-        if self.rolling_friction > 0.0 {
+        let rolling_friction = self.rolling_friction[pair];
+        if rolling_friction > 0.0 {
             let w = omega - omega.dot(n) * n;
             let spin = w.length();
             if spin > 0.0 {
                 let no_reversal = spin * 0.4 * c.mass * c.radius * c.radius / (2.0 * dt);
-                torque -= (self.rolling_friction * c.radius * load).min(no_reversal) / spin * w;
+                torque -= (rolling_friction * c.radius * load).min(no_reversal) / spin * w;
             }
         }
         (force, torque)
     }
 
-    fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real) {
-        let k = self.normal.stiffness_at_impact(species, radius, mass);
-        (k, self.damping.linear_coefficient(species, k, mass))
+    fn linearized(
+        &self,
+        species: usize,
+        material: usize,
+        radius: Real,
+        mass: Real,
+    ) -> (Real, Real) {
+        let pair = species * self.materials + material;
+        let k = self.normal.stiffness_at_impact(pair, radius, mass);
+        (k, self.damping.linear_coefficient(pair, k, mass))
     }
 }

@@ -17,6 +17,8 @@ use crate::math::{Real, Vec3};
 #[derive(Clone, Copy, Debug)]
 pub struct WallContact {
     pub species: usize,
+    /// The wall's (or body's) material: 0 the default, k the scene's wall material k - 1.
+    pub material: usize,
     /// Unit vector from the wall to the particle centre.
     pub normal: Vec3,
     /// Centre-to-plane distance.
@@ -28,19 +30,28 @@ pub struct WallContact {
 }
 
 impl WallContact {
+    /// The row of a law's species-and-material tables, `species * n_materials + material`
+    /// (LIGGGHTS: the particle's atom type against the wall's).
+    #[inline(always)]
+    pub fn pair_index(&self, n_materials: usize) -> usize {
+        self.species * n_materials + self.material
+    }
+
     /// The contact as the pair slots see it: the wall is a partner of infinite radius and
-    /// mass (as in LIGGGHTS), so `R_eff = r`, `m_eff = m`, and the overlap is `r - h`.
+    /// mass (as in LIGGGHTS), so `R_eff = r`, `m_eff = m`, and the overlap is `r - h`;
+    /// `pair` is the row of the slots' tables (`pair_index`).
     /// `relative_velocity` is the particle's against the wall, as the law takes it (with or
     /// without the spin), split into `normal_speed` and `tangential_velocity` by the caller.
     #[inline(always)]
     pub fn as_pair(
         &self,
+        pair: usize,
         relative_velocity: Vec3,
         normal_speed: Real,
         tangential_velocity: Vec3,
     ) -> Contact {
         Contact {
-            species_pair: self.species,
+            species_pair: pair,
             normal: self.normal,
             distance: self.distance,
             overlap: self.radius - self.distance,
@@ -83,8 +94,10 @@ pub trait WallLaw: Send + Sync {
     ) -> (Vec3, Vec3) {
         self.force_and_torque(contact, omega, dt)
     }
-    /// (stiffness, damping coefficient) of the linearized contact, for the time step.
-    fn linearized(&self, species: usize, radius: Real, mass: Real) -> (Real, Real);
+    /// (stiffness, damping coefficient) of the linearized contact of `species` against a
+    /// wall of `material`, for the time step.
+    fn linearized(&self, species: usize, material: usize, radius: Real, mass: Real)
+        -> (Real, Real);
 }
 
 /// The state of one particle that walls act on.
@@ -115,6 +128,8 @@ pub struct Wall {
     pub name: String,
     pub plane: FinitePlane,
     pub active: bool,
+    /// 0: the default material; k: the scene's wall material k - 1.
+    pub material: usize,
 }
 
 /// The scene's walls. Removing a wall only deactivates it, so its index stays valid.
@@ -238,6 +253,7 @@ impl WallSet {
                 // Only the front side repels: a particle behind a wall has left through it.
                 (distance > 0.0).then_some(WallContact {
                     species: particle.species,
+                    material: wall.material,
                     normal: wall.plane.normal,
                     distance,
                     relative_velocity: particle.velocity,

@@ -35,6 +35,7 @@ pub struct WcaWallSpecies {
     pub friction: Real,
 }
 
+/// Per species (walls of the WCA model have no materials: `WallContact::material` is 0).
 #[derive(Clone, Debug)]
 pub struct WcaWall {
     pub species: Vec<WcaWallSpecies>,
@@ -81,7 +82,7 @@ impl WallLaw for WcaWall {
         force
     }
 
-    fn linearized(&self, species: usize, _: Real, _: Real) -> (Real, Real) {
+    fn linearized(&self, species: usize, _: usize, _: Real, _: Real) -> (Real, Real) {
         let s = &self.species[species];
         (4.0 * s.wca.contact_stiffness(), s.gamma)
     }

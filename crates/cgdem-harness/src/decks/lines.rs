@@ -108,7 +108,7 @@ pub(crate) fn block_region(name: &str, lo: Vec3, hi: Vec3) -> String {
 }
 
 /// A `read_data` file for `atom_style sphere` (LAMMPS) or `granular` (LIGGGHTS, same columns):
-/// `n_types` atom types (at least one per species; LIGGGHTS walls take one more), per
+/// `n_types` atom types (at least one per species; LIGGGHTS walls take one per material), per
 /// species the diameter and density given, the particles' positions, velocities and
 /// spins (zero without angular state). Ids are `id + 1`, types `species + 1`.
 pub fn data_file(

@@ -21,6 +21,21 @@ pub struct Mindlin {
     pub friction: Vec<Real>,
 }
 
+impl Mindlin {
+    /// The shear displacement after this step's slip, `u_t + v_t dt` projected onto the
+    /// tangent plane (LIGGGHTS's order), and the stiffness `k_t = 8 G_eff sqrt(R_eff delta)`.
+    #[inline(always)]
+    pub(super) fn loaded_spring(&self, contact: &Contact, history: Vec3, dt: Real) -> (Vec3, Real) {
+        let n = contact.normal;
+        let mut u = history + contact.tangential_velocity * dt;
+        u -= u.dot(n) * n;
+        let k_t = 8.0
+            * self.g_eff[contact.species_pair]
+            * (contact.r_eff * contact.overlap.max(0.0)).sqrt();
+        (u, k_t)
+    }
+}
+
 impl TangentialModel for Mindlin {
     type History = Vec3;
     const NEEDS_ROTATION: bool = true;
@@ -28,10 +43,7 @@ impl TangentialModel for Mindlin {
     #[inline(always)]
     fn force(&self, contact: &Contact, normal_force: Real, history: &mut Vec3, dt: Real) -> Vec3 {
         let sp = contact.species_pair;
-        let n = contact.normal;
-        let mut u = *history + contact.tangential_velocity * dt;
-        u -= u.dot(n) * n;
-        let k_t = 8.0 * self.g_eff[sp] * (contact.r_eff * contact.overlap.max(0.0)).sqrt();
+        let (u, k_t) = self.loaded_spring(contact, *history, dt);
         let spring = -k_t * u;
         let cap = self.friction[sp] * normal_force.abs();
         let spring_size = spring.length();

@@ -31,6 +31,13 @@ impl YangTangential {
     pub fn slip_factor(friction: Real, poisson_ratio: Real) -> Real {
         friction * (2.0 - poisson_ratio) / (2.0 * (1.0 - poisson_ratio))
     }
+
+    /// The slip factor of two materials (Mindlin): `mu Y*/(4 G*)`, which for one material
+    /// is `mu (2 - nu)/(2 (1 - nu))` (`slip_factor`), since then `Y* = E/(2 (1 - nu^2))` and
+    /// `G* = E/(4 (2 - nu)(1 + nu))`.
+    pub fn slip_factor_of_pair(friction: Real, y_eff: Real, g_eff: Real) -> Real {
+        friction * y_eff / (4.0 * g_eff)
+    }
 }
 
 impl TangentialModel for YangTangential {

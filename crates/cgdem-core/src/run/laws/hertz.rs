@@ -1,41 +1,37 @@
-//! Laws for `[contact] model = "hertz"`: each slot built from the scene's settings, and the
-//! short list of combinations that are compiled (each its own force loop).
+//! Laws for `[contact] model = "hertz"`: each slot built from the scene's material and pair
+//! tables (`scene::ContactTables`), and the short list of combinations that are compiled
+//! (each its own force loop).
 
 use super::LawVisitor;
 use crate::contact::cohesion::{vdw_reach, NoCohesion, VanDerWaals};
 use crate::contact::damping::{liggghts_damping_factor, HertzDamping, YangDamping};
-use crate::contact::normal::{Hertz, Material};
+use crate::contact::normal::Hertz;
 use crate::contact::rolling::{ConstantTorque, Epsd2, NoRolling};
-use crate::contact::tangential::{Mindlin, YangTangential};
+use crate::contact::tangential::{CoulombMindlin, Mindlin, MindlinSpring, YangTangential};
 use crate::contact::{CohesionModel, ContactLaw, DampingModel, RollingModel, TangentialModel};
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 use crate::run::RunError;
 use crate::scene::{
-    CohesionKind, HertzDampingKind, HertzSettings, RollingKind, Scene, TangentialKind,
+    CohesionKind, ContactTables, HertzDampingKind, HertzSettings, RollingKind, Scene,
+    TangentialKind,
 };
 use crate::walls::{HertzHistoryWall, HertzWall};
 
-/// A slot built from the scene (one material for all species, so every species-pair table
-/// holds the same value).
+/// A slot built from the scene: per species pair, from the scene's [`ContactTables`]
+/// (materials and pair coefficients resolved).
 pub trait FromScene: Sized {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self;
 }
 
-fn material(h: &HertzSettings) -> Material {
-    Material {
-        youngs_modulus: h.youngs_modulus,
-        poisson_ratio: h.poisson_ratio,
-    }
-}
-
-fn table(scene: &Scene, value: Real) -> Vec<Real> {
-    vec![value; scene.species.len().pow(2)]
+fn tables(scene: &Scene, h: &HertzSettings) -> ContactTables {
+    ContactTables::of_hertz(scene, h)
 }
 
 impl FromScene for Hertz {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        let t = tables(scene, h);
         Hertz {
-            y_eff: table(scene, Material::y_eff(material(h), material(h))),
+            y_eff: t.pair_table(|a, b| t.y_eff(a, b)),
             characteristic_velocity: h.characteristic_velocity,
         }
     }
@@ -43,7 +39,8 @@ impl FromScene for Hertz {
 
 impl FromScene for HertzDamping {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
-        HertzDamping::from_restitution(&table(scene, h.restitution))
+        let t = tables(scene, h);
+        HertzDamping::from_restitution(&t.pair_table(|a, b| t.pair(a, b).restitution))
     }
 }
 
@@ -53,29 +50,42 @@ impl FromScene for YangDamping {
             unreachable!("dispatch pairs YangDamping with damping = \"yang\"")
         };
         YangDamping {
-            gamma_n: table(scene, gamma_n),
+            gamma_n: vec![gamma_n; scene.species.len().pow(2)],
         }
     }
 }
 
 impl FromScene for Mindlin {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        let t = tables(scene, h);
         Mindlin {
-            g_eff: table(scene, Material::g_eff(material(h), material(h))),
-            damping_factor: table(scene, liggghts_damping_factor(h.restitution)),
-            friction: table(scene, h.friction),
+            g_eff: t.pair_table(|a, b| t.g_eff(a, b)),
+            damping_factor: t.pair_table(|a, b| liggghts_damping_factor(t.pair(a, b).restitution)),
+            friction: t.pair_table(|a, b| t.pair(a, b).friction),
         }
+    }
+}
+
+impl FromScene for CoulombMindlin {
+    fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        CoulombMindlin(Mindlin::from_scene(scene, h))
     }
 }
 
 impl FromScene for YangTangential {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        let t = tables(scene, h);
         YangTangential {
-            friction: table(scene, h.friction),
-            slip_factor: table(
-                scene,
-                YangTangential::slip_factor(h.friction, h.poisson_ratio),
-            ),
+            friction: t.pair_table(|a, b| t.pair(a, b).friction),
+            slip_factor: t.pair_table(|a, b| {
+                let (ma, mb) = (t.species[a], t.species[b]);
+                let friction = t.pair(a, b).friction;
+                if ma == mb {
+                    YangTangential::slip_factor(friction, ma.poisson_ratio)
+                } else {
+                    YangTangential::slip_factor_of_pair(friction, t.y_eff(a, b), t.g_eff(a, b))
+                }
+            }),
         }
     }
 }
@@ -88,17 +98,19 @@ impl FromScene for NoRolling {
 
 impl FromScene for ConstantTorque {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        let t = tables(scene, h);
         ConstantTorque {
-            rolling_friction: table(scene, h.rolling_friction),
+            rolling_friction: t.pair_table(|a, b| t.pair(a, b).rolling_friction),
         }
     }
 }
 
 impl FromScene for Epsd2 {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        let t = tables(scene, h);
         Epsd2 {
-            rolling_friction: table(scene, h.rolling_friction),
-            g_eff: table(scene, Material::g_eff(material(h), material(h))),
+            rolling_friction: t.pair_table(|a, b| t.pair(a, b).rolling_friction),
+            g_eff: t.pair_table(|a, b| t.g_eff(a, b)),
         }
     }
 }
@@ -111,12 +123,7 @@ impl FromScene for NoCohesion {
 
 impl FromScene for VanDerWaals {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
-        let CohesionKind::VanDerWaals {
-            hamaker_constant,
-            h_min,
-            cutoff,
-        } = h.cohesion
-        else {
+        let CohesionKind::VanDerWaals { h_min, cutoff, .. } = h.cohesion else {
             unreachable!("dispatch pairs VanDerWaals with cohesion = \"vdw\"")
         };
         // Default reach: where the force of the widest-reaching species pair falls to 1e-3
@@ -130,8 +137,9 @@ impl FromScene for VanDerWaals {
             }
             reach
         });
+        let t = tables(scene, h);
         VanDerWaals {
-            hamaker_constant: table(scene, hamaker_constant),
+            hamaker_constant: t.pair_table(|a, b| t.pair(a, b).hamaker_constant),
             h_min,
             reach,
         }
@@ -155,50 +163,66 @@ where
     )
 }
 
-/// The wall law of a Hertz scene: the wall's material (default: the particles'), the wall
-/// restitution and friction of `[wall_contact]`.
+/// The wall law of a Hertz scene for paper B's keywords: per species and wall material, the
+/// materials' `Y*` and the pair's restitution, friction and rolling friction
+/// ([`ContactTables`]).
 pub fn hertz_wall(scene: &Scene, h: &HertzSettings) -> HertzWall {
-    let w = &scene.wall_contact;
-    let wall = Material {
-        youngs_modulus: w.youngs_modulus.unwrap_or(h.youngs_modulus),
-        poisson_ratio: w.poisson_ratio.unwrap_or(h.poisson_ratio),
-    };
-    let y_eff = vec![Material::y_eff(material(h), wall); scene.species.len()];
-    HertzWall::new(
-        &y_eff,
-        w.restitution,
-        w.friction,
-        w.rolling_friction,
+    let t = tables(scene, h);
+    HertzWall::from_tables(
+        t.n_wall_materials(),
+        t.wall_table(|a, k| t.wall_y_eff(a, k)),
+        &t.wall_table(|a, k| t.wall_pair(a, k).restitution),
+        t.wall_table(|a, k| t.wall_pair(a, k).friction),
+        t.wall_table(|a, k| t.wall_pair(a, k).rolling_friction),
         h.characteristic_velocity,
     )
 }
 
 /// LIGGGHTS's wall for `tangential = "history"`: the pair law's springs with `R_eff = r`
 /// (`walls::HertzHistoryWall`); epsd2 rolling when the particles have it.
-pub fn hertz_history_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall {
-    let w = &scene.wall_contact;
-    let wall = Material {
-        youngs_modulus: w.youngs_modulus.unwrap_or(h.youngs_modulus),
-        poisson_ratio: w.poisson_ratio.unwrap_or(h.poisson_ratio),
-    };
-    let moduli = vec![
-        (
-            Material::y_eff(material(h), wall),
-            Material::g_eff(material(h), wall)
-        );
-        scene.species.len()
-    ];
+pub fn hertz_history_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall<Mindlin> {
+    history_wall(scene, h, |t| t)
+}
+
+/// The wall for `tangential = "coulomb"`: `hertz_history_wall`'s springs with the pair law's
+/// Coulomb bound on their sum.
+pub fn hertz_coulomb_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall<CoulombMindlin> {
+    history_wall(scene, h, CoulombMindlin)
+}
+
+/// The history wall with the tangential slot `slot` makes of the wall pairs' `Mindlin`.
+fn history_wall<T: TangentialModel<History = Vec3> + MindlinSpring>(
+    scene: &Scene,
+    h: &HertzSettings,
+    slot: impl FnOnce(Mindlin) -> T,
+) -> HertzHistoryWall<T> {
+    let t = tables(scene, h);
     let rolling_friction = match h.rolling {
-        RollingKind::Epsd2 => w.rolling_friction,
-        _ => 0.0,
+        RollingKind::Epsd2 => t.wall_table(|a, k| t.wall_pair(a, k).rolling_friction),
+        _ => vec![0.0; t.wall_pairs.len()],
     };
-    HertzHistoryWall::new(
-        &moduli,
-        w.restitution,
-        w.friction,
-        rolling_friction,
+    let restitution = t.wall_table(|a, k| t.wall_pair(a, k).restitution);
+    let tangential = Mindlin {
+        g_eff: t.wall_table(|a, k| t.wall_g_eff(a, k)),
+        damping_factor: restitution
+            .iter()
+            .map(|&e| liggghts_damping_factor(e))
+            .collect(),
+        friction: t.wall_table(|a, k| t.wall_pair(a, k).friction),
+    };
+    let stateless = HertzWall::from_tables(
+        t.n_wall_materials(),
+        t.wall_table(|a, k| t.wall_y_eff(a, k)),
+        &restitution,
+        tangential.friction.clone(),
+        vec![0.0; t.wall_pairs.len()],
         h.characteristic_velocity,
-    )
+    );
+    HertzHistoryWall {
+        stateless,
+        tangential: slot(tangential),
+        rolling_friction,
+    }
 }
 
 /// The compiled combinations: each line is the keywords a scene gives (damping, tangential,
@@ -247,6 +271,12 @@ compiled_hertz_laws! {
         => <HertzDamping, Mindlin, Epsd2, NoCohesion>, hertz_history_wall, "hertz/history/epsd2/none";
     (Restitution, K::History, RollingKind::Epsd2, Vdw { .. })
         => <HertzDamping, Mindlin, Epsd2, VanDerWaals>, hertz_history_wall, "hertz/history/epsd2/vdw";
+    (Restitution, K::Coulomb, RollingKind::None, NoVdw)
+        => <HertzDamping, CoulombMindlin, NoRolling, NoCohesion>, hertz_coulomb_wall, "hertz/coulomb/none/none";
+    (Restitution, K::Coulomb, RollingKind::Epsd2, NoVdw)
+        => <HertzDamping, CoulombMindlin, Epsd2, NoCohesion>, hertz_coulomb_wall, "hertz/coulomb/epsd2/none";
+    (Restitution, K::Coulomb, RollingKind::Epsd2, Vdw { .. })
+        => <HertzDamping, CoulombMindlin, Epsd2, VanDerWaals>, hertz_coulomb_wall, "hertz/coulomb/epsd2/vdw";
     (Yang { .. }, K::Yang, RollingKind::None, NoVdw)
         => <YangDamping, YangTangential, NoRolling, NoCohesion>, hertz_wall, "yang/yang/none/none";
     (Yang { .. }, K::Yang, RollingKind::ConstantTorque, Vdw { .. })

@@ -9,6 +9,8 @@ pub(super) fn bodies(
     c: &Checker,
     raw: &RawScene,
     species: &[Species],
+    materials: &[WallMaterial],
+    hertz: bool,
 ) -> Result<Vec<BodySettings>, SceneError> {
     let mut bodies = Vec::new();
     for (k, b) in raw.bodies.iter().enumerate() {
@@ -60,7 +62,21 @@ pub(super) fn bodies(
                 ))
             }
         };
+        let material_field = format!("body[{k}].material");
+        if b.material.is_some() && !hertz {
+            return Err(c.invalid(material_field, "set", "only with contact.model = \"hertz\""));
+        }
+        if b.material.is_some() && particles.is_some() {
+            return Err(c.invalid(
+                material_field,
+                "set",
+                "no material for a body built of particles: they carry their species' (species youngs_modulus, poisson_ratio)",
+            ));
+        }
+        let material =
+            super::materials::material_index(c, &material_field, b.material.as_deref(), materials)?;
         bodies.push(BodySettings {
+            material,
             name: b.name.clone(),
             mesh: mesh_source(&b.mesh, c.file),
             cell_size,

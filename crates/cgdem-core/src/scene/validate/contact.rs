@@ -3,7 +3,7 @@
 
 use super::super::raw::*;
 use super::super::*;
-use super::Checker;
+use super::{materials, Checker};
 use crate::math::TWO_POW_ONE_SIXTH;
 
 /// `[contact]`: `model = "wca"` or `"hertz"`.
@@ -13,7 +13,7 @@ pub(super) fn contact(
     species: &[Species],
 ) -> Result<ContactSettings, SceneError> {
     match rc.model.as_str() {
-        "hertz" => Ok(ContactSettings::Hertz(hertz_contact(c, rc)?)),
+        "hertz" => Ok(ContactSettings::Hertz(hertz_contact(c, rc, species)?)),
         "wca" => wca_contact(c, rc, species),
         other => Err(c.invalid(
             "contact.model",
@@ -47,6 +47,7 @@ fn wca_contact(
             "characteristic_velocity",
             rc.characteristic_velocity.is_some(),
         ),
+        ("pair", !rc.pairs.is_empty()),
     ] {
         if set {
             return Err(c.invalid(
@@ -101,8 +102,13 @@ pub(super) fn poisson(c: &Checker, field: &str, nu: f64) -> Result<f64, SceneErr
     }
 }
 
-/// `[contact] model = "hertz"`: keywords as in LIGGGHTS/LAMMPS.
-fn hertz_contact(c: &Checker, rc: &RawContact) -> Result<HertzSettings, SceneError> {
+/// `[contact] model = "hertz"`: keywords as in LIGGGHTS/LAMMPS; `[[contact.pair]]` for the
+/// species pairs whose coefficients are not these.
+fn hertz_contact(
+    c: &Checker,
+    rc: &RawContact,
+    species: &[Species],
+) -> Result<HertzSettings, SceneError> {
     for (field, set) in [
         ("epsilon", rc.epsilon.is_some()),
         ("sigma", rc.sigma.is_some()),
@@ -148,9 +154,9 @@ fn hertz_contact(c: &Checker, rc: &RawContact) -> Result<HertzSettings, SceneErr
     )?;
     let (damping, restitution) = hertz_damping(c, rc)?;
     let tangential = tangential(c, rc)?;
-    let rolling = rolling(c, rc, rolling_friction)?;
+    let rolling = rolling(c, rc)?;
     let cohesion = cohesion(c, rc)?;
-    Ok(HertzSettings {
+    let mut h = HertzSettings {
         youngs_modulus,
         poisson_ratio,
         restitution,
@@ -164,7 +170,11 @@ fn hertz_contact(c: &Checker, rc: &RawContact) -> Result<HertzSettings, SceneErr
             "contact.characteristic_velocity",
             rc.characteristic_velocity.unwrap_or(1.0),
         )?,
-    })
+        pairs: Vec::new(),
+    };
+    h.pairs = materials::contact_pairs(c, &rc.pairs, species, &h)?;
+    materials::check_rolling_friction(c, rc.rolling_friction, &h, species)?;
+    Ok(h)
 }
 
 /// `damping = "hertz" | "yang"` and the restitution that goes (only) with the first.
@@ -221,25 +231,22 @@ fn hertz_damping(c: &Checker, rc: &RawContact) -> Result<(HertzDampingKind, Real
     Ok((damping, restitution))
 }
 
-/// `tangential = "history" | "yang"`.
+/// `tangential = "history" | "coulomb" | "yang"`.
 fn tangential(c: &Checker, rc: &RawContact) -> Result<TangentialKind, SceneError> {
     match rc.tangential.as_deref().unwrap_or("history") {
         "history" => Ok(TangentialKind::History),
+        "coulomb" => Ok(TangentialKind::Coulomb),
         "yang" => Ok(TangentialKind::Yang),
         other => Err(c.invalid(
             "contact.tangential",
             format!("\"{other}\""),
-            "\"history\" (LIGGGHTS tangential history, default) or \"yang\" (paper B Eq. 5)",
+            "\"history\" (LIGGGHTS tangential history, default), \"coulomb\" (the same spring and dashpot, their sum capped at mu max(F_n, 0)) or \"yang\" (paper B Eq. 5)",
         )),
     }
 }
 
-/// `rolling = "none" | "constant_torque" | "epsd2"`; a rolling model needs a friction > 0.
-fn rolling(
-    c: &Checker,
-    rc: &RawContact,
-    rolling_friction: Real,
-) -> Result<RollingKind, SceneError> {
+/// `rolling = "none" | "constant_torque" | "epsd2"` (its friction is checked with the pairs).
+fn rolling(c: &Checker, rc: &RawContact) -> Result<RollingKind, SceneError> {
     let rolling = match rc.rolling.as_deref().unwrap_or("none") {
         "none" => RollingKind::None,
         "constant_torque" => RollingKind::ConstantTorque,
@@ -250,13 +257,6 @@ fn rolling(
             "\"none\", \"constant_torque\" (paper B Eq. 10) or \"epsd2\" (LIGGGHTS rolling spring)",
         )),
     };
-    if rolling != RollingKind::None && rolling_friction == 0.0 {
-        return Err(c.invalid(
-            "contact.rolling_friction",
-            rolling_friction,
-            "> 0 when rolling is not \"none\"",
-        ));
-    }
     Ok(rolling)
 }
 
@@ -320,8 +320,25 @@ fn cohesion(c: &Checker, rc: &RawContact) -> Result<CohesionKind, SceneError> {
     }
 }
 
-/// `[wall_contact]`: required when the scene has walls; inert defaults otherwise.
+/// `[wall_contact]`: required when the scene has walls; inert defaults otherwise. With the
+/// `[[wall_material]]` tables and its `[[wall_contact.pair]]` (Hertz scenes).
 pub(super) fn wall_contact(
+    c: &Checker,
+    raw: &RawScene,
+    species: &[Species],
+    hertz: bool,
+) -> Result<WallContactSettings, SceneError> {
+    let materials = materials::wall_materials(c, &raw.wall_materials, hertz)?;
+    let mut settings = wall_contact_defaults(c, raw.wall_contact.as_ref(), !raw.walls.is_empty())?;
+    if let Some(w) = &raw.wall_contact {
+        settings.pairs = materials::wall_pairs(c, &w.pairs, species, &materials, hertz)?;
+    }
+    settings.materials = materials;
+    Ok(settings)
+}
+
+/// `[wall_contact]`'s own values.
+fn wall_contact_defaults(
     c: &Checker,
     raw: Option<&RawWallContact>,
     has_walls: bool,
@@ -348,6 +365,8 @@ pub(super) fn wall_contact(
                     "wall_contact.rolling_friction",
                     w.rolling_friction.unwrap_or(0.0),
                 )?,
+                materials: Vec::new(),
+                pairs: Vec::new(),
             })
         }
         None if !has_walls => Ok(WallContactSettings {
@@ -356,6 +375,8 @@ pub(super) fn wall_contact(
             youngs_modulus: None,
             poisson_ratio: None,
             rolling_friction: 0.0,
+            materials: Vec::new(),
+            pairs: Vec::new(),
         }),
         None => Err(c.invalid(
             "wall_contact",
@@ -365,8 +386,14 @@ pub(super) fn wall_contact(
     }
 }
 
-/// `[[wall]]`: planes by a point and a non-zero normal, names unique.
-pub(super) fn walls(c: &Checker, raw: &[RawWall]) -> Result<Vec<WallSettings>, SceneError> {
+/// `[[wall]]`: planes by a point and a non-zero normal, names unique, each of a known wall
+/// material (`materials`; Hertz scenes only).
+pub(super) fn walls(
+    c: &Checker,
+    raw: &[RawWall],
+    materials: &[WallMaterial],
+    hertz: bool,
+) -> Result<Vec<WallSettings>, SceneError> {
     let mut walls = Vec::new();
     for (k, w) in raw.iter().enumerate() {
         let point = c.vector(&format!("wall[{k}].point"), w.point)?;
@@ -385,10 +412,23 @@ pub(super) fn walls(c: &Checker, raw: &[RawWall]) -> Result<Vec<WallSettings>, S
                 "a name not used by another wall",
             ));
         }
+        if w.material.is_some() && !hertz {
+            return Err(c.invalid(
+                format!("wall[{k}].material"),
+                "set",
+                "only with contact.model = \"hertz\"",
+            ));
+        }
         walls.push(WallSettings {
             name: w.name.clone(),
             point,
             normal: normal.normalize(),
+            material: materials::material_index(
+                c,
+                &format!("wall[{k}].material"),
+                w.material.as_deref(),
+                materials,
+            )?,
         });
     }
     Ok(walls)

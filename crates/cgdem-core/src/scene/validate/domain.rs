@@ -2,7 +2,7 @@
 
 use super::super::raw::*;
 use super::super::*;
-use super::Checker;
+use super::{materials, Checker};
 
 /// `[domain]`: the box and what happens to a particle that leaves it (`stop_on_lost`).
 pub(super) fn domain(c: &Checker, raw: &RawDomain) -> Result<(Domain, bool), SceneError> {
@@ -36,11 +36,13 @@ pub(super) fn domain(c: &Checker, raw: &RawDomain) -> Result<(Domain, bool), Sce
     Ok((domain, stop_on_lost))
 }
 
-/// `[[species]]`: at least one, each smaller than the box, names unique.
+/// `[[species]]`: at least one, each smaller than the box, names unique; a material of its
+/// own only in a Hertz scene (`hertz`).
 pub(super) fn species(
     c: &Checker,
     raw: &[RawSpecies],
     domain: &Domain,
+    hertz: bool,
 ) -> Result<Vec<Species>, SceneError> {
     let shortest_side = (0..3)
         .map(|a| domain.hi[a] - domain.lo[a])
@@ -66,11 +68,14 @@ pub(super) fn species(
                 "a name not used by another species",
             ));
         }
+        let (youngs_modulus, poisson_ratio) = materials::species_material(c, k, s, hertz)?;
         species.push(Species {
             name: s.name.clone(),
             diameter,
             density,
             frozen: s.frozen,
+            youngs_modulus,
+            poisson_ratio,
         });
     }
     Ok(species)

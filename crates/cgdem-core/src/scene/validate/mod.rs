@@ -5,6 +5,7 @@ mod bodies;
 mod contact;
 mod domain;
 mod insertion;
+mod materials;
 mod packing;
 mod particles;
 mod stages;
@@ -85,10 +86,11 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         return Err(c.invalid("name", "\"\"", "a non-empty case name"));
     }
     let (domain, stop_on_lost) = domain::domain(&c, &raw.domain)?;
-    let species = domain::species(&c, &raw.species, &domain)?;
+    let hertz = raw.contact.model == "hertz";
+    let species = domain::species(&c, &raw.species, &domain, hertz)?;
     let contact = contact::contact(&c, &raw.contact, &species)?;
-    let wall_contact = contact::wall_contact(&c, raw.wall_contact.as_ref(), !raw.walls.is_empty())?;
-    let walls = contact::walls(&c, &raw.walls)?;
+    let wall_contact = contact::wall_contact(&c, &raw, &species, hertz)?;
+    let walls = contact::walls(&c, &raw.walls, &wall_contact.materials, hertz)?;
     let gravity = c.vector("gravity", raw.gravity.unwrap_or([0.0, 0.0, -9.81]))?;
     let (time_step, integrator) = domain::time(&c, &raw.time)?;
     let (skin_fraction, resort_every) =
@@ -102,7 +104,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         .as_ref()
         .map(|r| stages::repose(&c, r, &stages))
         .transpose()?;
-    let bodies = bodies::bodies(&c, &raw, &species)?;
+    let bodies = bodies::bodies(&c, &raw, &species, &wall_contact.materials, hertz)?;
     let deletions = bodies::deletions(&c, &raw.deletions)?;
     let conveying = raw
         .conveying

@@ -12,6 +12,10 @@
 //! to give the particle-wall `Y_eff`, `G_eff` (see the wall lines below: the wall fix of this
 //! LAMMPS does not use `1 - nu^2`).
 //!
+//! A scene with material tables (`scene::ContactTables`) gets one `pair_coeff I J` per species
+//! pair ([`table_pair_lines`]) and, `fix wall/gran` having one model, one wall fix per wall
+//! and mobile species; scenes with one material keep the one `pair_coeff * *`.
+//!
 //! Stages, wall removal (`unfix w_NAME`) and repose samples are written by `decks::stages`,
 //! as for the seed's deck and LIGGGHTS's, so the run goes through the same post-processing.
 
@@ -29,7 +33,7 @@ use cgdem_core::contact::damping::restitution_beta;
 use cgdem_core::contact::normal::{Hertz, Material};
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
+use cgdem_core::scene::{ContactTables, HertzSettings, PairProperties, RollingKind, Scene};
 
 /// LAMMPS's Tsuji polynomial `P(q)`: `damping tsuji q` gives `gamma_n = P(q) sqrt(m_eff k_n)`.
 pub fn tsuji_polynomial(q: Real) -> Real {
@@ -75,6 +79,17 @@ pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: 
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
+    // A scene with material tables: one `pair_coeff I J` per species pair and one wall fix
+    // per wall and mobile species (`table_pair_lines`, `table_wall_fix_lines`); without, the
+    // one material of `[contact]`.
+    let tables = if scene.gives_material_tables() {
+        if !scene.bodies.is_empty() {
+            return Err(unsupported("LAMMPS decks with bodies take the one material and coefficients of [contact] and [wall_contact]: this scene has materials per species or pair (LIGGGHTS decks take them)".into()));
+        }
+        Some(ContactTables::of_hertz(scene, h))
+    } else {
+        None
+    };
     let m = material(h);
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
 
@@ -92,13 +107,30 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     let mut d = written_by(&DIALECT, scene);
     d += "): Hertz, reference/MAPPING.md.\n";
     d += &preamble(&DIALECT, scene);
-    d += &pair_lines(scene, h, m)?;
+    d += &match &tables {
+        Some(t) => table_pair_lines(scene, h, t)?,
+        None => pair_lines(scene, h, m)?,
+    };
     d += &neighbor_lines(&DIALECT, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
     d += &integration_lines(scene, integrated, dt);
     let wall_model = wall_model(scene, h, m)?;
-    d += &wall_fix_lines(scene, &wall_model)?;
+    let wall_groups = match &tables {
+        Some(t) => {
+            let groups = wall_groups(scene);
+            d += &table_wall_fix_lines(scene, h, t, &groups)?;
+            groups
+        }
+        None => {
+            d += &wall_fix_lines(scene, &wall_model)?;
+            vec![WallGroup {
+                species: None,
+                suffix: String::new(),
+                group: "all".into(),
+            }]
+        }
+    };
     let bodies = body_lines(scene, integrated, &wall_model)?;
     d += &bodies.setup;
     // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
@@ -114,7 +146,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
             d += motion;
         }
     }
-    d += &removal_pads(scene, 1);
+    d += &removal_pads(scene, wall_groups.len());
     d += &deletion_lines(scene, integrated, dump_every);
     let top_ups = top_up_lines(scene, integrated, dt, &mut files);
     d += &top_ups.setup;
@@ -147,7 +179,10 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         dump_every,
         &dumps,
         &StageHooks {
-            unfix: &unfix_wall,
+            unfix: &|name: &str| {
+                let fixes = wall_groups.iter().map(|w| format!("{name}{}", w.suffix));
+                fixes.map(|f| unfix_wall(&f)).collect::<String>()
+            },
             begin: &begin,
             periodic: &periodic,
         },
@@ -219,6 +254,152 @@ fn pair_lines(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, D
         rolling
     );
     Ok(d)
+}
+
+/// `pair_style granular` with one `pair_coeff I J` per species pair of the scene's tables.
+/// `hertz/material E q nu` takes `E` and `nu` as one material for both sides
+/// (`Y* = E/(2 (1 - nu^2))`), so each pair is given the one material with its own `Y*` and
+/// `G*` ([`one_material`]); `q`, `mu` and `mu_r` are the pair's own, `k_roll` is that of
+/// its `R*` and `m*` (reference/MAPPING.md). Every pair is written: LAMMPS's mixing of an
+/// unset pair is not LIGGGHTS's.
+pub fn table_pair_lines(
+    scene: &Scene,
+    h: &HertzSettings,
+    t: &ContactTables,
+) -> Result<String, DeckError> {
+    let mut d = String::from("pair_style      granular\n");
+    d += "# per species pair: E, nu of one material with the pair's Y*, G*; q = P^-1(sqrt(5)|beta(e)|); x = sqrt(4 G*/Y*)\n";
+    let n = t.n_species();
+    for a in 0..n {
+        for b in a..n {
+            let (y, g_eff) = (t.y_eff(a, b), t.g_eff(a, b));
+            let (sa, sb) = (&scene.species[a], &scene.species[b]);
+            let r_eff = sa.radius() * sb.radius() / (sa.radius() + sb.radius());
+            let m_eff = sa.mass() * sb.mass() / (sa.mass() + sb.mass());
+            let (e, nu) = one_material(y, g_eff);
+            let p = t.pair(a, b);
+            let _ = writeln!(
+                d,
+                "pair_coeff      {} {} hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {}{}",
+                a + 1,
+                b + 1,
+                g(e),
+                g(tsuji_q_of(scene, p.restitution)?),
+                g(nu),
+                g(tangential_damping_ratio(y, g_eff)),
+                g(p.friction),
+                rolling_args(h, p, y, g_eff, r_eff, m_eff)
+            );
+        }
+    }
+    Ok(d)
+}
+
+/// The one material `(E, nu)` with `Y* = y_eff` and `G* = g_eff` against itself:
+/// `G*/Y* = r = (1 - nu)/(2 (2 - nu))` for one material, so `nu = (1 - 4r)/(1 - 2r)` and
+/// `E = 2 (1 - nu^2) Y*`.
+pub fn one_material(y_eff: Real, g_eff: Real) -> (Real, Real) {
+    let r = g_eff / y_eff;
+    let nu = (1.0 - 4.0 * r) / (1.0 - 2.0 * r);
+    (2.0 * (1.0 - nu * nu) * y_eff, nu)
+}
+
+/// ` rolling sds k_roll 0 mu_r` of pair coefficients `p` for epsd2, else nothing.
+fn rolling_args(
+    h: &HertzSettings,
+    p: &PairProperties,
+    y_eff: Real,
+    g_eff: Real,
+    r_eff: Real,
+    m_eff: Real,
+) -> String {
+    if h.rolling != RollingKind::Epsd2 {
+        return String::new();
+    }
+    let k_roll = rolling_stiffness(y_eff, g_eff, r_eff, m_eff, h.characteristic_velocity);
+    format!(" rolling sds {} 0.0 {}", g(k_roll), g(p.rolling_friction))
+}
+
+/// The particles one wall fix acts on: `fix wall/gran` has one model, so with material
+/// tables and several mobile species each species gets its own fix of each wall
+/// (`w_NAME_T` on group `grains_T`, T its atom type); one mobile species takes `w_NAME`.
+struct WallGroup {
+    /// The species whose wall coefficients the fix takes (None: the uniform deck's).
+    species: Option<usize>,
+    /// Appended to the fix's name `w_NAME`.
+    suffix: String,
+    group: String,
+}
+
+fn wall_groups(scene: &Scene) -> Vec<WallGroup> {
+    let mobile: Vec<usize> = (0..scene.species.len())
+        .filter(|&a| !scene.species[a].frozen)
+        .collect();
+    match mobile[..] {
+        [a] => vec![WallGroup {
+            species: Some(a),
+            suffix: String::new(),
+            group: "all".into(),
+        }],
+        _ => mobile
+            .iter()
+            .map(|&a| WallGroup {
+                species: Some(a),
+                suffix: format!("_{}", a + 1),
+                group: format!("grains_{}", a + 1),
+            })
+            .collect(),
+    }
+}
+
+/// The wall fixes of a scene with material tables: for each planar wall and each of
+/// `groups`, the model of that species against the wall's material. The wall fix of this
+/// LAMMPS takes `k_n = (4/3) E/(2 (1 - nu)) sqrt(R delta)`, so `E = 2 (1 - nu) Y*` with the
+/// species' `nu`, and the Mindlin stiffness `8 G*` explicitly (as `wall_model`); the wall is
+/// a particle of infinite radius and mass, so `R* = r`, `m* = m`.
+fn table_wall_fix_lines(
+    scene: &Scene,
+    h: &HertzSettings,
+    t: &ContactTables,
+    groups: &[WallGroup],
+) -> Result<String, DeckError> {
+    let mut lines = String::new();
+    for w in groups.iter().filter(|w| w.group != "all") {
+        let a = w.species.expect("a table wall group names its species");
+        let _ = writeln!(lines, "group           {} type {}", w.group, a + 1);
+    }
+    for wall in &scene.walls {
+        let (axis, up) = wall_axis(scene, wall)?;
+        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
+        let (lo, hi) = if up {
+            (at, "NULL".to_string())
+        } else {
+            ("NULL".to_string(), at)
+        };
+        for w in groups {
+            let a = w.species.expect("a table wall group names its species");
+            let k = wall.material;
+            let (s, nu) = (&scene.species[a], t.species[a].poisson_ratio);
+            let (y, g_eff) = (t.wall_y_eff(a, k), t.wall_g_eff(a, k));
+            let p = t.wall_pair(a, k);
+            let _ = writeln!(
+                lines,
+                "fix             w_{}{} {} wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {}plane {lo} {hi}",
+                wall.name,
+                w.suffix,
+                w.group,
+                g(2.0 * (1.0 - nu) * y),
+                g(tsuji_q_of(scene, p.restitution)?),
+                g(nu),
+                g(8.0 * g_eff),
+                g(tangential_damping_ratio(y, g_eff)),
+                g(p.friction),
+                rolling_args(h, p, y, g_eff, s.radius(), s.mass()),
+                ["x", "y", "z"][axis]
+            );
+        }
+    }
+    Ok(lines)
 }
 
 /// Time integration of the `integrated` group, gravity and the time step.
@@ -568,6 +749,83 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("planar walls with a top-up"), "{e}");
+    }
+
+    /// tests/data/tiny_two_material_collapse.toml: bead (type 1) and grit (2); every species
+    /// pair its own `pair_coeff` whose one material gives the pair's `Y*` and `G*`; each wall
+    /// one fix per species (grains_1, grains_2) with that species' coefficients against the
+    /// wall's material (steel floor, default material elsewhere), removed together.
+    #[test]
+    fn material_tables_give_a_pair_coeff_per_species_pair_and_a_wall_fix_per_species() {
+        crate::at_repo_root();
+        let scene = Scene::load(std::path::Path::new(
+            "tests/data/tiny_two_material_collapse.toml",
+        ))
+        .unwrap();
+        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let deck = write_hertz_deck(&scene, &particles, 1e-5).unwrap();
+        let d = &deck.input;
+        let t = ContactTables::of(&scene).unwrap();
+        assert!(!d.contains("pair_coeff      * *"));
+        for (a, b, e, mu) in [(0, 0, 0.5, 0.5), (0, 1, 0.4, 0.6), (1, 1, 0.3, 0.7)] {
+            let (y, g_eff) = (t.y_eff(a, b), t.g_eff(a, b));
+            let (young, nu) = one_material(y, g_eff);
+            // The one material reproduces the pair's mixed Y* and G*.
+            let m = Material {
+                youngs_modulus: young,
+                poisson_ratio: nu,
+            };
+            assert!((Material::y_eff(m, m) / y - 1.0).abs() < 1e-12);
+            assert!((Material::g_eff(m, m) / g_eff - 1.0).abs() < 1e-12);
+            at(
+                d,
+                &format!(
+                    "pair_coeff      {} {} hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {} rolling sds ",
+                    a + 1,
+                    b + 1,
+                    g(young),
+                    g(tsuji_q(e).unwrap()),
+                    g(nu),
+                    g(tangential_damping_ratio(y, g_eff)),
+                    g(mu)
+                ),
+            );
+        }
+        // Unlike materials: the pair's own nu is neither species' (0.3, 0.25).
+        let (_, nu_12) = one_material(t.y_eff(0, 1), t.g_eff(0, 1));
+        assert!(
+            (nu_12 - 0.3).abs() > 1e-3 && (nu_12 - 0.25).abs() > 1e-3,
+            "{nu_12}"
+        );
+        at(d, "group           grains_1 type 1\n");
+        at(d, "group           grains_2 type 2\n");
+        // The grit on the steel floor: e = 0.6, mu = 0.3, E = 2 (1 - nu) Y* with grit's nu.
+        let (y, g_eff) = (t.wall_y_eff(1, 1), t.wall_g_eff(1, 1));
+        at(
+            d,
+            &format!(
+                "fix             w_floor_2 grains_2 wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {} rolling sds ",
+                g(2.0 * (1.0 - 0.25) * y),
+                g(tsuji_q(0.6).unwrap()),
+                g(0.25),
+                g(8.0 * g_eff),
+                g(tangential_damping_ratio(y, g_eff)),
+                g(0.3)
+            ),
+        );
+        at(d, "fix             w_floor_1 grains_1 wall/gran granular");
+        for wall in ["back", "gate", "end"] {
+            for k in [1, 2] {
+                at(
+                    d,
+                    &format!("fix             w_{wall}_{k} grains_{k} wall/gran granular"),
+                );
+            }
+        }
+        // The gate goes with both its fixes, and two pads follow the wall fixes.
+        at(d, "unfix           w_gate_1\nunfix           w_gate_2\n");
+        at(d, "fix             pad_1 all addforce 0.0 0.0 0.0");
+        assert!(!d.contains("pad_2"));
     }
 
     #[test]

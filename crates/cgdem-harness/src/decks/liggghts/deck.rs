@@ -1,8 +1,11 @@
 //! The LIGGGHTS input for a Hertz scene, written from the scene alone: `pair_style gran model
 //! hertz tangential history [rolling_friction epsd2]`, the keywords cgdem's Hertz slots are
 //! named after, so no mapping is needed; walls are `fix wall/gran` primitives (axis-aligned
-//! planes) of their own atom type (`n_species + 1`), whose material and pair coefficients
-//! with every species come from `[wall_contact]`.
+//! planes) and meshes; each wall material in use is an atom type after the species'
+//! (`n_species + 1`, ...). The `peratomtype` and `peratomtypepair` tables are written from
+//! the scene's resolved tables (`scene::ContactTables`: a species' own material,
+//! `[[contact.pair]]`, `[[wall_material]]`, `[[wall_contact.pair]]`, defaults `[contact]` and
+//! `[wall_contact]`), which LIGGGHTS mixes as cgdem does (`Y*`, `G*`).
 //!
 //! LIGGGHTS needs `newton off`, `communicate single vel yes`, Young's modulus >= 5e6 Pa in SI
 //! units (it refuses softer materials), and an explicit dump format (default: 6 digits).
@@ -14,15 +17,16 @@
 use std::fmt::Write as _;
 
 use super::DIALECT;
-use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use crate::decks::hertz::{hertz_settings, wall_axis, HERTZ_COLUMNS};
 use crate::decks::lines::{
     block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
 use crate::decks::stages::{stage_lines, trajectory_lines, StageHooks};
 use crate::decks::{Deck, DeckError, DeckPlan};
+use cgdem_core::contact::normal::Material;
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
+use cgdem_core::scene::{ContactTables, HertzSettings, PairProperties, RollingKind, Scene};
 
 /// LIGGGHTS 3.8 rejects a Young's modulus below this in SI units.
 pub const MIN_YOUNGS_MODULUS: Real = 5e6;
@@ -31,17 +35,8 @@ pub const MIN_YOUNGS_MODULUS: Real = 5e6;
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
 pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
     let h = hertz_settings(scene, "LIGGGHTS", true)?;
-    let n = scene.species.len();
-    // Planar walls and meshes share one atom type, whose material is `[wall_contact]`.
-    let types = AtomTypes {
-        particles: n,
-        wall: !scene.walls.is_empty() || !scene.bodies.is_empty(),
-    };
-    let (m, wm) = (material(h), wall_material(scene, h));
-    for (what, e) in [
-        ("contact.youngs_modulus", m.youngs_modulus),
-        ("wall_contact.youngs_modulus", wm.youngs_modulus),
-    ] {
+    let types = AtomTypes::of(scene, h);
+    for (what, e) in types.youngs_moduli(scene) {
         if e < MIN_YOUNGS_MODULUS {
             return Err(DeckError::Unsupported {
                 file: scene.source.display().to_string(),
@@ -61,7 +56,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     d += &neighbor_lines(&DIALECT, scene);
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
-    let (materials, rolling) = material_lines(scene, h, &types);
+    let (materials, rolling) = material_lines(h, &types);
     d += &materials;
     let _ = writeln!(
         d,
@@ -81,8 +76,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             g(dir.z)
         );
     }
-    d += &wall_lines(scene, n + 1, rolling)?;
-    let meshes = mesh_lines(scene, n + 1, rolling)?;
+    d += &wall_lines(scene, &types, rolling)?;
+    let meshes = mesh_lines(scene, &types, rolling)?;
     d += &meshes.setup;
     // LIGGGHTS's dump_modify format is one C format for the whole line (default: 6 digits).
     let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
@@ -115,34 +110,92 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     })
 }
 
-/// LIGGGHTS's atom types: one per species, then one for all walls and meshes when the scene
-/// has any (it pairs with particles only).
+/// LIGGGHTS's atom types: one per species, then one per wall material that a wall or mesh
+/// uses (walls pair with particles only), with the scene's resolved tables.
 struct AtomTypes {
-    particles: usize,
-    wall: bool,
+    tables: ContactTables,
+    /// The wall materials in use (`ContactTables::wall_materials` indices), in order: wall
+    /// material `wall_materials[j]` is atom type `n_species + 1 + j`.
+    wall_materials: Vec<usize>,
 }
 
 impl AtomTypes {
-    fn count(&self) -> usize {
-        self.particles + usize::from(self.wall)
+    fn of(scene: &Scene, h: &HertzSettings) -> AtomTypes {
+        let mut wall_materials: Vec<usize> = (scene.walls.iter().map(|w| w.material))
+            .chain(scene.bodies.iter().map(|b| b.material))
+            .collect();
+        wall_materials.sort_unstable();
+        wall_materials.dedup();
+        AtomTypes {
+            tables: ContactTables::of_hertz(scene, h),
+            wall_materials,
+        }
     }
 
-    /// A `peratomtype` table: `particle` for every species, `wall` for the wall type.
-    fn per_type(&self, particle: Real, wall: Real) -> String {
-        let mut v = vec![g(particle); self.particles];
-        if self.wall {
-            v.push(g(wall));
+    fn particles(&self) -> usize {
+        self.tables.n_species()
+    }
+
+    fn count(&self) -> usize {
+        self.particles() + self.wall_materials.len()
+    }
+
+    /// The atom type (from 1) of walls of wall material `material`.
+    fn wall_type(&self, material: usize) -> usize {
+        let j = self.wall_materials.iter().position(|&k| k == material);
+        self.particles() + 1 + j.expect("every wall's material is in use")
+    }
+
+    /// The material of atom type `t` (from 0).
+    fn material(&self, t: usize) -> Material {
+        match t.checked_sub(self.particles()) {
+            None => self.tables.species[t],
+            Some(j) => self.tables.wall_materials[self.wall_materials[j]],
         }
+    }
+
+    /// Each type's Young's modulus and the field it comes from.
+    fn youngs_moduli(&self, scene: &Scene) -> Vec<(String, Real)> {
+        let species = scene.species.iter().enumerate().map(|(a, s)| {
+            let field = match s.youngs_modulus {
+                Some(_) => format!("species[{a}].youngs_modulus"),
+                None => "contact.youngs_modulus".into(),
+            };
+            (field, self.tables.species[a].youngs_modulus)
+        });
+        let walls = self.wall_materials.iter().map(|&k| {
+            let field = match k {
+                0 => "wall_contact.youngs_modulus".into(),
+                k => format!("wall_material[{}].youngs_modulus", k - 1),
+            };
+            (field, self.tables.wall_materials[k].youngs_modulus)
+        });
+        species.chain(walls).collect()
+    }
+
+    /// A `peratomtype` table of `f` of each type's material.
+    fn per_type(&self, f: impl Fn(Material) -> Real) -> String {
+        let v: Vec<String> = (0..self.count()).map(|t| g(f(self.material(t)))).collect();
         v.join(" ")
     }
 
-    /// A `peratomtypepair` table: `wall` for pairs with the wall type, else `particle`.
-    fn per_pair(&self, particle: Real, wall: Real) -> String {
-        let (n, n_types) = (self.particles, self.count());
+    /// A `peratomtypepair` table of `f` of each pair's coefficients: species pairs from
+    /// `[[contact.pair]]`, a species and a wall material from `[[wall_contact.pair]]`. Walls
+    /// never meet walls: their pairs take the first species' value against the later wall
+    /// material (any valid value, but LIGGGHTS wants the matrix symmetric).
+    fn per_pair(&self, f: impl Fn(&PairProperties) -> Real) -> String {
+        let (n, n_types) = (self.particles(), self.count());
+        let t = &self.tables;
         let mut v = Vec::new();
         for a in 0..n_types {
             for b in 0..n_types {
-                v.push(g(if a == n || b == n { wall } else { particle }));
+                let p = match (a.checked_sub(n), b.checked_sub(n)) {
+                    (None, None) => t.pair(a, b),
+                    (None, Some(j)) => t.wall_pair(a, self.wall_materials[j]),
+                    (Some(j), None) => t.wall_pair(b, self.wall_materials[j]),
+                    (Some(j), Some(k)) => t.wall_pair(0, self.wall_materials[j.max(k)]),
+                };
+                v.push(g(f(p)));
             }
         }
         format!("{n_types} {}", v.join(" "))
@@ -151,34 +204,32 @@ impl AtomTypes {
 
 /// The material tables (`fix property/global`), and the `pair_style` suffix for rolling
 /// friction (empty without it).
-fn material_lines(scene: &Scene, h: &HertzSettings, types: &AtomTypes) -> (String, &'static str) {
-    let w = &scene.wall_contact;
-    let (m, wm) = (material(h), wall_material(scene, h));
+fn material_lines(h: &HertzSettings, types: &AtomTypes) -> (String, &'static str) {
     let mut d = String::new();
     // LIGGGHTS refuses E > 1e9 Pa in SI units unless told the particles are hard (steel).
-    if m.youngs_modulus.max(wm.youngs_modulus) > 1e9 {
+    if (0..types.count()).any(|t| types.material(t).youngs_modulus > 1e9) {
         d += "hard_particles  yes\n";
     }
     for (fix, property, table) in [
         (
             "m1",
             "youngsModulus peratomtype",
-            types.per_type(m.youngs_modulus, wm.youngs_modulus),
+            types.per_type(|m| m.youngs_modulus),
         ),
         (
             "m2",
             "poissonsRatio peratomtype",
-            types.per_type(m.poisson_ratio, wm.poisson_ratio),
+            types.per_type(|m| m.poisson_ratio),
         ),
         (
             "m3",
             "coefficientRestitution peratomtypepair",
-            types.per_pair(h.restitution, w.restitution),
+            types.per_pair(|p| p.restitution),
         ),
         (
             "m4",
             "coefficientFriction peratomtypepair",
-            types.per_pair(h.friction, w.friction),
+            types.per_pair(|p| p.friction),
         ),
     ] {
         let _ = writeln!(
@@ -190,7 +241,7 @@ fn material_lines(scene: &Scene, h: &HertzSettings, types: &AtomTypes) -> (Strin
         let _ = writeln!(
             d,
             "fix             m5 all property/global coefficientRollingFriction peratomtypepair {}",
-            types.per_pair(h.rolling_friction, w.rolling_friction)
+            types.per_pair(|p| p.rolling_friction)
         );
         " rolling_friction epsd2"
     } else {
@@ -199,16 +250,17 @@ fn material_lines(scene: &Scene, h: &HertzSettings, types: &AtomTypes) -> (Strin
     (d, rolling)
 }
 
-/// One `fix wall/gran ... primitive` per planar wall, of atom type `wall_type`.
-fn wall_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<String, DeckError> {
+/// One `fix wall/gran ... primitive` per planar wall, of its wall material's atom type.
+fn wall_lines(scene: &Scene, types: &AtomTypes, rolling: &str) -> Result<String, DeckError> {
     let mut d = String::new();
     for wall in &scene.walls {
         let (axis, _) = wall_axis(scene, wall)?;
         let at = [wall.point.x, wall.point.y, wall.point.z][axis];
         let _ = writeln!(
             d,
-            "fix             w_{} all wall/gran model hertz tangential history{rolling} primitive type {wall_type} {}plane {}",
+            "fix             w_{} all wall/gran model hertz tangential history{rolling} primitive type {} {}plane {}",
             wall.name,
+            types.wall_type(wall.material),
             ["x", "y", "z"][axis],
             g(at)
         );
@@ -227,7 +279,7 @@ struct MeshLines {
     notes: Vec<String>,
 }
 
-fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLines, DeckError> {
+fn mesh_lines(scene: &Scene, types: &AtomTypes, rolling: &str) -> Result<MeshLines, DeckError> {
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let mut out = MeshLines {
         setup: String::new(),
@@ -242,6 +294,7 @@ fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLine
     let mut body_pieces = Vec::new();
     for (k, b) in scene.bodies.iter().enumerate() {
         let mut pieces = Vec::new();
+        let wall_type = types.wall_type(b.material);
         if b.particles.is_some() {
             return Err(unsupported(format!(
                 "body[{k}] `{}` is built of particles; LIGGGHTS decks take mesh bodies",
@@ -467,6 +520,81 @@ mod tests {
         assert!(!d.contains("move_casing"));
         at(d, "dump            traj all custom");
         assert!(deck.plan.notes.iter().any(|n| n.contains("fix evaporate")));
+    }
+
+    /// tests/data/tiny_two_material_collapse.toml: species bead (type 1) and grit (2), the
+    /// default wall material (3: the back, gate and end walls) and steel (4: the floor); each
+    /// table entry is the scene's pair value, both ways round.
+    #[test]
+    fn material_tables_are_written_per_atom_type_from_the_scene() {
+        crate::at_repo_root();
+        let scene = Scene::load(std::path::Path::new(
+            "tests/data/tiny_two_material_collapse.toml",
+        ))
+        .unwrap();
+        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let deck = write_deck(&scene, &particles, 1e-5).unwrap();
+        let d = &deck.input;
+        let row = |v: &[Real]| v.iter().map(|&x| g(x)).collect::<Vec<_>>().join(" ");
+        at(
+            d,
+            &format!(
+                "fix             m1 all property/global youngsModulus peratomtype {}\n",
+                row(&[5e6, 2e7, 5e6, 2e8])
+            ),
+        );
+        at(
+            d,
+            &format!(
+                "fix             m2 all property/global poissonsRatio peratomtype {}\n",
+                row(&[0.3, 0.25, 0.3, 0.3])
+            ),
+        );
+        // Rows by type: bead, grit, default wall, steel (wall-wall pairs: any valid value).
+        let e = [
+            [0.5, 0.4, 0.5, 0.5],
+            [0.4, 0.3, 0.5, 0.6],
+            [0.5, 0.5, 0.5, 0.5],
+            [0.5, 0.6, 0.5, 0.5],
+        ];
+        at(
+            d,
+            &format!(
+                "coefficientRestitution peratomtypepair 4 {}\n",
+                row(e.as_flattened())
+            ),
+        );
+        let mu = [
+            [0.5, 0.6, 0.5, 0.4],
+            [0.6, 0.7, 0.5, 0.3],
+            [0.5, 0.5, 0.5, 0.4],
+            [0.4, 0.3, 0.4, 0.4],
+        ];
+        at(
+            d,
+            &format!(
+                "coefficientFriction peratomtypepair 4 {}\n",
+                row(mu.as_flattened())
+            ),
+        );
+        let mu_r = [
+            [0.1, 0.15, 0.1, 0.1],
+            [0.15, 0.1, 0.1, 0.1],
+            [0.1, 0.1, 0.1, 0.1],
+            [0.1, 0.1, 0.1, 0.1],
+        ];
+        at(
+            d,
+            &format!(
+                "coefficientRollingFriction peratomtypepair 4 {}\n",
+                row(mu_r.as_flattened())
+            ),
+        );
+        at(d, "fix             w_floor all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 4 zplane");
+        for wall in ["back", "gate", "end"] {
+            at(d, &format!("fix             w_{wall} all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 3 xplane"));
+        }
+        assert!(deck.data.contains("\n4 atom types\n"), "{:.400}", deck.data);
     }
 
     #[test]
