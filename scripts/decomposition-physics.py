@@ -296,7 +296,7 @@ def item_hertz(a):
     # Seed by seed, both decompositions of a seed one after the other: a shortened series
     # (--seeds 1,2) still pairs them.
     for seed in a.seeds:
-        for grid in [None, "2x1x1"]:
+        for grid in a.grids:
             name = f"{grid or 'none'}-seed{seed}"
             cmd = [a.bin, "run", "validation/cases/aor_hertz.toml", "--seed", str(seed), "--quiet",
                    "--threads", str(a.threads if grid else 1)]
@@ -354,7 +354,7 @@ def item_screw(a):
     for case in ["screw_feeder_hertz", "screw_feeder_hertz_particles"]:
         # Seed by seed, both decompositions of a seed one after the other (see item_hertz).
         for seed in a.seeds:
-            for grid in [None, "2x1x1"]:
+            for grid in a.grids:
                 name = f"{case}-rpm{a.rpm}-{grid or 'none'}-seed{seed}"
                 cmd = [a.bin, "run", f"validation/cases/{case}.toml", *sets, "--seed", str(seed),
                        "--keep-going", "--quiet", "--threads", str(a.threads if grid else 1)]
@@ -496,6 +496,9 @@ def main():
     p.add_argument("--rpm", type=int, default=140)
     p.add_argument("--only", help="heap: only these grids (none,2x1x1,...; empty: only the bench)")
     p.add_argument("--no-bench", action="store_true", help="heap: do not run the bench")
+    p.add_argument("--grids", type=lambda s: [None if g == "none" else g for g in s.split(",")],
+                   default=[None, "2x1x1"],
+                   help="hertz, screw: the grids to run (none: the scene's own grid, no --grid)")
     p.add_argument("--stability-grid", default="2")
     p.add_argument("--balance-grids", type=lambda s: s.split(","), default=["2x1x1", "4x1x1"])
     p.add_argument("--balances", type=lambda s: s.split(","), default=["1.1", "off"])

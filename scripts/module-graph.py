@@ -4,7 +4,7 @@ its circles (strongly connected components of more than one module).
 
 Usage: python3 scripts/module-graph.py CRATE_SRC [--depth N] [--edges]
   CRATE_SRC  e.g. crates/cgdem-harness/src
-  --depth N  how many levels of the module path make a node (1: `lammps`; 2: `lammps::deck`)
+  --depth N  how many levels of the module path make a node (1: `decks`; 2: `decks::lammps`)
   --edges    print every edge, not only the circles
 Exit status 1 when there is a circle (usable as a check). Test modules (`#[cfg(test)]`
 blocks to the end of a file, files named `*tests.rs`) are left out: a test may import what

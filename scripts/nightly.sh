@@ -24,6 +24,23 @@ fi
 night="reports/nightly/${date}-${commit}"
 mkdir -p "$night"
 
+# The speed guard, on the quiet machine before the suite: this build against the previous
+# night's (kept in target/nightly-previous), alternating pairs on the heap bench and the
+# shortened main job. A median ratio below 0.95 is a flag on the history's first screen and
+# in the night's report (history.rs reads speed_guard.json).
+previous=target/nightly-previous
+if [ -x "$previous/cgdem" ]; then
+    started=$(date +%s)
+    guard=0
+    bash scripts/speed-guard.sh --json "$night/speed_guard.json" \
+        --base-label "$(cat "$previous/commit" 2>/dev/null || echo previous)" --new-label "$commit" \
+        "$previous/cgdem" "$cgdem" || guard=$?
+    [ "$guard" = 2 ] && echo "note: the speed guard did not finish; the night has no build comparison"
+    echo "speed guard: $(( $(date +%s) - started )) s wall time"
+else
+    echo "note: no previous night's build in $previous; the speed guard starts next night"
+fi
+
 started=$(date +%s)
 "$cgdem" validate --suite nightly --out "$night" --reuse --jobs 2 --history reports/nightly "$@"
 echo "nightly suite: $(( $(date +%s) - started )) s wall time"
@@ -49,6 +66,10 @@ stability_failed=$(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); 
 find "$night/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete
 
 flags=$("$cgdem" history reports/nightly --add "$night" --date "$date" --commit "$commit")
+# This build is the next night's base.
+mkdir -p "$previous"
+cp "$cgdem" "$previous/cgdem.tmp" && mv "$previous/cgdem.tmp" "$previous/cgdem"
+echo "$commit" >"$previous/commit"
 echo "$flags"
 failed=$(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print(sum(r['status']=='failed' for r in s['runs']))" "$night/summary.json")
 if [ "$stability_failed" != 0 ]; then

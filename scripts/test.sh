@@ -77,6 +77,9 @@ fi
 # nor the harness's.
 stage module-graph python3 scripts/module-graph.py crates/cgdem-core/src
 python3 scripts/module-graph.py crates/cgdem-harness/src
+# Every relative link of the README and the guide (docs/) resolves; the CLI reference
+# (docs/cli.md) is checked against --help by the tests (cli_reference).
+stage links python3 scripts/check-links.py
 stage fmt cargo fmt --all -- --check
 # The default build (no MPI) is linted; the tests below build with the features.
 stage clippy cargo clippy --release --workspace --all-targets -- -D warnings

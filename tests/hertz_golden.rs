@@ -26,11 +26,9 @@ use cgdem_core::math::{Real, Vec3};
 use cgdem_core::particles::Particles;
 use cgdem_core::run::{hertz_history_wall, hertz_law};
 use cgdem_core::scene::{ContactSettings, Scene};
-use cgdem_core::simulation::{NeighborSettings, World};
+use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::deck::Deck;
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem_harness::liggghts;
+use cgdem_harness::decks::{self, lammps, liggghts, Deck, RunStatus, RunnerOptions};
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -113,10 +111,9 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: 0,
     };
-    let mut world = World::new(
+    let mut setup = WorldSetup::new(
         initial.clone(),
         scene.domain.clone(),
-        cgdem_core::run::scene_walls(scene),
         law,
         hertz_history_wall(scene, h),
         1,
@@ -124,8 +121,10 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         DT,
         neighbor,
     );
-    let record = |world: &World<_, _>| {
-        let p = &world.particles;
+    setup.walls = cgdem_core::run::scene_walls(scene);
+    let mut world = World::new(setup, &Decompose::default()).expect("the case fits its box");
+    let record = |world: &mut World<_, _>| {
+        let p = world.synced_particles();
         let omega = &p.angular.as_ref().unwrap().omega;
         let mut state = vec![[Vec3::ZERO; 3]; p.len()];
         for k in 0..p.len() {
@@ -133,10 +132,10 @@ fn run_cgdem(scene: &Scene, initial: &Particles) -> Trajectory {
         }
         state
     };
-    let mut trajectory = vec![record(&world)];
+    let mut trajectory = vec![record(&mut world)];
     for _ in 0..STEPS {
         world.step();
-        trajectory.push(record(&world));
+        trajectory.push(record(&mut world));
     }
     trajectory
 }
@@ -151,7 +150,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
     if let Err(reason) = found {
         println!(
             "{code:?} not run ({reason}): its stored numbers are used; install with `{}`",
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }
@@ -180,7 +179,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
         matches!(status, RunStatus::Completed { .. }),
         "{case} {code:?}: {status:?}"
     );
-    let frames = lammps::read_dump(&dir.join("traj.dump")).expect("dump");
+    let frames = decks::read_dump(&dir.join("traj.dump")).expect("dump");
     assert_eq!(frames.len() as u64, STEPS + 1, "{case}: one frame per step");
     Some(
         frames

@@ -16,8 +16,8 @@ use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
 use cgdem_core::run;
 use cgdem_core::scene::{ContactSettings, Scene, StageEnd};
-use cgdem_core::simulation::{NeighborSettings, World};
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
+use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
+use cgdem_harness::decks::{self, lammps, RunStatus, RunnerOptions};
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -91,10 +91,9 @@ fn run_cgdem(scene: &Scene, initial: &Particles, dt: Real, steps: u64) -> Trajec
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: 0,
     };
-    let mut world = World::new(
+    let mut setup = WorldSetup::new(
         initial.clone(),
         scene.domain.clone(),
-        run::scene_walls(scene),
         law,
         wall_law,
         1,
@@ -102,18 +101,20 @@ fn run_cgdem(scene: &Scene, initial: &Particles, dt: Real, steps: u64) -> Trajec
         dt,
         neighbor,
     );
-    let record = |world: &World<_, _>| {
-        let p = &world.particles;
+    setup.walls = run::scene_walls(scene);
+    let mut world = World::new(setup, &Decompose::default()).expect("the case fits its box");
+    let record = |world: &mut World<_, _>| {
+        let p = world.synced_particles();
         let mut state = vec![(Vec3::ZERO, Vec3::ZERO); p.len()];
         for k in 0..p.len() {
             state[p.id[k] as usize] = (p.position[k], p.velocity[k]);
         }
         state
     };
-    let mut trajectory = vec![record(&world)];
+    let mut trajectory = vec![record(&mut world)];
     for _ in 0..steps {
         world.step();
-        trajectory.push(record(&world));
+        trajectory.push(record(&mut world));
     }
     trajectory
 }
@@ -129,7 +130,7 @@ fn run_lammps(
     if let Err(reason) = lammps::find_lmp() {
         println!(
             "lmp not run ({reason}): its stored numbers are used; install with `{}`",
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }
@@ -148,7 +149,7 @@ fn run_lammps(
         matches!(status, RunStatus::Completed { .. }),
         "{name}: {status:?}"
     );
-    let frames = lammps::read_dump(&dir.join(lammps::deck::TRAJECTORY_FILE)).expect("dump");
+    let frames = decks::read_dump(&dir.join(decks::TRAJECTORY_FILE)).expect("dump");
     assert_eq!(frames.len() as u64, steps + 1, "{name}: one frame per step");
     Some(
         frames

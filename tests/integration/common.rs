@@ -1,17 +1,18 @@
 //! Small worlds for the tests.
 
 use cgdem_core::contact::normal::WcaCoefficients;
-use cgdem_core::contact::SeedModel;
+use cgdem_core::contact::{PairLaw, SeedModel};
+use cgdem_core::decomposition::GridSpec;
 use cgdem_core::domain::Domain;
 use cgdem_core::math::{Real, Vec3, TWO_POW_ONE_SIXTH};
 use cgdem_core::particles::Particles;
 use cgdem_core::scene::Scene;
-use cgdem_core::simulation::{NeighborSettings, World};
-use cgdem_core::walls::{WallSet, WcaWall};
+use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
+use cgdem_core::walls::{WallLaw, WallSet, WcaWall};
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::{self, RunStatus, RunnerOptions};
-use cgdem_harness::liggghts;
-use cgdem_harness::reference::{run_reference, ReferenceOptions, ReferenceRun};
+use cgdem_harness::decks::{
+    self, lammps, liggghts, run_reference, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
+};
 
 /// The seed's coke parameters (paper A sec. 3), coarse-grained by `lambda`.
 pub struct Coke {
@@ -64,6 +65,49 @@ pub fn open_box(half: Real) -> Domain {
     }
 }
 
+/// The setup of a world of coke particles (the seed's law).
+pub fn setup(
+    coke: &Coke,
+    particles: Particles,
+    domain: Domain,
+    walls: WallSet,
+    wall_law: WcaWall,
+    gravity: Vec3,
+    dt: Real,
+) -> WorldSetup<SeedModel, WcaWall> {
+    let neighbor = NeighborSettings {
+        skin: 0.3 * coke.diameter(),
+        resort_every: 5,
+    };
+    let mut setup = WorldSetup::new(
+        particles,
+        domain,
+        coke.law(),
+        wall_law,
+        1,
+        gravity,
+        dt,
+        neighbor,
+    );
+    setup.walls = walls;
+    setup
+}
+
+/// The world of `setup`, on the grid the scene gives.
+pub fn build<L: PairLaw, W: WallLaw>(setup: WorldSetup<L, W>) -> World<L, W> {
+    World::new(setup, &Decompose::default()).expect("the test world fits its box")
+}
+
+/// The world of `setup` on `grid`.
+pub fn build_on<L: PairLaw, W: WallLaw>(setup: WorldSetup<L, W>, grid: GridSpec) -> World<L, W> {
+    let decompose = Decompose {
+        grid: Some(grid),
+        ..Decompose::default()
+    };
+    World::new(setup, &decompose).expect("the test world fits its grid")
+}
+
+/// The world of [`setup`].
 pub fn world(
     coke: &Coke,
     particles: Particles,
@@ -73,21 +117,7 @@ pub fn world(
     gravity: Vec3,
     dt: Real,
 ) -> World<SeedModel, WcaWall> {
-    let neighbor = NeighborSettings {
-        skin: 0.3 * coke.diameter(),
-        resort_every: 5,
-    };
-    World::new(
-        particles,
-        domain,
-        walls,
-        coke.law(),
-        wall_law,
-        1,
-        gravity,
-        dt,
-        neighbor,
-    )
+    build(setup(coke, particles, domain, walls, wall_law, gravity, dt))
 }
 
 /// Two coke particles approaching head-on (or offset by `impact_parameter` diameters) with
@@ -98,6 +128,16 @@ pub fn binary_collision(
     impact_parameter: Real,
     dt: Real,
 ) -> World<SeedModel, WcaWall> {
+    build(binary_collision_setup(coke, speed, impact_parameter, dt))
+}
+
+/// The setup of [`binary_collision`], for tests that change its particles first.
+pub fn binary_collision_setup(
+    coke: &Coke,
+    speed: Real,
+    impact_parameter: Real,
+    dt: Real,
+) -> WorldSetup<SeedModel, WcaWall> {
     let d = coke.diameter();
     let mut particles = Particles::new(false);
     let b = impact_parameter * d;
@@ -111,7 +151,7 @@ pub fn binary_collision(
     particles.push(0, Vec3::new(0.5 * gap, 0.5 * b, 0.0), 0.5 * d, coke.mass());
     particles.velocity[0] = Vec3::new(0.5 * speed, 0.0, 0.0);
     particles.velocity[1] = Vec3::new(-0.5 * speed, 0.0, 0.0);
-    world(
+    setup(
         coke,
         particles,
         open_box(20.0 * d),
@@ -124,8 +164,9 @@ pub fn binary_collision(
 
 /// Runs until the pair separates again; returns (steps in contact, relative velocity after).
 pub fn collide(world: &mut World<SeedModel, WcaWall>, contact_distance: Real) -> (u64, Vec3) {
-    let distance = |w: &World<SeedModel, WcaWall>| {
-        (w.particles.position[0] - w.particles.position[1]).length()
+    let distance = |w: &mut World<SeedModel, WcaWall>| {
+        let p = w.synced_particles();
+        (p.position[0] - p.position[1]).length()
     };
     let mut in_contact = 0;
     let mut touched = false;
@@ -140,15 +181,9 @@ pub fn collide(world: &mut World<SeedModel, WcaWall>, contact_distance: Real) ->
     }
     assert!(touched, "the particles never met");
     // Index order may have been re-sorted; the relative velocity's sign follows the ids.
-    let (a, b) = if world.particles.id[0] == 0 {
-        (0, 1)
-    } else {
-        (1, 0)
-    };
-    (
-        in_contact,
-        world.particles.velocity[a] - world.particles.velocity[b],
-    )
+    let p = world.particles();
+    let (a, b) = if p.id[0] == 0 { (0, 1) } else { (1, 0) };
+    (in_contact, p.velocity[a] - p.velocity[b])
 }
 
 /// Runs `scene` in a reference code into a fresh `dir` under the tests' temporary directory;
@@ -168,7 +203,7 @@ pub fn completed_reference_run(
         println!(
             "skipped {}: {reason}; install with `{}`",
             code.name(),
-            lammps::INSTALL_HINT
+            decks::INSTALL_HINT
         );
         return None;
     }

@@ -137,7 +137,7 @@ fn sigterm_stops_a_run_at_a_step_end_with_its_outputs_and_exit_143() {
 /// Starts `args` (a command that runs LAMMPS in `dir`), waits until `lmp` runs there, sends
 /// SIGINT and checks: exit 130, nothing left running in `dir`, a decoy outside untouched.
 fn interrupt_during_lammps(args: &[&str], dir: &Path) {
-    if let Err(reason) = cgdem_harness::lammps::find_lmp() {
+    if let Err(reason) = cgdem_harness::decks::lammps::find_lmp() {
         // This test is about the live process tree: there is nothing to end without lmp.
         println!("not run: {reason}");
         return;

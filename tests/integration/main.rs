@@ -4,6 +4,7 @@
 
 mod bodies;
 mod cli;
+mod cli_reference;
 mod common;
 mod decomposition;
 #[path = "../support/golden.rs"]

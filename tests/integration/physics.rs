@@ -2,6 +2,7 @@
 //! coarse-graining invariants, determinism.
 
 use crate::common::*;
+use cgdem_core::decomposition::GridSpec;
 use cgdem_core::domain::Domain;
 use cgdem_core::geometry::FinitePlane;
 use cgdem_core::math::{Real, Vec3};
@@ -121,39 +122,33 @@ fn pair_forces_obey_newtons_third_law_in_a_dense_random_packing() {
         Vec3::ZERO,
         coke.pair_period() / 50.0,
     );
-    let momentum = |w: &cgdem_core::simulation::World<_, _>| -> Vec3 {
-        w.particles
-            .velocity
-            .iter()
-            .zip(&w.particles.mass)
-            .map(|(v, m)| *m * *v)
-            .sum()
-    };
-    let p0 = momentum(&world);
+    let momentum =
+        |p: &Particles| -> Vec3 { p.velocity.iter().zip(&p.mass).map(|(v, m)| *m * *v).sum() };
+    let p0 = momentum(world.particles());
     let mut largest_force: Real = 0.0;
     for _ in 0..200 {
         world.step();
-        let net: Vec3 = world.particles.force.iter().copied().sum();
-        largest_force = world
-            .particles
+        let p = world.synced_particles();
+        let net: Vec3 = p.force.iter().copied().sum();
+        largest_force = p
             .force
             .iter()
             .map(|f| f.length())
             .fold(largest_force, Real::max);
         assert!(
-            net.length() <= 1e-12 * largest_force * world.particles.len() as Real,
+            net.length() <= 1e-12 * largest_force * p.len() as Real,
             "net force {net}"
         );
     }
     assert!(largest_force > 0.0, "no contact happened");
-    let momentum_scale: Real = world
-        .particles
+    let p = world.particles();
+    let momentum_scale: Real = p
         .velocity
         .iter()
-        .zip(&world.particles.mass)
+        .zip(&p.mass)
         .map(|(v, m)| m * v.length())
         .sum();
-    let drift = (momentum(&world) - p0).length();
+    let drift = (momentum(p) - p0).length();
     assert!(
         drift < 1e-12 * momentum_scale,
         "momentum drift {drift:e} of {momentum_scale:e}"
@@ -193,10 +188,10 @@ fn wall_rebounds_with_the_restitution_it_was_given() {
             Vec3::ZERO,
             period / 200.0,
         );
-        while world.particles.position[0].z < 0.5 * d * 1.01 {
+        while world.synced_particles().position[0].z < 0.5 * d * 1.01 {
             world.step();
         }
-        let rebound = world.particles.velocity[0].z / 0.1;
+        let rebound = world.synced_particles().velocity[0].z / 0.1;
         assert!(
             (rebound / e - 1.0).abs() < 5e-3,
             "e = {e}: rebound {rebound}"
@@ -228,20 +223,26 @@ fn wall_friction_stops_a_sliding_particle_at_mu_g_without_chatter() {
         }],
     };
     let dt = coke.pair_period() / 50.0;
-    let mut world = world(
-        &coke,
-        particles,
-        open_box(0.5),
-        walls,
-        coke.wall_law(0.5, mu),
-        Vec3::new(0.0, 0.0, -g),
-        dt,
-    );
+    let on_floor = |particles: Particles| {
+        world(
+            &coke,
+            particles,
+            open_box(0.5),
+            walls.clone(),
+            coke.wall_law(0.5, mu),
+            Vec3::new(0.0, 0.0, -g),
+            dt,
+        )
+    };
+    let mut settling = on_floor(particles);
     for _ in 0..20_000 {
-        world.step();
+        settling.step();
     }
-    world.particles.velocity[0].x = v0;
-    let start_x = world.particles.position[0].x;
+    // Settled: set sliding from there.
+    let mut settled = settling.synced_particles().clone();
+    settled.velocity[0] = Vec3::new(v0, 0.0, 0.0);
+    let start_x = settled.position[0].x;
+    let mut world = on_floor(settled);
     let expected_stop = v0 / (mu * g);
     let steps = (1.5 * expected_stop / dt) as usize;
     let mut stopped_at = None;
@@ -249,7 +250,7 @@ fn wall_friction_stops_a_sliding_particle_at_mu_g_without_chatter() {
     let mut last_vx = v0;
     for k in 0..steps {
         world.step();
-        let vx = world.particles.velocity[0].x;
+        let vx = world.synced_particles().velocity[0].x;
         if vx * last_vx < 0.0 {
             sign_changes += 1;
         }
@@ -263,7 +264,7 @@ fn wall_friction_stops_a_sliding_particle_at_mu_g_without_chatter() {
         (t / expected_stop - 1.0).abs() < 0.02,
         "stopped after {t} s, Coulomb predicts {expected_stop} s"
     );
-    let distance = world.particles.position[0].x - start_x;
+    let distance = world.particles().position[0].x - start_x;
     let expected_distance = v0 * v0 / (2.0 * mu * g);
     assert!(
         (distance / expected_distance - 1.0).abs() < 0.02,
@@ -273,7 +274,7 @@ fn wall_friction_stops_a_sliding_particle_at_mu_g_without_chatter() {
         sign_changes, 0,
         "friction reversed the sliding velocity (chatter)"
     );
-    assert!(world.particles.velocity[0].x.abs() < 1e-6);
+    assert!(world.particles().velocity[0].x.abs() < 1e-6);
 }
 
 #[test]
@@ -330,7 +331,9 @@ fn one_and_two_threads_give_bitwise_identical_positions() {
                     plane("right", Vec3::X * 20.0 * d, -Vec3::X),
                 ],
             };
-            let mut world = world(
+            // Four subdomains (the scene alone would run as one), stepped by one thread or
+            // two.
+            let column = setup(
                 &coke,
                 particles,
                 domain,
@@ -339,6 +342,7 @@ fn one_and_two_threads_give_bitwise_identical_positions() {
                 Vec3::new(0.0, 0.0, -9.81),
                 coke.pair_period() / 20.0,
             );
+            let mut world = build_on(column, GridSpec::Auto(4));
             for _ in 0..4000 {
                 world.step();
                 if let Some(trip) = world.take_guard_trip() {
@@ -349,13 +353,12 @@ fn one_and_two_threads_give_bitwise_identical_positions() {
                 world.list_builds() > 6,
                 "the test must cover list rebuilds and re-sorts (every 5th build)"
             );
-            let mut by_id: Vec<(u32, Vec3)> = world
-                .particles
-                .id
-                .iter()
-                .copied()
-                .zip(world.particles.position.iter().copied())
-                .collect();
+            let p = world.synced_particles();
+            let mut by_id: Vec<(u32, Vec3)> =
+                p.id.iter()
+                    .copied()
+                    .zip(p.position.iter().copied())
+                    .collect();
             by_id.sort_by_key(|(id, _)| *id);
             by_id.into_iter().map(|(_, p)| p).collect()
         })
@@ -380,21 +383,25 @@ fn a_frozen_particle_stays_put_and_acts_with_infinite_mass() {
     let zeta = coke.gamma_n / (2.0 * (coke.wca.contact_stiffness() * m_eff).sqrt());
     let predicted = linear_restitution(zeta);
     let dt = coke.pair_period() / 200.0;
-    let mut world = binary_collision(&coke, 0.1, 0.0, dt);
-    world.particles.freeze(1);
-    world.particles.velocity[0] = Vec3::new(0.1, 0.0, 0.0);
-    let frozen_at = world.particles.position[1];
+    let mut setup = binary_collision_setup(&coke, 0.1, 0.0, dt);
+    setup.particles.freeze(1);
+    setup.particles.velocity[0] = Vec3::new(0.1, 0.0, 0.0);
+    let frozen_at = setup.particles.position[1];
+    let mut world = build(setup);
     let (_, relative) = collide(&mut world, coke.diameter());
     let e = -relative.x / 0.1;
     assert!(
         (e / predicted - 1.0).abs() < 2e-3,
         "e = {e}, predicted {predicted}"
     );
-    let k = world.particles.id.iter().position(|&id| id == 1).unwrap();
-    assert_eq!(world.particles.position[k], frozen_at);
-    assert_eq!(world.particles.velocity[k], Vec3::ZERO);
-    // Two frozen particles are never listed.
-    world.particles.freeze(0);
-    world.rebuild();
-    assert!(world.pairs().is_empty());
+    let p = world.particles();
+    let k = p.id.iter().position(|&id| id == 1).unwrap();
+    assert_eq!(p.position[k], frozen_at);
+    assert_eq!(p.velocity[k], Vec3::ZERO);
+    // Two frozen particles are never listed, touching or not.
+    let mut both = binary_collision_setup(&coke, 0.1, 0.0, dt);
+    both.particles.freeze(0);
+    both.particles.freeze(1);
+    assert_eq!(build(both).listed_pairs(), 0);
+    assert_eq!(binary_collision(&coke, 0.1, 0.0, dt).listed_pairs(), 1);
 }

@@ -12,7 +12,7 @@ use std::path::Path;
 use cgdem_core::geometry::screw_feeder::ScrewFeederSpec;
 use cgdem_core::scene::{Override, Scene};
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::{self, read_dump};
+use cgdem_harness::decks::{self, read_dump};
 
 use crate::common::completed_reference_run;
 use crate::golden::GoldenFile;
@@ -89,7 +89,7 @@ fn live_check(scene: &Scene) -> Option<Vec<(&'static str, f64)>> {
     let frames = read_dump(&dir.join("traj.dump")).expect("dump");
     let convey_start = summary.stages[1].start_s;
     let screw_type = 2.0;
-    let atoms = |f: &lammps::Frame, screw: bool| -> Vec<(i64, [f64; 3])> {
+    let atoms = |f: &decks::Frame, screw: bool| -> Vec<(i64, [f64; 3])> {
         let (id, ty) = (f.column("id").unwrap(), f.column("type").unwrap());
         let (x, y, z) = (
             f.column("x").unwrap(),

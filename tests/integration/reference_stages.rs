@@ -9,8 +9,7 @@ use std::path::{Path, PathBuf};
 use cgdem_core::run::SampleTrigger;
 use cgdem_core::scene::Scene;
 use cgdem_harness::code::Code;
-use cgdem_harness::lammps::{self, read_dump, RunStatus, RunnerOptions};
-use cgdem_harness::liggghts;
+use cgdem_harness::decks::{self, lammps, liggghts, read_dump, RunStatus, RunnerOptions};
 
 use crate::common::completed_reference_run;
 use crate::golden::GoldenFile;
@@ -130,7 +129,7 @@ fn live_check(code: Code) -> Option<Vec<(&'static str, f64)>> {
     // beads beyond it at the end.
     let frames = read_dump(&dir.join("traj.dump")).expect("dump");
     let gate = 0.04;
-    let max_x = |f: &lammps::Frame| {
+    let max_x = |f: &decks::Frame| {
         f.column("x")
             .unwrap()
             .iter()

@@ -116,9 +116,19 @@ fn validate_grid_decomposes_cgdem_runs_and_reuse_tells_them_apart() {
         "{summary}"
     );
 
+    // Without --grid the runs are made again, on their scenes' own grids.
     validate(&["--reuse"]);
-    assert!(summary_of(case_run)["decomposition"].is_null());
-    assert!(summary_of(stability_run)["decomposition"].is_null());
+    for run in [case_run, stability_run] {
+        let d = &summary_of(run)["decomposition"];
+        assert_eq!(d["grid"], serde_json::json!([1, 1, 1]), "{run}: {d}");
+        assert!(
+            d["grid_reason"]
+                .as_str()
+                .unwrap()
+                .starts_with("chosen from the scene"),
+            "{d}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

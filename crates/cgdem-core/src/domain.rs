@@ -80,3 +80,13 @@ impl Domain {
         (0..3).all(|a| self.periodic[a] || (p[a] >= self.lo[a] && p[a] <= self.hi[a]))
     }
 }
+
+/// The corner of the box `lo..hi` lowest along `gravity`: gravitational energy `-m g.(x - o)`
+/// is counted from it (cgdem's energy guard, and the energy balance of every code's outputs).
+pub fn potential_origin(gravity: Vec3, lo: Vec3, hi: Vec3) -> Vec3 {
+    Vec3::new(
+        if gravity.x < 0.0 { lo.x } else { hi.x },
+        if gravity.y < 0.0 { lo.y } else { hi.y },
+        if gravity.z < 0.0 { lo.z } else { hi.z },
+    )
+}

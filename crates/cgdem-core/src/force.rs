@@ -1,14 +1,13 @@
-//! The force kernels the world and its subdomains share: the particle arrays a force pass
-//! borrows, one listed pair seen from its owner, and a body acting on one particle. Generic
-//! over the laws and inlined into each pass, so both compile to the same loop body.
+//! The force kernels of a step: the particle arrays a force pass borrows, one listed pair
+//! seen from its first particle, and what acts on one particle alone (gravity, the planar
+//! walls, the bodies). Generic over the laws and inlined into the subdomains' force pass.
 
 use crate::bodies::{Body, BodyLoad, Clearance};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
-use crate::neighbor::Pair;
 use crate::particles::Particles;
-use crate::walls::{WallContact, WallLaw, WallParticle};
+use crate::walls::{WallContact, WallLaw, WallMask, WallParticle, WallSet};
 
 /// The particle arrays the owner pass reads.
 #[derive(Clone, Copy)]
@@ -22,10 +21,9 @@ pub(crate) struct ParticleState<'a> {
     pub(crate) species: &'a [u16],
 }
 
-/// What a force pass borrows from the particles at once: the state it reads, the force and
-/// torque arrays it writes (torque empty without rotation), and the ids.
+/// What a force pass borrows from the particles at once: the state it reads and the force
+/// and torque arrays it writes (torque empty without rotation).
 pub(crate) struct ForceView<'a> {
-    pub(crate) id: &'a [u32],
     pub(crate) state: ParticleState<'a>,
     pub(crate) force: &'a mut [Vec3],
     pub(crate) torque: &'a mut [Vec3],
@@ -48,7 +46,6 @@ impl<'a> ParticleState<'a> {
     /// `p` split into the state a force pass reads and the arrays it writes.
     pub(crate) fn split(p: &'a mut Particles) -> ForceView<'a> {
         let Particles {
-            id,
             position,
             velocity,
             force,
@@ -57,13 +54,13 @@ impl<'a> ParticleState<'a> {
             inv_mass,
             species,
             angular,
+            ..
         } = p;
         let (omega, torque) = match angular.as_mut() {
             Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
             None => (None, &mut [][..]),
         };
         ForceView {
-            id,
             state: ParticleState {
                 position,
                 velocity,
@@ -82,7 +79,6 @@ impl<'a> ParticleState<'a> {
 /// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
 #[derive(Clone, Copy)]
 pub(crate) struct Owner {
-    pub(crate) index: usize,
     pub(crate) position: Vec3,
     pub(crate) velocity: Vec3,
     pub(crate) omega: Vec3,
@@ -92,21 +88,20 @@ pub(crate) struct Owner {
     pub(crate) species_row: usize,
 }
 
-/// The force of one listed pair `(i, j)` seen from its owner `i`; zero (and history reset)
-/// when out of range. Also returns the overlap and the smaller radius, for the guard.
-#[allow(clippy::too_many_arguments)]
+/// The force of the pair `(i, j)` seen from `i` (the `owner`), with `j` at `position_j` (its
+/// position, or a periodic image of it); zero (and history reset) when out of range. Also
+/// returns the overlap and the smaller radius, for the guard.
 #[inline(always)]
 pub(crate) fn pair_force<L: PairLaw>(
     law: &L,
     p: &ParticleState,
-    images: &[Vec3; 27],
     owner: &Owner,
-    pair: Pair,
+    j: usize,
+    position_j: Vec3,
     history: &mut L::History,
     dt: Real,
 ) -> (PairResult, Real, Real) {
-    let j = pair.j as usize;
-    let d = owner.position - (p.position[j] + images[pair.image as usize]);
+    let d = owner.position - position_j;
     let distance_sq = d.length_squared();
     let (radius_i, radius_j) = (owner.radius, p.radius[j]);
     let species_pair = owner.species_row + p.species[j] as usize;
@@ -154,6 +149,88 @@ pub(crate) fn pair_force<L: PairLaw>(
         overlap,
         radius_i.min(radius_j),
     )
+}
+
+/// What acts on one particle alone, besides its pairs: gravity, the planar walls and the
+/// bodies (posed at the step's end), with the wall law.
+pub(crate) struct Surroundings<'a, W> {
+    pub(crate) wall_law: &'a W,
+    pub(crate) walls: &'a WallSet,
+    pub(crate) bodies: &'a [Body],
+    pub(crate) gravity: Vec3,
+    pub(crate) dt: Real,
+}
+
+/// One particle's slots in the arrays its surroundings keep: the walls it may reach before
+/// the next list build, its contact histories (one per planar wall, then one per body;
+/// empty when particles do not spin) and its clearance per body.
+pub(crate) struct AloneSlots<'s, WH> {
+    pub(crate) near: WallMask,
+    pub(crate) history: &'s mut [WH],
+    pub(crate) clearances: &'s mut [Clearance],
+}
+
+impl<W: WallLaw> Surroundings<'_, W> {
+    /// Adds to `force` and `torque` (the particle's pair sums; the torque untouched when
+    /// particles do not spin) what gravity, the walls and the bodies exert on `particle`, and
+    /// returns its deepest wall or body overlap as a fraction of its radius; each body's load
+    /// from it is added to `loads` (one per body).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn act_on(
+        &self,
+        particle: &WallParticle,
+        omega: Vec3,
+        rotates: bool,
+        slots: AloneSlots<'_, W::History>,
+        loads: &mut [BodyLoad],
+        force: &mut Vec3,
+        torque: &mut Vec3,
+    ) -> Real {
+        let (law, dt) = (self.wall_law, self.dt);
+        *force += particle.mass * self.gravity;
+        let mut overlap;
+        let bodies = self.bodies.iter().zip(slots.clearances).zip(loads);
+        if rotates {
+            let (wall_history, body_history) = slots.history.split_at_mut(self.walls.walls.len());
+            if W::NEEDS_ROTATION {
+                let (f, t, o) = self.walls.force_and_torque_on(
+                    law,
+                    particle,
+                    slots.near,
+                    omega,
+                    wall_history,
+                    dt,
+                );
+                *force += f;
+                *torque += t;
+                overlap = o;
+            } else {
+                let (f, o) = self.walls.force_on(law, particle, slots.near, dt);
+                *force += f;
+                overlap = o;
+            }
+            for (((body, clearance), load), history) in bodies.zip(body_history) {
+                let (f, t, l, o) =
+                    body_force_and_torque(body, law, particle, omega, history, clearance, dt);
+                *force += f;
+                *torque += t;
+                *load += l;
+                overlap = larger(overlap, o);
+            }
+        } else {
+            let (f, o) = self.walls.force_on(law, particle, slots.near, dt);
+            *force += f;
+            overlap = o;
+            for ((body, clearance), load) in bodies {
+                let (f, l, o) = body_force(body, law, particle, clearance, dt);
+                *force += f;
+                *load += l;
+                overlap = larger(overlap, o);
+            }
+        }
+        overlap
+    }
 }
 
 /// Force of one body on one particle (the wall law with the SDF distance and normal and the

@@ -13,11 +13,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::accuracy::{settings, AccuracyPoint, Cost, Measure, SPREAD_STANDARD_ERRORS};
+use super::accuracy::{settings, AccuracyPoint, Cost, Measure, Setting, SPREAD_STANDARD_ERRORS};
 use super::code::Code;
 use super::runs::{ValidateError, ValidateOptions};
 use super::suite::Suite;
-use super::validate::validate_suite;
+use super::validation::validate_suite;
 
 #[derive(Debug, thiserror::Error)]
 pub enum AdviseError {
@@ -280,40 +280,8 @@ pub fn advise(
         })
         .map(Measure::quantity)
         .collect();
-    let mean_wall = |runs: &[&AccuracyPoint]| {
-        let w: Vec<f64> = runs.iter().filter_map(|p| p.wall_s).collect();
-        (!w.is_empty()).then(|| w.iter().sum::<f64>() / w.len() as f64)
-    };
-    let reference_cost = {
-        let c: Vec<f64> = reference
-            .runs
-            .iter()
-            .filter_map(|p| p.particle_steps)
-            .collect();
-        c.iter().sum::<f64>() / c.len().max(1) as f64
-    };
-    let reference_wall = mean_wall(&reference.runs);
     let first = reference.runs[0];
-    let mut considered: Vec<Level> = all
-        .iter()
-        .filter(|s| s.series.starts_with("lambda"))
-        .filter_map(|s| {
-            let mean = s.mean(m, Cost::ParticleSteps)?;
-            let wall = mean_wall(&s.runs);
-            Some(Level {
-                setting: s.setting.to_string(),
-                lambda: s.runs[0].lambda,
-                cg_rule: s.runs[0].cg_rule.name().to_string(),
-                error: mean.error,
-                spread: mean.se.map(|se| SPREAD_STANDARD_ERRORS * se),
-                seeds: mean.n,
-                particle_steps: mean.cost,
-                wall_s: wall,
-                saving_particle_steps: reference_cost / mean.cost,
-                saving_wall: reference_wall.zip(wall).map(|(r, w)| r / w),
-            })
-        })
-        .collect();
+    let considered = levels(&all, reference, m);
     if considered.is_empty() {
         return Err(AdviseError::NotMeasured {
             case: name.to_string(),
@@ -325,12 +293,6 @@ pub fn advise(
             },
         });
     }
-    considered.sort_by(|a, b| {
-        a.lambda
-            .cmp(&b.lambda)
-            .then(a.cg_rule.cmp(&b.cg_rule))
-            .then(a.particle_steps.total_cmp(&b.particle_steps))
-    });
     let advised = considered
         .iter()
         .filter(|l| l.reach() <= target)
@@ -362,6 +324,51 @@ pub fn advise(
         best_reached,
         considered,
     })
+}
+
+/// The coarse-grained settings that measured `m`, each with its error, spread and what it
+/// saves against `reference`; in the order of lambda, rule and cost.
+fn levels(all: &[Setting], reference: &Setting, m: Measure) -> Vec<Level> {
+    let mean_wall = |runs: &[&AccuracyPoint]| {
+        let w: Vec<f64> = runs.iter().filter_map(|p| p.wall_s).collect();
+        (!w.is_empty()).then(|| w.iter().sum::<f64>() / w.len() as f64)
+    };
+    let reference_cost = {
+        let c: Vec<f64> = reference
+            .runs
+            .iter()
+            .filter_map(|p| p.particle_steps)
+            .collect();
+        c.iter().sum::<f64>() / c.len().max(1) as f64
+    };
+    let reference_wall = mean_wall(&reference.runs);
+    let mut considered: Vec<Level> = all
+        .iter()
+        .filter(|s| s.series.starts_with("lambda"))
+        .filter_map(|s| {
+            let mean = s.mean(m, Cost::ParticleSteps)?;
+            let wall = mean_wall(&s.runs);
+            Some(Level {
+                setting: s.setting.to_string(),
+                lambda: s.runs[0].lambda,
+                cg_rule: s.runs[0].cg_rule.name().to_string(),
+                error: mean.error,
+                spread: mean.se.map(|se| SPREAD_STANDARD_ERRORS * se),
+                seeds: mean.n,
+                particle_steps: mean.cost,
+                wall_s: wall,
+                saving_particle_steps: reference_cost / mean.cost,
+                saving_wall: reference_wall.zip(wall).map(|(r, w)| r / w),
+            })
+        })
+        .collect();
+    considered.sort_by(|a, b| {
+        a.lambda
+            .cmp(&b.lambda)
+            .then(a.cg_rule.cmp(&b.cg_rule))
+            .then(a.particle_steps.total_cmp(&b.particle_steps))
+    });
+    considered
 }
 
 #[cfg(test)]

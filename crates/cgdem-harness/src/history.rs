@@ -35,6 +35,50 @@ pub struct Night {
     pub runs_failed: usize,
     pub comparisons_failed: usize,
     pub metrics: BTreeMap<String, Metric>,
+    /// This night's build against the previous night's, when the nightly ran the guard.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_guard: Option<SpeedGuard>,
+}
+
+/// Alternating pairs of the previous night's build and this one (`scripts/speed-guard.sh`,
+/// its `speed_guard.json`): the median ratios new / base on the heap bench (throughput) and
+/// the shortened main job (inverse wall time). Judged against a fixed threshold, not
+/// against the previous night: a slow build must not become the next night's baseline
+/// unnoticed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedGuard {
+    /// The builds compared, as the nightly names them (their commits).
+    pub base: String,
+    pub new: String,
+    pub pairs: usize,
+    /// A median ratio below this is a flag.
+    pub threshold: f64,
+    pub heap_ratio_median: f64,
+    pub mainjob_ratio_median: f64,
+}
+
+impl SpeedGuard {
+    /// One flag per comparison whose median ratio is below the threshold, with the base
+    /// build as 1.
+    pub fn flags(&self) -> Vec<Flag> {
+        [
+            ("heap bench", self.heap_ratio_median),
+            ("main job", self.mainjob_ratio_median),
+        ]
+        .into_iter()
+        .filter(|&(_, ratio)| ratio < self.threshold)
+        .map(|(what, ratio)| Flag {
+            metric: format!(
+                "speed guard: {what}, build {} against {} ({} alternating pairs)",
+                self.new, self.base, self.pairs
+            ),
+            previous: 1.0,
+            current: ratio,
+            tolerance: 1.0 - self.threshold,
+            relative: true,
+        })
+        .collect()
+    }
 }
 
 /// A metric that moved beyond its tolerance since the previous night.
@@ -138,25 +182,30 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 
 /// The metrics of `current` that moved beyond their tolerance since `previous`.
 pub fn flags(previous: &Night, current: &Night) -> Vec<Flag> {
-    current
-        .metrics
-        .iter()
-        .filter_map(|(name, m)| {
-            let p = previous.metrics.get(name)?;
-            let allowed = if m.relative {
-                m.tolerance * p.value.abs()
-            } else {
-                m.tolerance
-            };
-            ((m.value - p.value).abs() > allowed).then(|| Flag {
-                metric: name.clone(),
-                previous: p.value,
-                current: m.value,
-                tolerance: m.tolerance,
-                relative: m.relative,
-            })
+    let moved = current.metrics.iter().filter_map(|(name, m)| {
+        let p = previous.metrics.get(name)?;
+        let allowed = if m.relative {
+            m.tolerance * p.value.abs()
+        } else {
+            m.tolerance
+        };
+        ((m.value - p.value).abs() > allowed).then(|| Flag {
+            metric: name.clone(),
+            previous: p.value,
+            current: m.value,
+            tolerance: m.tolerance,
+            relative: m.relative,
         })
-        .collect()
+    });
+    moved.chain(guard_flags(current)).collect()
+}
+
+/// The flags of a night's speed guard (none when it did not run).
+pub fn guard_flags(night: &Night) -> Vec<Flag> {
+    night
+        .speed_guard
+        .as_ref()
+        .map_or(Vec::new(), SpeedGuard::flags)
 }
 
 /// Adds the night in `night_dir` (a `cgdem validate` output) to the history in
@@ -241,8 +290,21 @@ pub fn add_night(
         runs_failed,
         comparisons_failed,
         metrics: night_metrics(&summary),
+        speed_guard: None,
     };
     let mut night = night;
+    // The night's speed guard, when it ran (scripts/nightly.sh writes it before the suite).
+    let guard_path = night_dir.join("speed_guard.json");
+    if let Ok(text) = std::fs::read_to_string(&guard_path) {
+        night.speed_guard =
+            Some(
+                serde_json::from_str(&text).map_err(|e| HistoryError::Invalid {
+                    file: guard_path.clone(),
+                    what: "speed guard result",
+                    message: e.to_string(),
+                })?,
+            );
+    }
     // The night's `cgdem bench`, when it ran (scripts/nightly.sh runs it into bench/).
     let bench_path = night_dir.join("bench").join("bench.json");
     if let Ok(text) = std::fs::read_to_string(&bench_path) {
@@ -269,7 +331,7 @@ pub fn add_night(
     })?;
     let latest = nights.len() - 1;
     let flagged = match latest {
-        0 => Vec::new(),
+        0 => guard_flags(&nights[0]),
         k => flags(&nights[k - 1], &nights[k]),
     };
     write_page(history_dir, &nights)?;
@@ -303,8 +365,14 @@ pub fn since_previous(
             Vec::new(),
         );
     };
+    // The night's own speed guard (scripts/nightly.sh runs it before the suite), not the
+    // previous night's.
+    let speed_guard = std::fs::read_to_string(night_dir.join("speed_guard.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok());
     let current = Night {
         metrics: night_metrics(summary),
+        speed_guard,
         ..previous.clone()
     };
     let mut items: Vec<String> = flags(previous, &current)
@@ -400,18 +468,8 @@ fn relative_to(path: &Path, base: &Path) -> String {
         .unwrap_or_else(|_| p.display().to_string())
 }
 
-fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
-    let output = |file: &Path, e: &dyn std::fmt::Display| HistoryError::Output {
-        file: file.to_path_buf(),
-        message: e.to_string(),
-    };
-    let mut report = Report::new("cgdem nightly validation: history");
-    let intro = report.intro();
-    intro.paragraph(
-        "One row per night (newest last), with a link to its report; then the metrics that \
-         moved beyond their tolerance since the previous night, and the trends. Repose angles \
-         are judged by the suite's angle tolerance; throughput by 25% (the machine is shared).",
-    );
+/// One row per night: its report, runs, failures and flags.
+fn nights_table(nights: &[Night]) -> Table {
     let mut table = Table::new([
         "night",
         "date",
@@ -425,7 +483,7 @@ fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
     .caption("Nights");
     for (k, n) in nights.iter().enumerate() {
         let flagged = if k == 0 {
-            0
+            guard_flags(n).len()
         } else {
             flags(&nights[k - 1], n).len()
         };
@@ -447,12 +505,43 @@ fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
             count(flagged),
         ]);
     }
-    intro.table(table);
-    if nights.len() >= 2 {
-        let k = nights.len() - 1;
+    table
+}
+
+fn write_page(dir: &Path, nights: &[Night]) -> Result<(), HistoryError> {
+    let output = |file: &Path, e: &dyn std::fmt::Display| HistoryError::Output {
+        file: file.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut report = Report::new("cgdem nightly validation: history");
+    let intro = report.intro();
+    intro.paragraph(
+        "One row per night (newest last), with a link to its report; then the metrics that \
+         moved beyond their tolerance since the previous night, and the trends. Repose angles \
+         are judged by the suite's angle tolerance; throughput by 25% (the machine is shared).",
+    );
+    intro.table(nights_table(nights));
+    if let Some(guard) = nights.last().and_then(|n| n.speed_guard.as_ref()) {
+        intro.paragraph(format!(
+            "Speed of build {} against the previous night's {} ({} alternating pairs, \
+             new / base, a median below {} is a flag): heap bench {:.3}, main job {:.3}.",
+            guard.new,
+            guard.base,
+            guard.pairs,
+            guard.threshold,
+            guard.heap_ratio_median,
+            guard.mainjob_ratio_median
+        ));
+    }
+    let flagged = match nights.len() {
+        0 => Vec::new(),
+        1 => guard_flags(&nights[0]),
+        n => flags(&nights[n - 2], &nights[n - 1]),
+    };
+    if nights.len() >= 2 || !flagged.is_empty() {
         let mut moved = Table::new(["metric", "previous", "latest", "tolerance"])
-            .caption("Moved beyond tolerance since the previous night");
-        for f in flags(&nights[k - 1], &nights[k]) {
+            .caption("Moved beyond tolerance since the previous night (or the previous build)");
+        for f in flagged {
             let tol = if f.relative {
                 format!("{:.0}%", 100.0 * f.tolerance)
             } else {
@@ -559,6 +648,7 @@ mod tests {
             runs_failed: 0,
             comparisons_failed: 0,
             metrics: night_metrics(&summary(angle, rate)),
+            speed_guard: None,
         };
         assert!(flags(&night(30.0, 1e6), &night(31.0, 1.2e6)).is_empty());
         let f = flags(&night(30.0, 1e6), &night(32.0, 0.5e6));
@@ -631,6 +721,46 @@ mod tests {
         assert_eq!(items.len(), 2, "{items:?}");
         assert!(items[0].contains("repose angle: 30.0 -> 33.0"), "{items:?}");
         assert!(items[1].ends_with("pass -> fail"), "{items:?}");
+        let _ = std::fs::remove_dir_all(&base);
+    }
+
+    #[test]
+    fn a_slower_build_is_a_flag_on_the_first_screen_and_an_unchanged_one_is_not() {
+        let base = std::env::temp_dir().join(format!("cgdem-guard-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        let guard = |heap: f64, mainjob: f64| {
+            serde_json::json!({
+                "base": "aaa1111", "new": "bbb2222", "pairs": 5, "threshold": 0.95,
+                "heap_ratio_median": heap, "mainjob_ratio_median": mainjob,
+                "heap_ratios": [heap], "flagged": heap < 0.95 || mainjob < 0.95
+            })
+        };
+        for (k, (heap, mainjob)) in [(1, (0.99, 1.02)), (2, (0.80, 1.0))] {
+            let night = base.join(format!("night{k}"));
+            std::fs::create_dir_all(&night).unwrap();
+            std::fs::write(night.join("summary.json"), summary(30.0, 1e6).to_string()).unwrap();
+            std::fs::write(
+                night.join("speed_guard.json"),
+                guard(heap, mainjob).to_string(),
+            )
+            .unwrap();
+            let f = add_night(&base, &night, &format!("2026-11-0{k}"), "bbb2222").unwrap();
+            let page = std::fs::read_to_string(base.join("index.html")).unwrap();
+            assert!(page.contains("against the previous night"), "night {k}");
+            if k == 1 {
+                assert!(f.is_empty(), "{f:?}");
+            } else {
+                assert_eq!(f.len(), 1, "{f:?}");
+                assert!(f[0]
+                    .metric
+                    .contains("heap bench, build bbb2222 against aaa1111"));
+                assert_eq!(f[0].current, 0.80);
+                assert!(page.contains("speed guard: heap bench"));
+                // The night's report says it too, before the history is written.
+                let (_, items) = since_previous(&base, &base.join("night2"), &summary(30.0, 1e6));
+                assert!(items.iter().any(|i| i.contains("speed guard")), "{items:?}");
+            }
+        }
         let _ = std::fs::remove_dir_all(&base);
     }
 }

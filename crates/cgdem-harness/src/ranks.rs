@@ -19,7 +19,7 @@ use cgdem_core::decomposition::GridSpec;
 use cgdem_core::run::{RunOptions, RunSummary};
 use cgdem_core::scene::Scene;
 
-use crate::lammps::runner::{self, RunStatus, RunnerOptions};
+use crate::decks::runner::{self, RunStatus, RunnerOptions};
 
 /// What `cgdem --version` prints in a build with the `mpi` feature (src/main.rs).
 pub const MPI_MARK: &str = "with MPI";

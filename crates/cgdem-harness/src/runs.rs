@@ -11,6 +11,7 @@ use crate::code::Code;
 use crate::ranks::{run_scene, Ranks};
 use crate::suite_entry::SuiteError;
 use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
+use cgdem_core::decomposition::placement::FROM_THE_SCENE;
 use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_core::math::Real;
 use cgdem_core::run::{restart, CheckpointOptions, Progress, RunOptions, StageEnding};
@@ -214,12 +215,12 @@ impl ValidateOptions {
 }
 
 /// `validate --grid` and `--balance`: every cgdem run of the suite (cases, accuracy sweeps,
-/// stability) split into subdomains on the suite's threads, so that its verdicts can be
-/// compared with the undecomposed suite's; with `--np`, as MPI ranks. The reference codes
+/// stability) on the given grid instead of the one each scene chooses, so that its verdicts
+/// can be compared with the default suite's; with `--np`, as MPI ranks. The reference codes
 /// run as without it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CgdemDecomposition {
-    /// None: undecomposed (the default).
+    /// None: each scene's own grid (the default).
     pub grid: Option<GridSpec>,
     pub balance: BalanceSpec,
     /// `--np`: each run as this many MPI ranks (`mpirun`) instead of threads in this
@@ -229,12 +230,14 @@ pub struct CgdemDecomposition {
 
 impl CgdemDecomposition {
     /// Whether the run that wrote `summary` (its summary.json) was decomposed this way, so
-    /// that `--reuse` never takes a decomposed run for an undecomposed one or the reverse.
-    /// A count (`--grid 4`) matches any grid of that many subdomains.
+    /// that `--reuse` never takes a run on a given grid for one on its scene's grid or the
+    /// reverse. A count (`--grid 4`) matches any grid of that many subdomains.
     pub fn made(&self, summary: &serde_json::Value) -> bool {
         let done = &summary["decomposition"];
         let Some(spec) = self.grid else {
-            return done.is_null();
+            let reason = done["grid_reason"].as_str().unwrap_or("");
+            return reason.starts_with(FROM_THE_SCENE)
+                && done["balance_threshold"].as_f64() == self.balance.threshold();
         };
         let Some(grid) = done["grid"].as_array() else {
             return false;
@@ -417,8 +420,7 @@ fn run_reference_code(
     dir: &Path,
     validate: &ValidateOptions,
 ) -> Result<bool, RunOutcome> {
-    use super::lammps::{RunStatus, RunnerOptions};
-    use super::reference::{run_reference, ReferenceOptions};
+    use super::decks::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
     let reference = match code {
         Code::Liggghts => Code::Liggghts,
         _ => Code::Lammps,
@@ -545,7 +547,7 @@ mod tests {
 
     #[test]
     fn reuse_takes_only_a_run_decomposed_as_asked() {
-        let plain = serde_json::json!({ "scene_digest": "x" });
+        let plain = serde_json::json!({ "decomposition": { "grid": [1, 1, 1], "balance_threshold": 1.1, "grid_reason": format!("{FROM_THE_SCENE}: 40 particles") } });
         let split = |grid: [u64; 3], threshold: Option<f64>| serde_json::json!({ "decomposition": { "grid": grid, "balance_threshold": threshold } });
         let asked = |grid: Option<GridSpec>, balance: BalanceSpec| CgdemDecomposition {
             grid,
@@ -555,6 +557,8 @@ mod tests {
         let none = CgdemDecomposition::default();
         assert!(none.made(&plain));
         assert!(!none.made(&split([2, 1, 1], Some(1.1))));
+        // Written before every run was a grid: made again.
+        assert!(!none.made(&serde_json::json!({ "scene_digest": "x" })));
         let given = asked(Some(GridSpec::Given([2, 1, 1])), BalanceSpec::Shift(1.1));
         assert!(given.made(&split([2, 1, 1], Some(1.1))));
         assert!(!given.made(&plain));
@@ -566,5 +570,26 @@ mod tests {
         let count = asked(Some(GridSpec::Auto(4)), BalanceSpec::Shift(1.1));
         assert!(count.made(&split([1, 2, 2], Some(1.1))));
         assert!(!count.made(&split([2, 1, 1], Some(1.1))));
+    }
+
+    #[test]
+    fn concurrent_runs_take_every_item_once_and_keep_the_order() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let items: Vec<u32> = (0..17).collect();
+        for jobs in [1, 2, 3, 40] {
+            let calls = AtomicUsize::new(0);
+            let out = run_concurrently(&items, jobs, |&k| {
+                calls.fetch_add(1, Ordering::Relaxed);
+                (k * k, rayon::current_num_threads())
+            });
+            assert_eq!(calls.load(Ordering::Relaxed), items.len(), "jobs {jobs}");
+            let squares: Vec<u32> = out.iter().map(|o| o.0).collect();
+            assert_eq!(squares, items.iter().map(|k| k * k).collect::<Vec<_>>());
+            if jobs > 1 {
+                // Each job's pool holds its share of the threads, at least one.
+                let share = (rayon::current_num_threads() / jobs).max(1);
+                assert!(out.iter().all(|o| o.1 == share), "jobs {jobs}: {out:?}");
+            }
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! screw speed for every code with its block-average standard error, beside Eq. (7) with
 //! each code's measured fill ratio (paper A Fig. 8), and a table of the numbers. Every code's
 //! flow is measured the same way (`analysis::conveying`: cgdem from its state, LIGGGHTS and
-//! LAMMPS from their dumps, `lammps::postprocess::conveying_samples`).
+//! LAMMPS from their dumps, `decks::postprocess::conveying_samples`).
 
 use std::path::Path;
 

@@ -146,153 +146,12 @@ impl Suite {
             file: path.to_path_buf(),
             message: e.to_string().trim_end().replace('\n', "\n  "),
         })?;
-        let invalid = |field: String, value: String, allowed: &str| SuiteError::Invalid {
-            file: path.to_path_buf(),
-            field,
-            value,
-            allowed: allowed.into(),
-        };
-        let mut cases = Vec::new();
-        for (k, c) in raw.cases.into_iter().enumerate() {
-            let codes = parse_codes(&c.codes, &format!("case[{k}].codes"), path)?;
-            if codes.is_empty() {
-                return Err(invalid(
-                    format!("case[{k}].codes"),
-                    "[]".into(),
-                    "at least one code",
-                ));
-            }
-            if c.lambdas.is_empty() || c.lambdas.iter().any(|l| !l.is_power_of_two()) {
-                return Err(invalid(
-                    format!("case[{k}].lambdas"),
-                    format!("{:?}", c.lambdas),
-                    "one or more powers of two",
-                ));
-            }
-            if c.seeds.is_empty() {
-                return Err(invalid(
-                    format!("case[{k}].seeds"),
-                    "[]".into(),
-                    "at least one insertion seed",
-                ));
-            }
-            let cg_rules = if c.cg_rules.is_empty() {
-                vec![CoarseGrainRule::Seed]
-            } else {
-                c.cg_rules
-                    .iter()
-                    .map(|name| {
-                        CoarseGrainRule::from_name(name).ok_or_else(|| {
-                            invalid(
-                                format!("case[{k}].cg_rules"),
-                                format!("\"{name}\""),
-                                &rule_names(),
-                            )
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()?
-            };
-            let angle_tolerance_deg = c.angle_tolerance_deg.unwrap_or(2.0);
-            if angle_tolerance_deg.is_nan() || angle_tolerance_deg <= 0.0 {
-                return Err(invalid(
-                    format!("case[{k}].angle_tolerance_deg"),
-                    angle_tolerance_deg.to_string(),
-                    "a number of degrees > 0",
-                ));
-            }
-            let fraction = |field: &str, value: Option<f64>, default: f64| {
-                let v = value.unwrap_or(default);
-                if v.is_finite() && v > 0.0 && v < 1.0 {
-                    Ok(v)
-                } else {
-                    Err(invalid(
-                        format!("case[{k}].{field}"),
-                        v.to_string(),
-                        "a fraction between 0 and 1 (exclusive)",
-                    ))
-                }
-            };
-            let time_ratio_tolerance =
-                fraction("time_ratio_tolerance", c.time_ratio_tolerance, 0.10)?;
-            let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
-            let wall_height_tolerance =
-                fraction("wall_height_tolerance", c.wall_height_tolerance, 0.05)?;
-            let kinetic_energy_tolerance =
-                fraction("kinetic_energy_tolerance", c.kinetic_energy_tolerance, 0.10)?;
-            let mut known_differences = Vec::new();
-            for (j, kd) in c.known_difference.into_iter().enumerate() {
-                let field = |f: &str| format!("case[{k}].known_difference[{j}].{f}");
-                if !CRITERIA.contains(&kd.criterion.as_str()) {
-                    return Err(invalid(
-                        field("criterion"),
-                        format!("\"{}\"", kd.criterion),
-                        "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\"",
-                    ));
-                }
-                if !(kd.band[0].is_finite() && kd.band[1].is_finite() && kd.band[0] <= kd.band[1]) {
-                    return Err(invalid(
-                        field("band"),
-                        format!("{:?}", kd.band),
-                        "[low, high], finite, low <= high, in the criterion's units",
-                    ));
-                }
-                if kd.reason.trim().is_empty() {
-                    return Err(invalid(
-                        field("reason"),
-                        "\"\"".into(),
-                        "why the codes or levels differ, in words",
-                    ));
-                }
-                // The evidence is a file of the repository (paths from its root, as `file`).
-                if !Path::new(&kd.evidence).is_file() {
-                    return Err(invalid(
-                        field("evidence"),
-                        format!("\"{}\"", kd.evidence),
-                        "an existing file, relative to the repository root, that documents the difference",
-                    ));
-                }
-                if kd.comparison.trim().is_empty() {
-                    return Err(invalid(
-                        field("comparison"),
-                        "\"\"".into(),
-                        "the start of a comparison's name, e.g. \"cgdem vs lammps\"",
-                    ));
-                }
-                known_differences.push(KnownDifference {
-                    comparison: kd.comparison,
-                    criterion: kd.criterion,
-                    reason: kd.reason,
-                    evidence: kd.evidence,
-                    band: kd.band,
-                });
-            }
-            let overrides =
-                parse_variant(&c.set, c.variant.as_deref(), &format!("case[{k}]"), path)?;
-            if let Some(bad) = c.rpms.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
-                return Err(invalid(
-                    format!("case[{k}].rpms"),
-                    bad.to_string(),
-                    "screw speeds in rev/min, finite and > 0",
-                ));
-            }
-            cases.push(SuiteCase {
-                file: c.file,
-                codes,
-                lambdas: c.lambdas,
-                cg_rules,
-                seeds: c.seeds,
-                angle_tolerance_deg,
-                time_ratio_tolerance,
-                front_tolerance,
-                wall_height_tolerance,
-                kinetic_energy_tolerance,
-                known_differences,
-                overrides,
-                variant: c.variant,
-                rpms: c.rpms,
-                keep_going: c.keep_going,
-            });
-        }
+        let cases = raw
+            .cases
+            .into_iter()
+            .enumerate()
+            .map(|(k, c)| parse_case(c, k, path))
+            .collect::<Result<Vec<_>, _>>()?;
         let accuracy = raw
             .accuracy
             .into_iter()
@@ -302,6 +161,7 @@ impl Suite {
         let stability = super::stability::parse_cases(raw.stability, path)?;
         if cases.is_empty() && accuracy.is_empty() && stability.is_empty() {
             return Err(invalid(
+                path,
                 "case".into(),
                 "(none)".into(),
                 "at least one [[case]], [[accuracy]] or [[stability]]",
@@ -315,6 +175,171 @@ impl Suite {
             accuracy,
             stability,
         })
+    }
+}
+
+/// `[[case]]` number `k` of the suite at `path`, checked.
+fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError> {
+    let invalid =
+        |field: String, value: String, allowed: &str| invalid(path, field, value, allowed);
+    let codes = parse_codes(&c.codes, &format!("case[{k}].codes"), path)?;
+    if codes.is_empty() {
+        return Err(invalid(
+            format!("case[{k}].codes"),
+            "[]".into(),
+            "at least one code",
+        ));
+    }
+    if c.lambdas.is_empty() || c.lambdas.iter().any(|l| !l.is_power_of_two()) {
+        return Err(invalid(
+            format!("case[{k}].lambdas"),
+            format!("{:?}", c.lambdas),
+            "one or more powers of two",
+        ));
+    }
+    if c.seeds.is_empty() {
+        return Err(invalid(
+            format!("case[{k}].seeds"),
+            "[]".into(),
+            "at least one insertion seed",
+        ));
+    }
+    let cg_rules = if c.cg_rules.is_empty() {
+        vec![CoarseGrainRule::Seed]
+    } else {
+        c.cg_rules
+            .iter()
+            .map(|name| {
+                CoarseGrainRule::from_name(name).ok_or_else(|| {
+                    invalid(
+                        format!("case[{k}].cg_rules"),
+                        format!("\"{name}\""),
+                        &rule_names(),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?
+    };
+    let angle_tolerance_deg = c.angle_tolerance_deg.unwrap_or(2.0);
+    if angle_tolerance_deg.is_nan() || angle_tolerance_deg <= 0.0 {
+        return Err(invalid(
+            format!("case[{k}].angle_tolerance_deg"),
+            angle_tolerance_deg.to_string(),
+            "a number of degrees > 0",
+        ));
+    }
+    let fraction = |field: &str, value: Option<f64>, default: f64| {
+        let v = value.unwrap_or(default);
+        if v.is_finite() && v > 0.0 && v < 1.0 {
+            Ok(v)
+        } else {
+            Err(invalid(
+                format!("case[{k}].{field}"),
+                v.to_string(),
+                "a fraction between 0 and 1 (exclusive)",
+            ))
+        }
+    };
+    let time_ratio_tolerance = fraction("time_ratio_tolerance", c.time_ratio_tolerance, 0.10)?;
+    let front_tolerance = fraction("front_tolerance", c.front_tolerance, 0.05)?;
+    let wall_height_tolerance = fraction("wall_height_tolerance", c.wall_height_tolerance, 0.05)?;
+    let kinetic_energy_tolerance =
+        fraction("kinetic_energy_tolerance", c.kinetic_energy_tolerance, 0.10)?;
+    let known_differences = c
+        .known_difference
+        .into_iter()
+        .enumerate()
+        .map(|(j, kd)| parse_known_difference(kd, k, j, path))
+        .collect::<Result<Vec<_>, _>>()?;
+    let overrides = parse_variant(&c.set, c.variant.as_deref(), &format!("case[{k}]"), path)?;
+    if let Some(bad) = c.rpms.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+        return Err(invalid(
+            format!("case[{k}].rpms"),
+            bad.to_string(),
+            "screw speeds in rev/min, finite and > 0",
+        ));
+    }
+    Ok(SuiteCase {
+        file: c.file,
+        codes,
+        lambdas: c.lambdas,
+        cg_rules,
+        seeds: c.seeds,
+        angle_tolerance_deg,
+        time_ratio_tolerance,
+        front_tolerance,
+        wall_height_tolerance,
+        kinetic_energy_tolerance,
+        known_differences,
+        overrides,
+        variant: c.variant,
+        rpms: c.rpms,
+        keep_going: c.keep_going,
+    })
+}
+
+/// The `j`th known difference of `[[case]]` number `k`, checked.
+fn parse_known_difference(
+    kd: RawKnownDifference,
+    k: usize,
+    j: usize,
+    path: &Path,
+) -> Result<KnownDifference, SuiteError> {
+    let invalid =
+        |field: String, value: String, allowed: &str| invalid(path, field, value, allowed);
+    let field = |f: &str| format!("case[{k}].known_difference[{j}].{f}");
+    if !CRITERIA.contains(&kd.criterion.as_str()) {
+        return Err(invalid(
+            field("criterion"),
+            format!("\"{}\"", kd.criterion),
+            "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\"",
+        ));
+    }
+    if !(kd.band[0].is_finite() && kd.band[1].is_finite() && kd.band[0] <= kd.band[1]) {
+        return Err(invalid(
+            field("band"),
+            format!("{:?}", kd.band),
+            "[low, high], finite, low <= high, in the criterion's units",
+        ));
+    }
+    if kd.reason.trim().is_empty() {
+        return Err(invalid(
+            field("reason"),
+            "\"\"".into(),
+            "why the codes or levels differ, in words",
+        ));
+    }
+    // The evidence is a file of the repository (paths from its root, as `file`).
+    if !Path::new(&kd.evidence).is_file() {
+        return Err(invalid(
+            field("evidence"),
+            format!("\"{}\"", kd.evidence),
+            "an existing file, relative to the repository root, that documents the difference",
+        ));
+    }
+    if kd.comparison.trim().is_empty() {
+        return Err(invalid(
+            field("comparison"),
+            "\"\"".into(),
+            "the start of a comparison's name, e.g. \"cgdem vs lammps\"",
+        ));
+    }
+    Ok(KnownDifference {
+        comparison: kd.comparison,
+        criterion: kd.criterion,
+        reason: kd.reason,
+        evidence: kd.evidence,
+        band: kd.band,
+    })
+}
+
+/// A suite field's bad value, with what is allowed.
+fn invalid(path: &Path, field: String, value: String, allowed: &str) -> SuiteError {
+    SuiteError::Invalid {
+        file: path.to_path_buf(),
+        field,
+        value,
+        allowed: allowed.into(),
     }
 }
 

@@ -7,8 +7,10 @@
 //! two sides estimated from their seeds (`sqrt(s_a^2/n_a + s_b^2/n_b)`; for a curve gap, the
 //! largest such error over time of the seed-mean curves). A side with one seed has no
 //! noise estimate: its noise counts as 0 and the criterion says so. A criterion declared a
-//! known difference (the suite's `known_difference`) is judged by its band instead: inside,
-//! "known difference"; outside, "fail". The row's verdict is its worst criterion's, and the
+//! known difference (the suite's `known_difference`) is judged by its band instead, widened
+//! on each side by the same `K * noise` (a band holds the expected value, and a mean over a
+//! few seeds scatters around it as much as around a tolerance): inside, "known difference";
+//! outside, "fail". The row's verdict is its worst criterion's, and the
 //! row names the criterion that decided it.
 
 use serde::Serialize;
@@ -58,6 +60,13 @@ impl KnownDifference {
     pub fn applies_to(&self, comparison: &str, criterion: &str) -> bool {
         comparison.starts_with(&self.comparison) && criterion == self.criterion
     }
+
+    /// Whether `value`, with the seeds' `noise`, lies in the band widened by `K_NOISE`
+    /// times the noise on each side.
+    pub fn holds(&self, value: f64, noise: f64) -> bool {
+        let allowance = K_NOISE * noise;
+        value >= self.band[0] - allowance && value <= self.band[1] + allowance
+    }
 }
 
 /// One sub-criterion of a comparison with its own verdict.
@@ -95,7 +104,7 @@ impl Criterion {
     ) -> Criterion {
         let threshold = tolerance + K_NOISE * noise;
         let verdict = match known {
-            Some(k) if value >= k.band[0] && value <= k.band[1] => Verdict::KnownDifference,
+            Some(k) if k.holds(value, noise) => Verdict::KnownDifference,
             Some(_) => Verdict::Fail,
             None if value <= threshold => Verdict::Pass,
             None => Verdict::Fail,
@@ -117,14 +126,8 @@ impl Criterion {
     /// known difference).
     fn margin(&self) -> f64 {
         match &self.known_difference {
-            Some(k) => {
-                let (lo, hi) = (k.band[0], k.band[1]);
-                if self.value > hi || self.value < lo {
-                    f64::INFINITY
-                } else {
-                    0.0
-                }
-            }
+            Some(k) if k.holds(self.value, self.noise) => 0.0,
+            Some(_) => f64::INFINITY,
             None if self.threshold > 0.0 => self.value / self.threshold,
             None => f64::INFINITY,
         }
@@ -142,13 +145,14 @@ impl Criterion {
         };
         match &self.known_difference {
             Some(k) => format!(
-                "{} {} {}: {}, band [{}, {}] ({}; evidence {}){seeds}",
+                "{} {} {}: {}, band [{}, {}] +- {K_NOISE} x noise {} ({}; evidence {}){seeds}",
                 self.name,
                 fmt(self.value),
                 self.unit,
                 self.verdict.name(),
                 fmt(k.band[0]),
                 fmt(k.band[1]),
+                fmt(self.noise),
                 k.reason,
                 k.evidence
             ),
@@ -256,6 +260,14 @@ mod tests {
         // Leaving the band downwards is a change too: the difference it documents is gone.
         let c = Criterion::judge("repose angle", "deg", 1.0, 0.5, [2, 2], 5.0, Some(&k));
         assert_eq!(c.verdict, Verdict::Fail);
+        // The band is widened by the seeds' noise as a tolerance is: 9.5 with noise 0.5 is
+        // inside [10 - 1, 20 + 1], 8.5 is not; 21.5 with noise 1 is inside [8, 22].
+        let c = Criterion::judge("repose angle", "deg", 9.5, 0.5, [2, 2], 5.0, Some(&k));
+        assert_eq!(c.verdict, Verdict::KnownDifference);
+        let c = Criterion::judge("repose angle", "deg", 8.5, 0.5, [2, 2], 5.0, Some(&k));
+        assert_eq!(c.verdict, Verdict::Fail);
+        let c = Criterion::judge("repose angle", "deg", 21.5, 1.0, [2, 2], 5.0, Some(&k));
+        assert_eq!(c.verdict, Verdict::KnownDifference);
         assert!(k.applies_to("cgdem vs lammps, lambda = 8 (seed)", "repose angle"));
         assert!(!k.applies_to("cgdem vs liggghts, lambda = 8 (seed)", "repose angle"));
         assert!(!k.applies_to("cgdem vs lammps, lambda = 8 (seed)", "front gap"));

@@ -6,9 +6,9 @@
 use std::path::Path;
 use std::sync::atomic::AtomicU64;
 
+use cgdem_harness::decks::dump::parse_dump;
+use cgdem_harness::decks::postprocess::log_timing;
 use cgdem_harness::history::{flags, night_metrics, parse_history};
-use cgdem_harness::lammps::dump::parse_dump;
-use cgdem_harness::lammps::postprocess::log_timing;
 use cgdem_harness::stability::LogFindings;
 use proptest::prelude::*;
 

@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use super::Body;
+use super::{Body, BodyLoad};
 use crate::geometry::{Bvh, FastWindingNumber, TriMesh};
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
@@ -63,6 +63,21 @@ impl KinematicParticles {
         id.checked_sub(self.first_id)
             .and_then(|k| self.reference.get(k as usize))
             .copied()
+    }
+
+    /// The load of the grains on this body's particles among the first `n` of `p`, after a
+    /// force evaluation: the contact force `F - m g` on each and its torque about `center`
+    /// (the body's axis point), summed in index order.
+    pub fn load(&self, p: &Particles, n: usize, gravity: Vec3, center: Vec3) -> BodyLoad {
+        let mut load = BodyLoad::default();
+        for k in 0..n {
+            if self.reference_of(p.id[k]).is_some() {
+                let f = p.force[k] - p.mass[k] * gravity;
+                load.force += f;
+                load.torque += (p.position[k] - center).cross(f);
+            }
+        }
+        load
     }
 
     /// Moves this body's particles among the first `n` of `p` to `body`'s pose: position
@@ -155,8 +170,8 @@ mod tests {
     use crate::domain::Domain;
     use crate::geometry::Aabb;
     use crate::particles::Particles;
-    use crate::simulation::{NeighborSettings, World};
-    use crate::walls::{WallSet, WcaWall};
+    use crate::simulation::{Decompose, NeighborSettings, World, WorldSetup};
+    use crate::walls::WcaWall;
 
     const R: Real = 0.675e-3;
 
@@ -202,17 +217,6 @@ mod tests {
             skin: 0.3 * 2.0 * R,
             resort_every: 1,
         };
-        let mut world = World::new(
-            particles,
-            domain,
-            WallSet { walls: vec![] },
-            law,
-            wall,
-            2,
-            Vec3::ZERO,
-            dt,
-            neighbor,
-        );
         let bounds = Aabb {
             min: Vec3::new(-0.01, -0.01, 0.0),
             max: Vec3::new(0.01, 0.01, 0.0),
@@ -223,13 +227,14 @@ mod tests {
             Motion::rotation_rpm(Vec3::Z, Vec3::ZERO, rpm),
         );
         body.start(0.0);
-        world.set_bodies(vec![body]);
-        world.set_kinematic(vec![KinematicParticles {
+        let mut setup = WorldSetup::new(particles, domain, law, wall, 2, Vec3::ZERO, dt, neighbor);
+        setup.bodies = vec![body];
+        setup.kinematic = vec![KinematicParticles {
             body: 0,
             first_id: 0,
             reference,
-        }]);
-        world
+        }];
+        World::new(setup, &Decompose::default()).expect("the ring fits its box")
     }
 
     #[test]
@@ -244,7 +249,8 @@ mod tests {
         }
         assert!(world.list_builds() > 10, "{}", world.list_builds());
         let t = world.time;
-        let p = &world.particles;
+        world.sync_particles();
+        let p = world.particles();
         assert_eq!(p.len(), n);
         for k in 0..n {
             let id = p.id[k] as usize;
@@ -269,7 +275,8 @@ mod tests {
         let grain = Vec3::new(0.01, 2.0 * R * 0.99, 0.0);
         let mut world = ring_world(6, 0.0, &[grain], 1e-9, false);
         world.step();
-        let p = &world.particles;
+        world.sync_particles();
+        let p = world.particles();
         let g = (0..p.len()).find(|&k| !p.is_frozen(k)).unwrap();
         let s = (0..p.len()).find(|&k| p.id[k] == 0).unwrap();
         let on_grain = p.force[g];
@@ -292,7 +299,7 @@ mod tests {
             world.step();
         }
         world.add_particles(0, &[Vec3::new(0.0, -0.03, 0.0)], R, 1e-6);
-        let mut ids = world.particles.id.clone();
+        let mut ids = world.particles().id.clone();
         ids.sort_unstable();
         ids.dedup();
         assert_eq!(ids.len(), 12);

@@ -51,6 +51,16 @@ impl std::fmt::Display for GridSpec {
 /// every subdomain face is a cut (the images cross it), on a bounded one the outer faces are
 /// not. Ties go to more cuts across x, then across y.
 pub fn choose_counts(count: usize, extent: Vec3, periodic: [bool; 3]) -> [usize; 3] {
+    choose_counts_uncut(count, extent, periodic, None)
+}
+
+/// [`choose_counts`] among the grids that do not cut axis `uncut` (if given).
+pub fn choose_counts_uncut(
+    count: usize,
+    extent: Vec3,
+    periodic: [bool; 3],
+    uncut: Option<usize>,
+) -> [usize; 3] {
     let mut best = ([count, 1, 1], Real::INFINITY);
     for nx in (1..=count).rev() {
         if !count.is_multiple_of(nx) {
@@ -61,6 +71,9 @@ pub fn choose_counts(count: usize, extent: Vec3, periodic: [bool; 3]) -> [usize;
                 continue;
             }
             let n = [nx, ny, count / nx / ny];
+            if uncut.is_some_and(|a| n[a] > 1) {
+                continue;
+            }
             let surface: Real = (0..3)
                 .map(|a| {
                     let cuts = if periodic[a] { n[a] } else { n[a] - 1 };
@@ -167,22 +180,17 @@ impl Grid {
         (lo, hi)
     }
 
-    /// Checks that ghosts of width `width` come from the adjacent subdomains only (each
-    /// subdomain at least `width` thick where it has neighbours on both sides; a periodic axis
-    /// that is not cut at least `width` long, its ghosts being its own images one period
-    /// away). Returns what is wrong, for the user. A cut periodic axis is then at least two
-    /// layers long; an uncut one may be shorter (see [`Grid::check_periodic_images`]).
+    /// Checks that ghosts of width `width` come from the adjacent subdomains only: each
+    /// subdomain at least `width` thick where it has neighbours on both sides (a cut periodic
+    /// axis is then at least two layers long). Returns what is wrong, for the user. A
+    /// periodic axis that is not cut has no ghosts (its pairs meet through images), and may
+    /// be as short as [`Grid::check_periodic_images`] allows.
     pub fn check_width(&self, width: Real) -> Result<(), String> {
         for a in 0..3 {
             let axis = ["x", "y", "z"][a];
-            let length = self.hi[a] - self.lo[a];
-            if self.periodic[a] && length < width {
-                return Err(format!(
-                    "the periodic {axis} axis ({length:.4e} m) is shorter than the ghost layer ({width:.4e} m: the largest diameter plus the contact reach plus the skin); use a longer box"
-                ));
-            }
             for c in 0..self.counts[a] {
-                let interior = self.periodic[a] || (c > 0 && c + 1 < self.counts[a]);
+                let cut = self.counts[a] > 1;
+                let interior = (self.periodic[a] && cut) || (c > 0 && c + 1 < self.counts[a]);
                 if !interior {
                     continue;
                 }
@@ -201,13 +209,30 @@ impl Grid {
         Ok(())
     }
 
-    /// The subdomains adjacent to `index` (itself included through periodic images), each
-    /// with the shift that takes a position from `index`'s frame into the neighbour's:
-    /// one entry per offset in {-1, 0, 1}^3 that stays inside bounded axes, except
+    /// Whether axis `a` is periodic and not cut: each subdomain spans it alone, and its pairs
+    /// across it meet through images, not ghosts.
+    pub fn spans_periodic(&self, a: usize) -> bool {
+        self.periodic[a] && self.counts[a] == 1
+    }
+
+    /// The box a subdomain's list searches: periodic where the subdomain spans a periodic
+    /// axis alone, bounded (spanning the particles) elsewhere.
+    pub fn list_box(&self) -> Domain {
+        Domain {
+            lo: self.lo,
+            hi: self.hi,
+            periodic: std::array::from_fn(|a| self.spans_periodic(a)),
+        }
+    }
+
+    /// The subdomains adjacent to `index` (a subdomain can be its own neighbour across a
+    /// cut periodic axis of two), each with the shift that takes a position from `index`'s
+    /// frame into the neighbour's: one entry per offset in {-1, 0, 1}^3 that stays inside
+    /// bounded axes and is 0 along the periodic axes not cut (no ghosts there), except
     /// `(index, 0)`. Fixed order (z, y, x offsets increasing).
     /// Checks that a particle touches a partner through one periodic image at most: every
-    /// periodic axis at least twice `contact` (the largest contact distance) long, as the
-    /// undecomposed world's minimum image needs. On an axis shorter than two ghost layers a
+    /// periodic axis at least twice `contact` (the largest contact distance) long, as a
+    /// minimum image needs. On an axis shorter than two ghost layers a
     /// subdomain then lists a partner through both images, but the farther one never comes
     /// within contact: its pair gives no force and its history stays at rest.
     pub fn check_periodic_images(&self, contact: Real) -> Result<(), String> {
@@ -237,7 +262,10 @@ impl Grid {
                     for a in 0..3 {
                         let n = self.counts[a] as i64;
                         let v = c[a] as i64 + offset[a];
-                        if self.periodic[a] {
+                        if self.spans_periodic(a) {
+                            inside &= offset[a] == 0;
+                            t[a] = 0;
+                        } else if self.periodic[a] {
                             t[a] = v.rem_euclid(n) as usize;
                             shift[a] = -(v.div_euclid(n) as Real) * length[a];
                         } else if v < 0 || v >= n {
@@ -331,19 +359,24 @@ mod tests {
     }
 
     #[test]
-    fn neighbours_include_periodic_images_of_oneself_and_not_beyond_bounded_faces() {
+    fn neighbours_cross_cut_periodic_axes_and_not_uncut_ones_nor_bounded_faces() {
         let domain = Domain {
             lo: Vec3::ZERO,
             hi: Vec3::splat(1.0),
             periodic: [true, false, false],
         };
+        // x periodic and not cut: no neighbours across it (pairs meet through images); y:
+        // the other subdomain; z: none.
         let grid = Grid::balanced([1, 2, 1], &domain, &[]);
-        let n = grid.neighbours(0);
-        // x: self at -1 and +1 images; y: the other subdomain (0 or 1 offset); z: none.
-        assert_eq!(n.len(), 5);
-        assert!(n.contains(&(0, Vec3::new(1.0, 0.0, 0.0))));
-        assert!(n.contains(&(0, Vec3::new(-1.0, 0.0, 0.0))));
+        assert_eq!(grid.neighbours(0), vec![(1, Vec3::ZERO)]);
+        assert!(grid.spans_periodic(0) && !grid.spans_periodic(1));
+        // x periodic and cut in two: the other subdomain on both sides, through an image on
+        // one of them.
+        let cut = Grid::balanced([2, 1, 1], &domain, &[]);
+        let n = cut.neighbours(0);
+        assert_eq!(n.len(), 2);
         assert!(n.contains(&(1, Vec3::ZERO)));
+        assert!(n.contains(&(1, Vec3::new(1.0, 0.0, 0.0))));
     }
 
     #[test]
@@ -359,10 +392,9 @@ mod tests {
             .check_width(0.34)
             .unwrap_err()
             .contains("subdomain 2 along x"));
-        // An uncut periodic axis needs one ghost layer, and two contact distances.
+        // An uncut periodic axis has no ghost layer; it needs two contact distances.
         let one = Grid::balanced([1, 1, 1], &domain, &[]);
-        assert!(one.check_width(0.6).is_ok());
-        assert!(one.check_width(1.1).unwrap_err().contains("periodic y"));
+        assert!(one.check_width(1.1).is_ok());
         assert!(one.check_periodic_images(0.5).is_ok());
         let e = one.check_periodic_images(0.55).unwrap_err();
         assert!(

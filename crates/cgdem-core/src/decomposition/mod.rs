@@ -25,8 +25,9 @@ pub mod borders;
 pub mod exchange;
 pub mod forward;
 pub mod grid;
-pub mod list;
+pub mod placement;
 pub mod rebalance;
+pub mod removal;
 pub mod state;
 pub mod step;
 pub mod team;
@@ -39,13 +40,18 @@ pub use transport::Comm;
 
 use crate::contact::PairHistory;
 use crate::math::{Real, Vec3};
+pub use crate::neighbor::HistoryRows;
+use crate::neighbor::PairList;
 use crate::particles::Particles;
 
-/// What `summary.json` says of a decomposed run (`--grid`, issue 23).
+/// What `summary.json` says of a run's subdomains.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct DecompositionSummary {
     /// Subdomains along x, y, z.
     pub grid: [usize; 3],
+    /// Why: `--grid` given, or chosen from the scene (and by which rule).
+    #[serde(default)]
+    pub grid_reason: String,
     /// MPI ranks (1: threads in one process).
     pub ranks: usize,
     /// Owned particles per subdomain at the end.
@@ -76,71 +82,6 @@ pub struct DecompositionSummary {
     pub bytes_sent_between_ranks_per_step: Real,
 }
 
-/// Per owned particle, the contact histories of its pairs keyed by the partner's id (LAMMPS
-/// `fix neigh/history`'s partner lists, kept with both particles of a pair when newton is
-/// off): they travel with the particle in an exchange and seed the new list's histories.
-/// Histories are in the pair's canonical orientation (lower id first), so both copies are
-/// equal and never mirrored.
-#[derive(Clone, Debug)]
-pub struct HistoryRows<H> {
-    /// Rows of particle `k` are `rows[start[k]..start[k + 1]]`, sorted by partner id.
-    pub start: Vec<u32>,
-    pub rows: Vec<(u32, H)>,
-}
-
-impl<H> Default for HistoryRows<H> {
-    fn default() -> Self {
-        HistoryRows {
-            start: vec![0],
-            rows: Vec::new(),
-        }
-    }
-}
-
-impl<H: PairHistory> HistoryRows<H> {
-    pub fn len(&self) -> usize {
-        self.start.len() - 1
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    pub fn of(&self, k: usize) -> &[(u32, H)] {
-        &self.rows[self.start[k] as usize..self.start[k + 1] as usize]
-    }
-
-    /// Appends a particle with `rows` (sorted by partner id).
-    pub fn push(&mut self, rows: &[(u32, H)]) {
-        self.rows.extend_from_slice(rows);
-        self.start.push(self.rows.len() as u32);
-    }
-
-    /// The history of the pair with `partner`, if the particle has one.
-    pub fn find(&self, k: usize, partner: u32) -> Option<H> {
-        let rows = self.of(k);
-        rows.binary_search_by_key(&partner, |r| r.0)
-            .ok()
-            .map(|at| rows[at].1)
-    }
-
-    /// Rows from per-particle lists of `(particle, partner, history)`, `n` particles.
-    pub fn from_entries(n: usize, mut entries: Vec<(u32, u32, H)>) -> Self {
-        entries.sort_unstable_by_key(|e| (e.0, e.1));
-        let mut start = vec![0u32; n + 1];
-        for e in &entries {
-            start[e.0 as usize + 1] += 1;
-        }
-        for k in 0..n {
-            start[k + 1] += start[k];
-        }
-        HistoryRows {
-            start,
-            rows: entries.into_iter().map(|e| (e.1, e.2)).collect(),
-        }
-    }
-}
-
 /// One subdomain: its bounds, its owned particles (first `n_owned` entries of `particles`)
 /// followed by its ghosts, and what it needs to rebuild and step.
 #[derive(Clone, Debug)]
@@ -158,10 +99,14 @@ pub struct Subdomain<H, WH> {
     pub sends: Vec<borders::SendList>,
     /// The send lists this subdomain's ghosts come from, in ghost order: (subdomain, list).
     pub receives: Vec<(usize, usize)>,
-    pub list: list::LocalList<H>,
+    pub list: PairList<H>,
     /// Per owned particle, per body: where it needs no SDF lookup (as the world's; not
     /// stored in restart files).
     pub body_clearances: Vec<crate::bodies::Clearance>,
+    /// Per owned particle, the walls it may reach before the next list build; made by the
+    /// first force pass after a build (not stored in restart files: any pass makes them
+    /// right, they only spare looking at walls out of reach).
+    pub near_walls: Vec<crate::walls::WallMask>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
@@ -177,8 +122,9 @@ impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
             rows: HistoryRows::default(),
             sends: Vec::new(),
             receives: Vec::new(),
-            list: list::LocalList::default(),
+            list: PairList::default(),
             body_clearances: Vec::new(),
+            near_walls: Vec::new(),
         }
     }
 

@@ -256,7 +256,16 @@ mod tests {
             assert!(before > 1.5, "{counts:?}: crowded start {before}");
             d.rebalance(&domain(), &keep);
             assert_eq!(d.balance.shifts, 1, "{counts:?}");
-            d.rebuild(&domain(), 1, &keep, false);
+            let the_box = domain();
+            let rule = crate::decomposition::removal::RemovalRule {
+                domain: &the_box,
+                delete_regions: &[],
+                stop_on_lost: false,
+                tripped: false,
+                gravity: Vec3::ZERO,
+                origin: Vec3::ZERO,
+            };
+            d.rebuild(&rule, 1, false);
             let after = d.owned_counts();
             assert_eq!(after.iter().sum::<u64>(), 3000);
             // Per axis the slabs are balanced to 2%; a grid cut along two axes multiplies

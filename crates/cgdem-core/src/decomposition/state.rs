@@ -11,11 +11,11 @@ use serde::{Deserialize, Serialize};
 use super::balance::Balance;
 use super::borders::SendList;
 use super::forward::States;
-use super::list::LocalList;
 use super::step::Decomposition;
 use super::{Comm, Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
 use crate::math::Real;
+use crate::neighbor::PairList;
 use crate::particles::Particles;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -42,7 +42,7 @@ struct SubdomainOut<'a, H: Serialize, WH: Serialize> {
     wall_history: &'a [WH],
     sends: &'a [SendList],
     receives: &'a [(usize, usize)],
-    list: &'a LocalList<H>,
+    list: &'a PairList<H>,
     capacities: Vec<usize>,
     /// The subdomain's forward buffers (one per send list).
     buffers: Vec<usize>,
@@ -56,7 +56,7 @@ struct SubdomainState<H, WH> {
     wall_history: Vec<WH>,
     sends: Vec<SendList>,
     receives: Vec<(usize, usize)>,
-    list: LocalList<H>,
+    list: PairList<H>,
     capacities: Vec<usize>,
     buffers: Vec<usize>,
 }
@@ -76,8 +76,9 @@ macro_rules! subdomain_arrays {
         $m!($s.wall_history);
         $m!($s.receives);
         $m!($s.list.pairs);
-        $m!($s.list.out_start);
         $m!($s.list.history);
+        $m!($s.list.image_pairs);
+        $m!($s.list.image_history);
         $m!($s.list.reference);
         if let Some(a) = $s.particles.angular.$angular() {
             $m!(a.omega);
@@ -224,7 +225,6 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             total,
             bytes_sent,
             balance,
-            kinematic_loads: Vec::new(),
             buffers,
             forward_counts: None,
         })
@@ -288,14 +288,10 @@ fn check<H, WH>(
     }
     let l = &s.list;
     if l.reference.len() != owned
-        || l.out_start.len() != owned + 1
         || l.history.len() != l.pairs.len()
-        || l.out_start
-            .last()
-            .is_some_and(|&e| e as usize != l.pairs.len())
-        || l.pairs
-            .iter()
-            .any(|&[i, j]| i as usize >= n || j as usize >= n)
+        || l.image_history.len() != l.image_pairs.len()
+        || l.each()
+            .any(|([i, j], _, _)| i as usize >= n || j as usize >= n)
     {
         return bad("its pair list does not match its particles");
     }

@@ -1,45 +1,43 @@
-//! The decomposed world: subdomains stepped each on its own task (velocity Verlet), with
-//! the four phases of communication between them, and the global arrays the outputs read
-//! kept as the subdomains' owned particles side by side.
+//! The step of the subdomains: each stepped on the thread (or rank) that owns it, with the
+//! four phases of communication between them. The world asks for the three parts of a step
+//! in turn: `Decomposition::advance` (the first half of the integrator), a
+//! `Decomposition::rebuild` when a particle moved past half the skin, and
+//! `Decomposition::forces` (then the second half). The owned particles of all subdomains
+//! side by side are what the outputs read (`Decomposition::gathered`).
 
 use super::balance::{imbalance, Balance};
 use super::borders::borders;
 use super::exchange::exchange;
 use super::forward::{pack, unpack, States};
-use super::list::LocalList;
+use super::removal::{RemovalRule, Removals};
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
 use crate::bodies::{Body, BodyLoad, Clearance, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
-use crate::domain::{Domain, NO_IMAGE};
-use crate::force::{
-    body_force, body_force_and_torque, larger, pair_force, ForceView, Owner, ParticleState,
-};
+use crate::domain::Domain;
+use crate::force::{larger, pair_force, AloneSlots, ForceView, Owner, ParticleState, Surroundings};
 use crate::geometry::aabb::in_delete_region;
 use crate::geometry::Aabb;
-use crate::integrate::{pcvv, Integrator};
+use crate::integrate::{closing_kick, drift_kick, kick, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::memory_use::MemoryUse;
-use crate::neighbor::{CellGrid, Pair};
+use crate::neighbor::{CellGrid, PairList};
 use crate::particles::Particles;
-use crate::walls::{WallLaw, WallParticle, WallSet};
+use crate::walls::{WallLaw, WallParticle};
 
 /// The laws and what acts on a particle alone, for one force pass.
-pub struct Physics<'a, L, W> {
-    pub law: &'a L,
-    pub wall_law: &'a W,
-    pub walls: &'a WallSet,
-    /// Posed at the step's end; their history slots follow the walls'.
-    pub bodies: &'a [Body],
+pub(crate) struct Physics<'a, L, W> {
+    pub(crate) law: &'a L,
+    /// Gravity, walls and bodies (posed at the step's end; their history slots follow the
+    /// walls'), with the wall law and the step.
+    pub(crate) surroundings: Surroundings<'a, W>,
     /// The particles of bodies built of particles, whose load goes to their bodies.
-    pub kinematic: &'a [KinematicParticles],
-    pub gravity: Vec3,
-    pub n_species: usize,
-    pub dt: Real,
-    pub wall_slots: usize,
-    pub rotates: bool,
+    pub(crate) kinematic: &'a [KinematicParticles],
+    pub(crate) n_species: usize,
+    pub(crate) wall_slots: usize,
+    pub(crate) rotates: bool,
 }
 
 /// What moves or removes particles in a step besides the integrator.
@@ -129,8 +127,6 @@ pub struct Decomposition<H, WH> {
     pub bytes_sent: u64,
     /// Whether and how the cut planes follow the particles, and what it saw.
     pub balance: Balance,
-    /// Per group of body particles, their load at the last force pass (over all ranks).
-    pub kinematic_loads: Vec<BodyLoad>,
     pub(super) buffers: Vec<Vec<States>>,
     /// Words each rank sends here in a forward, fixed between rebuilds.
     pub(super) forward_counts: Option<Vec<usize>>,
@@ -183,7 +179,6 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             comm,
             total: particles.len(),
             bytes_sent: 0,
-            kinematic_loads: Vec::new(),
             buffers: Vec::new(),
             forward_counts: None,
         };
@@ -200,10 +195,12 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         }
         self.bytes_sent += borders(&mut self.subdomains, &self.grid, width, &self.comm);
         self.forward_counts = None;
-        let extra = self.extra;
+        let (extra, list_box) = (self.extra, self.grid.list_box());
         self.comm.each_owned(&mut self.subdomains, |sub| {
-            sub.list = LocalList::build(sub, extra, width);
+            let p = &sub.particles;
+            sub.list = PairList::build(p, sub.n_owned, &sub.rows, extra, width, &list_box);
             sub.rows = HistoryRows::default();
+            sub.near_walls.clear();
         });
         self.builds += 1;
     }
@@ -216,25 +213,38 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             .filter(move |sub| comm.owns(sub.index, count))
     }
 
-    /// A list rebuild: histories into rows, the cut planes moved if the balance asks,
-    /// exchange (dropping particles `keep` refuses), borders, lists.
-    pub fn rebuild(
+    /// A list rebuild: the particles `rule` removes (or reports) gathered from every
+    /// subdomain in order, histories into rows, the cut planes moved if the balance asks,
+    /// exchange (dropping the removed particles), borders, lists.
+    pub(crate) fn rebuild(
         &mut self,
-        domain: &Domain,
+        rule: &RemovalRule<'_>,
         wall_slots: usize,
-        keep: &(impl Fn(Vec3) -> bool + Sync),
         resort: bool,
-    ) {
+    ) -> Removals {
+        let events = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                let sub = &self.subdomains[s];
+                for k in 0..sub.n_owned {
+                    rule.record(&sub.particles, k, out);
+                }
+            });
+        let mut removals = Removals::default();
+        for words in &events {
+            removals.add_words(words);
+        }
         self.comm.each_owned(&mut self.subdomains, |sub| {
             sub.rows = sub.list.rows(&sub.particles.id, sub.n_owned);
         });
-        self.rebalance(domain, keep);
+        let keep = |x: Vec3| rule.keeps(x);
+        self.rebalance(rule.domain, &keep);
         self.bytes_sent += exchange(
             &mut self.subdomains,
             &self.grid,
-            domain,
+            rule.domain,
             wall_slots,
-            keep,
+            &keep,
             &self.comm,
         );
         self.borders_and_lists(resort);
@@ -249,6 +259,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             // The planes never moved: the owned counts are the static split's.
             b.static_worst = b.static_worst.max(now);
         }
+        removals
     }
 
     /// The owned particles of all subdomains side by side (the world's arrays after a
@@ -341,18 +352,52 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         rows
     }
 
+    /// What `summary.json` says of the grid: `reason` it is what it is, the particles per
+    /// subdomain, the imbalance, the balance's record (`keep`: the particles the next
+    /// rebuild keeps, for what the start's planes would give now) and the bytes sent between
+    /// ranks per step over `steps`. Collective under MPI.
+    pub fn summary(
+        &self,
+        reason: &str,
+        steps: u64,
+        domain: &Domain,
+        keep: &(impl Fn(Vec3) -> bool + Sync),
+    ) -> super::DecompositionSummary {
+        let counts: Vec<usize> = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                out.push(self.subdomains[s].n_owned as Real)
+            })
+            .iter()
+            .map(|w| w[0] as usize)
+            .collect();
+        let mean = counts.iter().sum::<usize>() as Real / counts.len().max(1) as Real;
+        let most = counts.iter().copied().max().unwrap_or(0) as Real;
+        let bytes = self.comm.sum(self.bytes_sent) as Real;
+        let b = &self.balance;
+        let static_now = imbalance(&self.counts_over(&[&b.start], domain, keep)[0]);
+        super::DecompositionSummary {
+            grid: self.grid.counts,
+            grid_reason: reason.to_string(),
+            ranks: self.comm.size(),
+            subdomain_particles: counts,
+            imbalance: if mean > 0.0 { most / mean } else { 1.0 },
+            bytes_sent_between_ranks_per_step: bytes / steps.max(1) as Real,
+            balance_threshold: b.threshold,
+            shifts: b.shifts,
+            imbalance_max_after_first_shift: b.worst_after_first_shift,
+            static_imbalance: static_now,
+            static_imbalance_max: b.static_worst.max(static_now),
+        }
+    }
+
     /// The first half of a step of `integrator` for the owned particles (velocity
     /// Verlet's half kick and drift, or PCVV's predictor), then the particles of bodies
     /// built of particles moved to their bodies' pose, and the new states packed for the
     /// ghosts, in one pass per subdomain. Whether a rebuild is due, on any rank: a particle
     /// moved past half the skin, or entered one of the delete regions (the rebuild removes
-    /// it, at the step the undecomposed run does); then the packed states are not used.
-    pub fn advance_and_pack(
-        &mut self,
-        dt: Real,
-        integrator: Integrator,
-        drive: &Drive<'_>,
-    ) -> bool {
+    /// it); then the packed states are not used.
+    pub(crate) fn advance(&mut self, dt: Real, integrator: Integrator, drive: &Drive<'_>) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
         let regions = drive.delete_regions;
         self.buffers.resize_with(self.subdomains.len(), Vec::new);
@@ -360,23 +405,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         let due = self
             .comm
             .each_owned(&mut with_buffers, |(sub, out)| {
-                let pcvv = integrator == Integrator::Pcvv;
-                let mut moved = if pcvv {
-                    predict(sub, dt, drive.rotates);
-                    false
-                } else {
-                    drift_kick(sub, dt, limit_sq)
-                };
-                // PCVV's predictor has no displacement test of its own.
-                if pcvv || !drive.kinematic.is_empty() {
-                    // The test runs again once the body particles have moved.
-                    drive_kinematic(sub, drive);
-                    let p = &sub.particles.position[..sub.n_owned];
-                    moved = p
-                        .iter()
-                        .zip(&sub.list.reference)
-                        .any(|(&x, &r)| (x - r).length_squared() > limit_sq);
-                }
+                let moved = first_half(sub, dt, integrator, drive, limit_sq);
                 pack(sub, out);
                 let p = &sub.particles.position[..sub.n_owned];
                 moved || (!regions.is_empty() && p.iter().any(|&x| in_delete_region(regions, x)))
@@ -387,32 +416,27 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         self.comm.any(due)
     }
 
-    /// The ghosts take the states `advance_and_pack` packed (`forward`), then forces and
-    /// the closing half kick: see `forces`.
-    pub fn forward_and_forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
-        &mut self,
-        physics: &Physics<'_, L, W>,
-        closing: Integrator,
-    ) -> ForceSums {
-        let subs = &self.subdomains;
-        self.bytes_sent += self.comm.route(
-            &mut self.buffers,
-            |from, list, _| subs[from].sends[list].to,
-            &mut self.forward_counts,
-        );
-        self.pass(physics, Some(closing), true)
-    }
-
     /// Forces on the owned particles, then the second half of a step of `closing` if
-    /// given (velocity Verlet's closing half kick, or PCVV's corrector). The world's arrays
-    /// are not touched: `gathered` brings the owned particles when they are read. Returns
-    /// the deepest overlaps, finiteness and body loads over all subdomains of all ranks.
-    pub fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
+    /// given (velocity Verlet's closing half kick, or PCVV's corrector). With `forwarded`
+    /// the ghosts first take the states `advance` packed (`forward`: no rebuild this
+    /// step). The world's arrays are not touched: `gathered` brings the owned particles
+    /// when they are read. Returns the deepest overlaps, finiteness and body loads over all
+    /// subdomains of all ranks.
+    pub(crate) fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         closing: Option<Integrator>,
+        forwarded: bool,
     ) -> ForceSums {
-        self.pass(physics, closing, false)
+        if forwarded {
+            let subs = &self.subdomains;
+            self.bytes_sent += self.comm.route(
+                &mut self.buffers,
+                |from, list, _| subs[from].sends[list].to,
+                &mut self.forward_counts,
+            );
+        }
+        self.pass(physics, closing, forwarded)
     }
 
     /// One pass per owned subdomain: unpack the ghosts' states (if `unpack_ghosts`),
@@ -425,12 +449,12 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         unpack_ghosts: bool,
     ) -> ForceSums {
         let count = self.subdomains.len();
-        let (comm, buffers) = (&self.comm, &self.buffers);
+        let (comm, buffers, skin) = (&self.comm, &self.buffers, self.skin);
         let mine: Vec<Option<ForceSums>> = comm.each_owned(&mut self.subdomains, |sub| {
             if unpack_ghosts {
                 unpack(sub, buffers);
             }
-            forces_and_closing(sub, physics, closing)
+            forces_and_closing(sub, physics, closing, skin)
         });
         let in_order = |all: Vec<ForceSums>| {
             all.into_iter()
@@ -440,7 +464,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         if !comm.is_distributed() {
             return in_order(mine.into_iter().flatten().collect());
         }
-        if physics.bodies.is_empty() && physics.kinematic.is_empty() {
+        if physics.surroundings.bodies.is_empty() && physics.kinematic.is_empty() {
             let here = in_order(mine.into_iter().flatten().collect());
             // One reduction for the three (max is exact in any order).
             let finite = if here.finite { 0.0 } else { 1.0 };
@@ -458,7 +482,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         let per_sub = comm.gather_by_subdomain(count, |s, out| {
             mine[s].as_ref().expect("owned here").write(out)
         });
-        let bodies = physics.bodies.len();
+        let bodies = physics.surroundings.bodies.len();
         in_order(per_sub.iter().map(|w| ForceSums::read(w, bodies)).collect())
     }
 
@@ -496,14 +520,11 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 out.push({
                     let p = &sub.particles;
                     sub.list
-                        .pairs
-                        .iter()
-                        .filter(|&&[i, j]| {
-                            (j as usize) < sub.n_owned || p.id[i as usize] < p.id[j as usize]
-                        })
-                        .map(|&[i, j]| {
+                        .each()
+                        .filter(|&([a, _], _, _)| (a as usize) < sub.n_owned)
+                        .map(|([i, j], shift, _)| {
                             let (i, j) = (i as usize, j as usize);
-                            let distance = (p.position[i] - p.position[j]).length();
+                            let distance = (p.position[i] - (p.position[j] + shift)).length();
                             let species_pair =
                                 p.species[i] as usize * n_species + p.species[j] as usize;
                             law.elastic_energy(species_pair, p.radius[i], p.radius[j], distance)
@@ -512,6 +533,39 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 })
             });
         per_sub.iter().map(|w| w[0]).sum()
+    }
+
+    /// Every listed pair once, by id (lower first), with its contact history: owned pairs,
+    /// and pairs with a ghost from the side of the lower id; gathered from every rank, in
+    /// subdomain and list order (for tests and diagnostics).
+    pub fn pair_histories(&self) -> Vec<(u32, u32, H)> {
+        let per_sub = self
+            .comm
+            .gather_by_subdomain(self.subdomains.len(), |s, out| {
+                let sub = &self.subdomains[s];
+                let id = &sub.particles.id;
+                let (mut ids, mut histories) = (Vec::new(), Vec::new());
+                for ([a, b], _, &h) in sub.list.each() {
+                    if (a as usize) < sub.n_owned {
+                        ids.extend_from_slice(&[id[a as usize] as Real, id[b as usize] as Real]);
+                        histories.push(h);
+                    }
+                }
+                out.push(histories.len() as Real);
+                out.extend_from_slice(&ids);
+                write_histories(&histories, out);
+            });
+        let mut all = Vec::new();
+        for words in per_sub {
+            let n = words[0] as usize;
+            let ids = &words[1..1 + 2 * n];
+            let mut rest = &words[1 + 2 * n..];
+            let histories: Vec<H> = read_histories(&mut rest);
+            for (pair, h) in ids.chunks_exact(2).zip(histories) {
+                all.push((pair[0] as u32, pair[1] as u32, h));
+            }
+        }
+        all
     }
 
     /// The arrays of the subdomains this rank steps: particles (owned and ghosts), wall
@@ -534,13 +588,16 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             m.particle_bytes += sub.particles.array_bytes()
                 + bytes(&sub.wall_history)
                 + bytes(&sub.body_clearances)
-                + bytes(&sub.list.out_start)
                 + bytes(&sub.list.reference)
                 + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
                 + bytes(&sub.receives);
-            m.pairs += sub.list.pairs.len();
-            m.pair_bytes += bytes(&sub.list.pairs) + bytes(&sub.list.history);
-            m.history_entries += sub.list.history.len();
+            let l = &sub.list;
+            m.pairs += l.len();
+            m.pair_bytes += bytes(&l.pairs)
+                + bytes(&l.history)
+                + bytes(&l.image_pairs)
+                + bytes(&l.image_history);
+            m.history_entries += l.len();
         }
         m.particle_bytes += self
             .buffers
@@ -553,7 +610,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
 
     /// Pairs listed over all subdomains (a pair across a boundary twice).
     pub fn listed_pairs(&self) -> usize {
-        let here: usize = self.owned().map(|s| s.list.pairs.len()).sum();
+        let here: usize = self.owned().map(|s| s.list.len()).sum();
         self.comm.sum(here as u64) as usize
     }
 
@@ -587,61 +644,57 @@ fn resort_by_cell<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, c
     }
 }
 
-/// `v += dt/2 F/m; x += dt v` (and the spin's half kick) for the owned particles; whether
-/// one moved farther than `sqrt(limit_sq)` from its position at the last build.
-fn drift_kick<H: PairHistory, WH: PairHistory>(
+/// The first half of a step of `integrator` for `sub`'s owned particles (velocity Verlet's
+/// half kick and drift, or PCVV's predictor), then the particles of bodies built of
+/// particles moved to their bodies' pose; whether one moved farther than
+/// `sqrt(limit_sq)` from its position at the last build.
+fn first_half<H: PairHistory, WH: PairHistory>(
     sub: &mut Subdomain<H, WH>,
     dt: Real,
+    integrator: Integrator,
+    drive: &Drive<'_>,
     limit_sq: Real,
 ) -> bool {
-    let half = 0.5 * dt;
     let n = sub.n_owned;
     let p = &mut sub.particles;
-    let mut moved = false;
-    for k in 0..n {
-        p.velocity[k] += half * p.inv_mass[k] * p.force[k];
-        p.position[k] += dt * p.velocity[k];
-        moved |= (p.position[k] - sub.list.reference[k]).length_squared() > limit_sq;
-    }
-    if let Some(a) = p.angular.as_mut() {
-        for k in 0..n {
-            a.omega[k] += half * a.inv_inertia[k] * a.torque[k];
+    let reference = &sub.list.reference;
+    let (position, velocity) = (&mut p.position[..n], &mut p.velocity[..n]);
+    let mut moved = match integrator {
+        Integrator::VelocityVerlet => drift_kick(
+            position,
+            velocity,
+            &p.force,
+            &p.inv_mass,
+            reference,
+            limit_sq,
+            dt,
+        ),
+        Integrator::Pcvv => {
+            pcvv::predict(position, velocity, &p.force[..n], &p.inv_mass[..n], dt);
+            false
+        }
+    };
+    if let Some(a) = p.angular.as_mut().filter(|_| drive.rotates) {
+        let (omega, torque, inv_inertia) = (&mut a.omega[..n], &a.torque[..n], &a.inv_inertia);
+        match integrator {
+            Integrator::VelocityVerlet => {
+                kick(omega, torque, inv_inertia, 0.5 * dt);
+            }
+            Integrator::Pcvv => pcvv::predict_rate(omega, torque, &inv_inertia[..n], dt),
         }
     }
-    moved
-}
-
-/// Moves the owned particles of bodies built of particles to their bodies' pose.
-fn drive_kinematic<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, drive: &Drive<'_>) {
-    for group in drive.kinematic {
-        group.drive(&drive.bodies[group.body], &mut sub.particles, sub.n_owned);
+    // The body particles move after the drift, and PCVV's predictor has no displacement
+    // test of its own: the test runs (again) on the final positions.
+    if integrator == Integrator::Pcvv || !drive.kinematic.is_empty() {
+        for group in drive.kinematic {
+            group.drive(&drive.bodies[group.body], p, n);
+        }
+        moved = p.position[..n]
+            .iter()
+            .zip(reference)
+            .any(|(&x, &r)| (x - r).length_squared() > limit_sq);
     }
-}
-
-/// Per group of body particles, the load of the grains on its owned particles here:
-/// contact force `F - m g` on each and its torque about the body's axis point (as
-/// `World::record_kinematic_loads`).
-fn kinematic_loads<H: PairHistory, WH: PairHistory, L, W>(
-    sub: &Subdomain<H, WH>,
-    physics: &Physics<'_, L, W>,
-) -> Vec<BodyLoad> {
-    let p = &sub.particles;
-    physics
-        .kinematic
-        .iter()
-        .map(|group| {
-            let center = physics.bodies[group.body].center();
-            let mut load = BodyLoad::default();
-            for k in 0..sub.n_owned {
-                if group.reference_of(p.id[k]).is_some() {
-                    let f = p.force[k] - p.mass[k] * physics.gravity;
-                    load.force += f;
-                    load.torque += (p.position[k] - center).cross(f);
-                }
-            }
-            load
-        })
-        .collect()
+    moved
 }
 
 /// Forces on `sub`'s owned particles, the load on the particles of bodies built of
@@ -651,223 +704,181 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
     closing: Option<Integrator>,
+    skin: Real,
 ) -> ForceSums {
+    let n = sub.n_owned;
     // PCVV's F0 and T0: the forces of the last step, which travel with their particles in
     // an exchange.
     let old = (closing == Some(Integrator::Pcvv)).then(|| {
-        let n = sub.n_owned;
         let p = &sub.particles;
         let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
         (p.force[..n].to_vec(), torque)
     });
-    let mut sums = forces(sub, physics);
-    sums.kinematic_loads = kinematic_loads(sub, physics);
+    let mut sums = forces(sub, physics, skin);
+    let (p, gravity) = (&sub.particles, physics.surroundings.gravity);
+    sums.kinematic_loads = physics
+        .kinematic
+        .iter()
+        .map(|group| {
+            let center = physics.surroundings.bodies[group.body].center();
+            group.load(p, n, gravity, center)
+        })
+        .collect();
+    let dt = physics.surroundings.dt;
+    let p = &mut sub.particles;
+    let spins = p.angular.as_mut().filter(|_| physics.rotates);
     sums.finite = match closing {
         None => true,
-        Some(Integrator::VelocityVerlet) => closing_kick(sub, physics.dt),
+        Some(Integrator::VelocityVerlet) => {
+            let mut finite = closing_kick(&mut p.velocity[..n], &p.force, &p.inv_mass, dt);
+            if let Some(a) = spins {
+                finite &= closing_kick(&mut a.omega[..n], &a.torque, &a.inv_inertia, dt);
+            }
+            finite
+        }
         Some(Integrator::Pcvv) => {
             let (force, torque) = old.expect("kept for PCVV");
-            correct(sub, &force, torque.as_deref(), physics)
+            let mut finite = pcvv::correct(
+                &mut p.velocity[..n],
+                &p.force[..n],
+                &force,
+                &p.inv_mass[..n],
+                dt,
+            );
+            if let (Some(a), Some(torque)) = (spins, torque) {
+                let (omega, new) = (&mut a.omega[..n], &a.torque[..n]);
+                finite &= pcvv::correct(omega, new, &torque, &a.inv_inertia[..n], dt);
+            }
+            finite
         }
     };
     sums
 }
 
-/// PCVV's predictor for the owned particles (`integrate::pcvv`, as the undecomposed step).
-fn predict<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt: Real, rotates: bool) {
-    let n = sub.n_owned;
-    let p = &mut sub.particles;
-    let (position, velocity) = (&mut p.position[..n], &mut p.velocity[..n]);
-    pcvv::predict(position, velocity, &p.force[..n], &p.inv_mass[..n], dt);
-    if let Some(a) = p.angular.as_mut().filter(|_| rotates) {
-        pcvv::predict_rate(&mut a.omega[..n], &a.torque[..n], &a.inv_inertia[..n], dt);
-    }
-}
-
-/// PCVV's corrector for the owned particles from the forces (and torques) before this
-/// step's; whether all stay finite.
-fn correct<H: PairHistory, WH: PairHistory, L, W>(
-    sub: &mut Subdomain<H, WH>,
-    old_force: &[Vec3],
-    old_torque: Option<&[Vec3]>,
-    physics: &Physics<'_, L, W>,
-) -> bool {
-    let n = sub.n_owned;
-    let dt = physics.dt;
-    let p = &mut sub.particles;
-    let mut finite = pcvv::correct(
-        &mut p.velocity[..n],
-        &p.force[..n],
-        old_force,
-        &p.inv_mass[..n],
-        dt,
-    );
-    if let (Some(a), Some(old_torque)) = (p.angular.as_mut(), old_torque) {
-        if physics.rotates {
-            let (omega, torque) = (&mut a.omega[..n], &a.torque[..n]);
-            finite &= pcvv::correct(omega, torque, old_torque, &a.inv_inertia[..n], dt);
-        }
-    }
-    finite
-}
-
-/// `v += dt/2 F/m` (and spins) for the owned particles; whether all stay finite.
-fn closing_kick<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, dt: Real) -> bool {
-    let half = 0.5 * dt;
-    let p = &mut sub.particles;
-    let mut finite = true;
-    for k in 0..sub.n_owned {
-        p.velocity[k] += half * p.inv_mass[k] * p.force[k];
-        finite &= p.velocity[k].is_finite();
-    }
-    if let Some(a) = p.angular.as_mut() {
-        for k in 0..sub.n_owned {
-            a.omega[k] += half * a.inv_inertia[k] * a.torque[k];
-            finite &= a.omega[k].is_finite();
-        }
-    }
-    finite
-}
-
 /// Forces (and torques) on `sub`'s owned particles: every listed pair evaluated with the
 /// lower id first and added to whichever of its particles are owned here (both for an owned
-/// pair: a half list without stored reactions), then gravity, the planar walls and the
-/// bodies (with their histories, as the undecomposed owner pass). Returns the deepest pair
-/// and wall (or body) overlaps and the bodies' loads summed over the owned particles in
+/// pair: a half list without stored reactions), then what acts on each particle alone
+/// (gravity, the planar walls and the bodies, with their histories). Returns the deepest
+/// pair and wall (or body) overlaps and the bodies' loads summed over the owned particles in
 /// order.
 fn forces<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
+    skin: Real,
 ) -> ForceSums {
     let n = sub.n_owned;
     let ForceView {
-        id,
         state,
         force,
         torque,
+        ..
     } = ParticleState::split(&mut sub.particles);
-    let images = [Vec3::ZERO; 27];
     let rotates = physics.rotates;
+    let dt = physics.surroundings.dt;
     force[..n].fill(Vec3::ZERO);
     if rotates {
         torque[..n].fill(Vec3::ZERO);
     }
     let mut deepest_pair: Real = 0.0;
+    // One pair, `b` seen at `position_b`: its force added to whichever of the two are owned
+    // (a macro, written once for the direct pairs and those through an image, so that each
+    // loop keeps its sums in registers).
+    macro_rules! pair {
+        ($a:expr, $b:expr, $position_b:expr, $history:expr) => {{
+            let (a, b): (usize, usize) = ($a, $b);
+            let owner = Owner {
+                position: state.position[a],
+                velocity: state.velocity[a],
+                omega: state.omega.map_or(Vec3::ZERO, |w| w[a]),
+                radius: state.radius[a],
+                inv_mass: state.inv_mass[a],
+                species_row: state.species[a] as usize * physics.n_species,
+            };
+            let (result, overlap, smaller_radius) =
+                pair_force(physics.law, &state, &owner, b, $position_b, $history, dt);
+            if overlap > deepest_pair * smaller_radius {
+                deepest_pair = overlap / smaller_radius;
+            }
+            if a < n {
+                force[a] += result.force_on_i;
+                if rotates {
+                    torque[a] += result.torque_on_i;
+                }
+            }
+            if b < n {
+                force[b] -= result.force_on_i;
+                if rotates {
+                    torque[b] += result.torque_on_j;
+                }
+            }
+        }};
+    }
     let list = &mut sub.list;
-    for (k, &[i, j]) in list.pairs.iter().enumerate() {
-        let (a, b) = if id[i as usize] < id[j as usize] {
-            (i as usize, j as usize)
-        } else {
-            (j as usize, i as usize)
-        };
-        let owner = Owner {
-            index: a,
-            position: state.position[a],
-            velocity: state.velocity[a],
-            omega: state.omega.map_or(Vec3::ZERO, |w| w[a]),
-            radius: state.radius[a],
-            inv_mass: state.inv_mass[a],
-            species_row: state.species[a] as usize * physics.n_species,
-        };
-        let pair = Pair {
-            i: a as u32,
-            j: b as u32,
-            image: NO_IMAGE,
-        };
-        let (result, overlap, smaller_radius) = pair_force(
-            physics.law,
-            &state,
-            &images,
-            &owner,
-            pair,
-            &mut list.history[k],
-            physics.dt,
+    for (&[a, b], history) in list.pairs.iter().zip(&mut list.history) {
+        let b = b as usize;
+        pair!(a as usize, b, state.position[b], history);
+    }
+    for (image, history) in list.image_pairs.iter().zip(&mut list.image_history) {
+        let b = image.pair[1] as usize;
+        pair!(
+            image.pair[0] as usize,
+            b,
+            state.position[b] + image.shift,
+            history
         );
-        if overlap > deepest_pair * smaller_radius {
-            deepest_pair = overlap / smaller_radius;
-        }
-        if a < n {
-            force[a] += result.force_on_i;
-            if rotates {
-                torque[a] += result.torque_on_i;
-            }
-        }
-        if b < n {
-            force[b] -= result.force_on_i;
-            if rotates {
-                torque[b] += result.torque_on_j;
-            }
-        }
     }
     let mut deepest_wall: Real = 0.0;
-    let walls = physics.walls;
-    let n_bodies = physics.bodies.len();
+    let n_bodies = physics.surroundings.bodies.len();
     let mut body_loads = vec![BodyLoad::default(); n_bodies];
-    // Sized exactly, as the world's (the reported memory must not depend on the history).
+    // Sized exactly (the reported memory must not depend on the run's history).
     if sub.body_clearances.len() != n * n_bodies {
         sub.body_clearances = vec![Clearance::NONE; n * n_bodies];
     }
-    for i in 0..n {
-        let clearances = &mut sub.body_clearances[i * n_bodies..(i + 1) * n_bodies];
-        let particle = WallParticle {
-            species: state.species[i] as usize,
-            position: state.position[i],
-            velocity: state.velocity[i],
-            radius: state.radius[i],
-            mass: state.mass[i],
-        };
-        let mut f = force[i] + state.mass[i] * physics.gravity;
-        let mut overlap;
+    let slots = if rotates { physics.wall_slots } else { 0 };
+    let particle = |i: usize| WallParticle {
+        species: state.species[i] as usize,
+        position: state.position[i],
+        velocity: state.velocity[i],
+        radius: state.radius[i],
+        mass: state.mass[i],
+    };
+    if sub.near_walls.len() != n {
+        // After a list build: the walls each particle may reach before the next one; the
+        // histories of the others are at rest (a pass over all walls would reset them now).
+        let walls = physics.surroundings.walls;
+        sub.near_walls = (0..n)
+            .map(|i| walls.near(physics.surroundings.wall_law, &particle(i), skin))
+            .collect();
         if rotates {
-            let slots = &mut sub.wall_history[i * physics.wall_slots..][..physics.wall_slots];
-            let (wall_history, body_history) = slots.split_at_mut(walls.walls.len());
-            let omega = state.omega.map_or(Vec3::ZERO, |w| w[i]);
-            if W::NEEDS_ROTATION {
-                let (wf, wt, o) = walls.force_and_torque_on(
-                    physics.wall_law,
-                    &particle,
-                    omega,
-                    wall_history,
-                    physics.dt,
-                );
-                f += wf;
-                torque[i] += wt;
-                overlap = o;
-            } else {
-                let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
-                f += wf;
-                overlap = o;
-            }
-            let with_history = physics.bodies.iter().zip(body_history).zip(clearances);
-            for (((body, history), clearance), load) in with_history.zip(&mut body_loads) {
-                let (bf, bt, l, o) = body_force_and_torque(
-                    body,
-                    physics.wall_law,
-                    &particle,
-                    omega,
-                    history,
-                    clearance,
-                    physics.dt,
-                );
-                f += bf;
-                torque[i] += bt;
-                *load += l;
-                overlap = larger(overlap, o);
-            }
-        } else {
-            let (wf, o) = walls.force_on(physics.wall_law, &particle, physics.dt);
-            f += wf;
-            overlap = o;
-            let with_clearance = physics.bodies.iter().zip(clearances);
-            for ((body, clearance), load) in with_clearance.zip(&mut body_loads) {
-                let (bf, l, o) =
-                    body_force(body, physics.wall_law, &particle, clearance, physics.dt);
-                f += bf;
-                *load += l;
-                overlap = larger(overlap, o);
+            for (i, near) in sub.near_walls.iter().enumerate() {
+                let history = &mut sub.wall_history[i * slots..][..walls.walls.len()];
+                for (k, h) in history.iter_mut().enumerate() {
+                    if !near.has(k) {
+                        *h = Default::default();
+                    }
+                }
             }
         }
-        force[i] = f;
+    }
+    for i in 0..n {
+        let particle = particle(i);
+        let alone = AloneSlots {
+            near: sub.near_walls[i],
+            history: &mut sub.wall_history[i * slots..(i + 1) * slots],
+            clearances: &mut sub.body_clearances[i * n_bodies..(i + 1) * n_bodies],
+        };
+        let omega = state.omega.map_or(Vec3::ZERO, |w| w[i]);
+        let mut unused = Vec3::ZERO;
+        let spin = if rotates { &mut torque[i] } else { &mut unused };
+        let overlap = physics.surroundings.act_on(
+            &particle,
+            omega,
+            rotates,
+            alone,
+            &mut body_loads,
+            &mut force[i],
+            spin,
+        );
         deepest_wall = larger(deepest_wall, overlap);
     }
     ForceSums {

@@ -1,9 +1,9 @@
-//! Time integration.
+//! Time integration: the half-steps of each scheme as kernels over slices of particles.
 
 pub mod pcvv;
 mod velocity_verlet;
 
-pub use velocity_verlet::{complete_and_kick, drift_kick};
+pub use velocity_verlet::{closing_kick, drift_kick, kick};
 
 /// The scheme a world steps with, chosen once per scene (`[time] integrator`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

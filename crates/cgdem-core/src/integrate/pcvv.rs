@@ -7,13 +7,7 @@
 //! with the full-step prediction `v1`. For position-only forces both give the same positions
 //! and velocities.
 
-use rayon::prelude::*;
-
 use crate::math::{Real, Vec3};
-
-/// Particles per task of the parallel forms (the world's arrays); a subdomain of a
-/// decomposed run calls the serial forms on its own thread.
-const CHUNK: usize = 1024;
 
 /// The predictor for positions and velocities.
 pub fn predict(
@@ -60,42 +54,4 @@ pub fn correct(
         finite &= v.is_finite();
     }
     finite
-}
-
-/// [`predict`] in chunks on the rayon pool.
-pub fn par_predict(
-    position: &mut [Vec3],
-    velocity: &mut [Vec3],
-    force: &[Vec3],
-    inv_mass: &[Real],
-    dt: Real,
-) {
-    position
-        .par_chunks_mut(CHUNK)
-        .zip(velocity.par_chunks_mut(CHUNK))
-        .zip(force.par_chunks(CHUNK).zip(inv_mass.par_chunks(CHUNK)))
-        .for_each(|((x, v), (f, inv_m))| predict(x, v, f, inv_m, dt));
-}
-
-/// [`predict_rate`] in chunks on the rayon pool.
-pub fn par_predict_rate(rate: &mut [Vec3], torque: &[Vec3], inv_inertia: &[Real], dt: Real) {
-    rate.par_chunks_mut(CHUNK)
-        .zip(torque.par_chunks(CHUNK).zip(inv_inertia.par_chunks(CHUNK)))
-        .for_each(|(w, (t, inv_i))| predict_rate(w, t, inv_i, dt));
-}
-
-/// [`correct`] in chunks on the rayon pool.
-pub fn par_correct(
-    velocity: &mut [Vec3],
-    force: &[Vec3],
-    old_force: &[Vec3],
-    inv_mass: &[Real],
-    dt: Real,
-) -> bool {
-    velocity
-        .par_chunks_mut(CHUNK)
-        .zip(force.par_chunks(CHUNK).zip(old_force.par_chunks(CHUNK)))
-        .zip(inv_mass.par_chunks(CHUNK))
-        .map(|((v, (f1, f0)), inv_m)| correct(v, f1, f0, inv_m, dt))
-        .reduce(|| true, |a, b| a && b)
 }

@@ -1,187 +1,91 @@
-//! Velocity Verlet, split around the force evaluation:
-//! `v += dt/2 F/m; x += dt v` (drift_kick), forces at the new positions and half-step
-//! velocities, then `v += dt/2 F/m` (complete_and_kick, which first adds what the force
-//! pass left to add); spins the same with torque and inverse inertia.
-//! Every particle is updated independently, so the result does not depend on how rayon
-//! splits the work.
-//!
-//! Each half of the step is one parallel pass over all particles (translation, spin and,
-//! in the drift, the pair list's displacement test together): every pass costs a fork and
-//! a join, which is what limits the gain from a second thread.
-
-use rayon::prelude::*;
+//! Velocity Verlet, split around the force evaluation: `v += dt/2 F/m; x += dt v`
+//! ([`drift_kick`]), forces at the new positions and half-step velocities, then
+//! `v += dt/2 F/m` ([`closing_kick`]); spins the same with torque and inverse inertia
+//! ([`kick`]). Kernels over slices (a subdomain's owned particles): every particle is
+//! updated on its own, so the result does not depend on who steps which slice.
 
 use crate::math::{Real, Vec3};
-use crate::neighbor::DisplacementCheck;
-use crate::particles::{AngularState, Particles};
 
-const CHUNK: usize = 1024;
-
-/// Half kick then drift of every particle, half kick of the spins. Returns whether some
-/// particle moved past the `check` (false without one).
-pub fn drift_kick(p: &mut Particles, dt: Real, check: Option<DisplacementCheck>) -> bool {
-    let half = 0.5 * dt;
-    let Particles {
-        position,
-        velocity,
-        force,
-        inv_mass,
-        angular,
-        ..
-    } = p;
-    let (force, inv_mass) = (&*force, &*inv_mass);
-    let translate = |start: usize, x: &mut [Vec3], v: &mut [Vec3]| -> bool {
-        for (k, (x, v)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
-            *v += half * inv_mass[start + k] * force[start + k];
-            *x += dt * *v;
-        }
-        check.is_some_and(|c| {
-            x.iter()
-                .zip(&c.reference[start..])
-                .any(|(x, r)| (*x - *r).length_squared() > c.limit_sq)
-        })
-    };
-    let chunks = position
-        .par_chunks_mut(CHUNK)
-        .zip(velocity.par_chunks_mut(CHUNK))
-        .enumerate();
-    match angular {
-        Some(AngularState {
-            omega,
-            torque,
-            inv_inertia,
-        }) => chunks
-            .zip(omega.par_chunks_mut(CHUNK))
-            .map(|((c, (x, v)), w)| {
-                let start = c * CHUNK;
-                kick_slice(w, &torque[start..], &inv_inertia[start..], half);
-                translate(start, x, v)
-            })
-            .reduce(|| false, |a, b| a || b),
-        None => chunks
-            .map(|(c, (x, v))| translate(c * CHUNK, x, v))
-            .reduce(|| false, |a, b| a || b),
-    }
-}
-
-/// Half kick of velocities and spins, completing each particle's force and torque first
-/// with `complete(i, force, torque)` (what the force pass left to add, such as the
-/// reactions of pairs owned by other particles): the pass that finishes the forces is the
-/// pass that kicks, so the particles are read once. Returns whether every updated value is
-/// finite (the non-finite guard, at no extra pass).
-pub fn complete_and_kick(
-    p: &mut Particles,
+/// Half kick then drift of each particle; whether one moved farther than
+/// `sqrt(limit_sq)` from its `reference` position (the pair list's rebuild test, at no
+/// extra pass).
+pub fn drift_kick(
+    position: &mut [Vec3],
+    velocity: &mut [Vec3],
+    force: &[Vec3],
+    inv_mass: &[Real],
+    reference: &[Vec3],
+    limit_sq: Real,
     dt: Real,
-    complete: impl Fn(usize, &mut Vec3, &mut Vec3) + Sync,
 ) -> bool {
     let half = 0.5 * dt;
-    let Particles {
-        velocity,
-        force,
-        inv_mass,
-        angular,
-        ..
-    } = p;
-    let inv_mass = &*inv_mass;
-    let chunks = velocity
-        .par_chunks_mut(CHUNK)
-        .zip(force.par_chunks_mut(CHUNK))
-        .enumerate();
-    match angular {
-        Some(AngularState {
-            omega,
-            torque,
-            inv_inertia,
-        }) => chunks
-            .zip(omega.par_chunks_mut(CHUNK))
-            .zip(torque.par_chunks_mut(CHUNK))
-            .map(|(((c, (v, f)), w), t)| {
-                let start = c * CHUNK;
-                let mut finite = true;
-                for k in 0..v.len() {
-                    let i = start + k;
-                    complete(i, &mut f[k], &mut t[k]);
-                    v[k] += half * inv_mass[i] * f[k];
-                    w[k] += half * inv_inertia[i] * t[k];
-                    finite &= v[k].is_finite() & w[k].is_finite();
-                }
-                finite
-            })
-            .reduce(|| true, |a, b| a && b),
-        None => chunks
-            .map(|(c, (v, f))| {
-                let start = c * CHUNK;
-                let mut finite = true;
-                for k in 0..v.len() {
-                    let i = start + k;
-                    let mut unused_torque = Vec3::ZERO;
-                    complete(i, &mut f[k], &mut unused_torque);
-                    v[k] += half * inv_mass[i] * f[k];
-                    finite &= v[k].is_finite();
-                }
-                finite
-            })
-            .reduce(|| true, |a, b| a && b),
+    let mut moved = false;
+    let n = position.len();
+    let (velocity, force, inv_mass, reference) = (
+        &mut velocity[..n],
+        &force[..n],
+        &inv_mass[..n],
+        &reference[..n],
+    );
+    for k in 0..n {
+        velocity[k] += half * inv_mass[k] * force[k];
+        position[k] += dt * velocity[k];
+        moved |= (position[k] - reference[k]).length_squared() > limit_sq;
     }
+    moved
 }
 
-/// `v += half F/m` over one chunk; whether every result is finite.
-#[inline(always)]
-fn kick_slice(velocity: &mut [Vec3], force: &[Vec3], inv_mass: &[Real], half: Real) -> bool {
+/// `v += half F/m` (or `w += half T/I`): a half kick; whether every result is finite.
+pub fn kick(rate: &mut [Vec3], load: &[Vec3], inv_inertia: &[Real], half: Real) -> bool {
     let mut finite = true;
-    for ((v, f), inv_m) in velocity.iter_mut().zip(force).zip(inv_mass) {
+    for ((v, f), inv_m) in rate.iter_mut().zip(load).zip(inv_inertia) {
         *v += half * *inv_m * *f;
         finite &= v.is_finite();
     }
     finite
 }
 
+/// The closing half kick `v += dt/2 F/m`; whether every result is finite (the non-finite
+/// guard, at no extra pass).
+pub fn closing_kick(velocity: &mut [Vec3], force: &[Vec3], inv_mass: &[Real], dt: Real) -> bool {
+    kick(velocity, force, inv_mass, 0.5 * dt)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn particles(n: usize, rotation: bool) -> Particles {
-        let mut p = Particles::new(rotation);
-        for k in 0..n {
-            p.push(0, Vec3::new(k as Real, 0.0, 0.0), 0.5, 2.0);
-            p.force[k] = Vec3::new(0.0, 0.0, -4.0);
-        }
-        p
-    }
-
     #[test]
-    fn drift_kick_moves_every_chunk_and_reports_the_displacement_test() {
-        let n = 3 * CHUNK + 7;
-        let mut p = particles(n, true);
-        let reference = p.position.clone();
-        p.velocity[n - 1] = Vec3::new(10.0, 0.0, 0.0);
-        let check = DisplacementCheck {
-            reference: &reference,
-            limit_sq: 0.5 * 0.5,
-        };
+    fn drift_kick_moves_and_reports_the_displacement_test() {
+        let n = 7;
+        let mut x: Vec<Vec3> = (0..n).map(|k| Vec3::new(k as Real, 0.0, 0.0)).collect();
+        let reference = x.clone();
+        let mut v = vec![Vec3::ZERO; n];
+        let f = vec![Vec3::new(0.0, 0.0, -4.0); n];
+        let inv_m = vec![0.5; n];
+        v[n - 1] = Vec3::new(10.0, 0.0, 0.0);
         // dt = 0.1: the last particle moves 1 (beyond 0.5), the others 0.01.
-        assert!(drift_kick(&mut p, 0.1, Some(check)));
-        assert!((p.velocity[0].z - -0.1).abs() < 1e-15);
-        assert!((p.position[0].z - -0.01).abs() < 1e-15);
-        assert!((p.position[n - 1].x - (n as Real - 1.0 + 1.0)).abs() < 1e-9);
-        // Without the fast particle nothing moved past the limit.
-        let mut q = particles(n, false);
-        assert!(!drift_kick(&mut q, 0.1, Some(check)));
-        assert!(!drift_kick(&mut q, 0.1, None));
+        assert!(drift_kick(
+            &mut x, &mut v, &f, &inv_m, &reference, 0.25, 0.1
+        ));
+        assert!((v[0].z - -0.1).abs() < 1e-15);
+        assert!((x[0].z - -0.01).abs() < 1e-15);
+        assert!((x[n - 1].x - (n as Real - 1.0 + 1.0)).abs() < 1e-9);
+        let mut slow = reference.clone();
+        let mut w = vec![Vec3::ZERO; n];
+        assert!(!drift_kick(
+            &mut slow, &mut w, &f, &inv_m, &reference, 0.25, 0.1
+        ));
     }
 
     #[test]
-    fn kick_completes_the_forces_and_reports_a_non_finite_velocity_or_spin() {
-        let n = CHUNK + 3;
-        let nothing = |_: usize, _: &mut Vec3, _: &mut Vec3| {};
-        let mut p = particles(n, true);
-        assert!(complete_and_kick(&mut p, 0.1, nothing));
-        assert!((p.velocity[n - 1].z - -0.1).abs() < 1e-15);
-        // The completion runs before the kick, for every particle.
-        let lift = |_: usize, f: &mut Vec3, _: &mut Vec3| f.z += 8.0;
-        assert!(complete_and_kick(&mut p, 0.1, lift));
-        assert!((p.velocity[n - 1].z - 0.0).abs() < 1e-15 && p.force[0].z == 4.0);
-        p.angular.as_mut().unwrap().torque[n - 2] = Vec3::new(Real::NAN, 0.0, 0.0);
-        assert!(!complete_and_kick(&mut p, 0.1, nothing));
+    fn closing_kick_reports_a_non_finite_velocity() {
+        let mut v = vec![Vec3::ZERO; 3];
+        let mut f = vec![Vec3::new(0.0, 0.0, -4.0); 3];
+        let inv_m = vec![0.5; 3];
+        assert!(closing_kick(&mut v, &f, &inv_m, 0.1));
+        assert!((v[2].z - -0.1).abs() < 1e-15);
+        f[1] = Vec3::new(Real::NAN, 0.0, 0.0);
+        assert!(!closing_kick(&mut v, &f, &inv_m, 0.1));
     }
 }

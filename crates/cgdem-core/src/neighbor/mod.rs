@@ -1,12 +1,12 @@
-//! Neighbour search: linked cells feeding a Verlet pair list with a skin.
-//!
-//! The list is a *half* list (each pair once, `i < j`, with the periodic image of `j`), so a
-//! pair's force and history are computed and stored once. Forces are gathered per particle
-//! over its incident pairs in a fixed order, which keeps results independent of the thread
-//! count without atomics.
+//! Neighbour search: linked cells ([`CellGrid`]) feeding each subdomain's Verlet pair list
+//! with a skin ([`PairList`], a half list: each pair's force and history computed and stored
+//! once per side), and a pair search over a whole set of particles with periodic images
+//! ([`pairs_within`]) for what reads the gathered particles.
 
 mod cell_grid;
-mod verlet_list;
+mod pair_list;
+mod pair_search;
 
 pub use cell_grid::CellGrid;
-pub use verlet_list::{brute_force_pairs, DisplacementCheck, Pair, VerletList};
+pub use pair_list::{HistoryRows, ImagePair, PairList};
+pub use pair_search::{brute_force_pairs, pairs_within, Pair};

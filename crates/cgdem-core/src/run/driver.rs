@@ -7,13 +7,15 @@ use std::time::Instant;
 
 use crate::bodies::KinematicParticles;
 use crate::contact::PairLaw;
+use crate::decomposition::placement::MAX_SUBDOMAINS;
+use crate::decomposition::GridSpec;
 use crate::geometry::Aabb;
 use crate::guard::{GuardKind, GuardSettings, GuardTrip};
 use crate::io::write_atomic;
 use crate::math::Real;
 use crate::particles::Particles;
 use crate::scene::{Scene, Stage, StageEnd};
-use crate::simulation::{NeighborSettings, World};
+use crate::simulation::{Decompose, NeighborSettings, World, WorldSetup, WorldState};
 use crate::timestep::Timescales;
 use crate::walls::WallLaw;
 
@@ -52,8 +54,29 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     if let Some(w) = warning {
         warnings.push(w);
     }
+    // A resumed run's state, decoded before the world is built: the world starts on its
+    // grid (unless another is given), so that its ranks fit.
+    let stored: Option<WorldState<L::History, W::History>> = match resume {
+        Some(r) => Some(
+            decode(&r.restart.world)
+                .map_err(|e| RunError::Restart(format!("{}: {e}", r.path.display())))?,
+        ),
+        None => None,
+    };
+    let grid = options
+        .grid
+        .or(stored.as_ref().map(|s| GridSpec::Given(s.grid())));
     let (mut world, mut n_inserted, mut n_body_particles) =
-        build_world(scene, law, wall_law, dt, &scales, options)?;
+        build_world(scene, law, wall_law, dt, &scales, options, grid)?;
+    // A scene large enough for more subdomains than the default grid gives, on more
+    // threads than it has: say how to use them.
+    let subdomains: usize = world.grid().iter().product();
+    let workers = rayon::current_num_threads() * options.comm.size();
+    if grid.is_none() && subdomains == MAX_SUBDOMAINS && workers > subdomains {
+        warnings.push(format!(
+            "the grid chosen from the scene has {subdomains} subdomains (the most it chooses), fewer than the {workers} threads, which take whole subdomains: give --grid {workers} (or more) to keep them all busy"
+        ));
+    }
     // Under MPI only rank 0 writes into the run's directory: the others' outputs (in a
     // scratch directory) start afresh.
     let root = options.comm.is_root();
@@ -102,15 +125,20 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
         wall_before: 0.0,
         started: Instant::now(),
     };
-    let resume_at = match resume {
-        Some(loaded) => {
-            let (at, counts) =
-                driver.resume_from(&mut world, &mut observers, &mut warnings, loaded)?;
+    let resume_at = match (resume, stored) {
+        (Some(loaded), Some(state)) => {
+            let (at, counts) = driver.resume_from(
+                &mut world,
+                &mut observers,
+                &mut warnings,
+                loaded,
+                state,
+                options.grid,
+            )?;
             (n_inserted, n_body_particles) = counts;
-            resume_grid(&mut world, scene, options, &loaded.path)?;
             at
         }
-        None => {
+        _ => {
             let start = Position {
                 stage: 0,
                 within: None,
@@ -179,39 +207,6 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     }
 }
 
-/// A resumed world back on its subdomains (`--grid`: the same grid steps on bit for bit,
-/// another deals the particles out again); an error when the restart file and the options
-/// disagree on whether the run is decomposed.
-fn resume_grid<L: PairLaw, W: WallLaw>(
-    world: &mut World<L, W>,
-    scene: &Scene,
-    options: &RunOptions,
-    path: &Path,
-) -> Result<(), RunError> {
-    match (options.grid, world.restored_grid()) {
-        (None, None) => Ok(()),
-        (None, Some([x, y, z])) => Err(RunError::Restart(format!(
-            "{}: written by a run with --grid {x}x{y}x{z}: resume it with --grid (the same grid continues bit for bit, another one from the stored particles)",
-            path.display()
-        ))),
-        (Some(spec), None) => Err(RunError::Restart(format!(
-            "{}: written by a run without --grid: resume it without --grid (not --grid {spec})",
-            path.display()
-        ))),
-        (Some(spec), Some(_)) => {
-            world.set_grid(spec, options.comm.clone()).map_err(|e| {
-                RunError::Restart(format!(
-                    "{}: --grid {spec}: {e} (restart file {})",
-                    scene.source.display(),
-                    path.display()
-                ))
-            })?;
-            world.set_balance(options.balance);
-            Ok(())
-        }
-    }
-}
-
 /// The inserted and body particle counts of a run.
 struct Counts {
     inserted: usize,
@@ -235,7 +230,7 @@ fn base_summary<L: PairLaw, W: WallLaw>(
         code: "cgdem".into(),
         lambda: scene.lambda,
         cg_rule: scene.cg_rule,
-        n_particles: world.particles.len(),
+        n_particles: world.particles().len(),
         n_particles_inserted: counts.inserted,
         n_particles_refilled: driver.refilled,
         n_body_particles: counts.body_particles,
@@ -265,14 +260,15 @@ fn base_summary<L: PairLaw, W: WallLaw>(
         scene_file: scene.source.display().to_string(),
         scene_digest: scene.digest(),
         cgdem_version: env!("CARGO_PKG_VERSION").into(),
-        final_state: options.keep_final_state.then(|| world.particles.clone()),
+        final_state: options.keep_final_state.then(|| world.particles().clone()),
         memory: Some(world.memory_use()),
-        decomposition: world.decomposition_summary(),
+        decomposition: Some(world.decomposition_summary()),
     }
 }
 
 /// The world at the start of the run, with the particles inserted (or given), bodies,
-/// walls, deletion regions and guards; with the inserted and body particle counts.
+/// walls, deletion regions and guards, on `grid` (or the scene's); with the inserted and
+/// body particle counts.
 fn build_world<L: PairLaw, W: WallLaw>(
     scene: &Scene,
     law: L,
@@ -280,6 +276,7 @@ fn build_world<L: PairLaw, W: WallLaw>(
     dt: Real,
     scales: &Timescales,
     options: &RunOptions,
+    grid: Option<GridSpec>,
 ) -> Result<(World<L, W>, usize, usize), RunError> {
     let (bodies, body_sites) = build_bodies(scene, &wall_law)?;
     let (particles, kinematic): (Particles, Vec<KinematicParticles>) = match &options.initial_state
@@ -300,42 +297,40 @@ fn build_world<L: PairLaw, W: WallLaw>(
         skin: scene.skin_fraction * scene.max_diameter(),
         resort_every: scene.resort_every,
     };
-    let mut world = World::new(
+    let mut setup = WorldSetup::new(
         particles,
         scene.domain.clone(),
-        scene_walls(scene),
         law,
         wall_law,
         scene.species.len(),
         scene.gravity,
         dt,
         neighbor,
-    )
-    .with_integrator(scene.integrator);
-    world.set_guard_settings(GuardSettings {
+    );
+    setup.walls = scene_walls(scene);
+    setup.integrator = scene.integrator;
+    setup.bodies = bodies;
+    setup.kinematic = kinematic;
+    setup.delete_regions = scene
+        .deletions
+        .iter()
+        .map(|&(min, max)| Aabb { min, max })
+        .collect();
+    setup.guard = GuardSettings {
         stable_dt: scales.stable_limit,
         // With --keep-going guards only warn: lost particles are removed, as with "warn".
         stop_on_lost: scene.stop_on_lost && !options.keep_going,
         ..GuardSettings::default()
-    });
-    if !bodies.is_empty() {
-        world.set_bodies(bodies);
-        world.set_kinematic(kinematic);
-    }
-    world.set_delete_regions(
-        scene
-            .deletions
-            .iter()
-            .map(|&(min, max)| Aabb { min, max })
-            .collect(),
-    );
-    // A resumed run takes its subdomains from the restart file (`resume_grid`).
-    if let Some(spec) = options.grid.filter(|_| options.resume.is_none()) {
-        world.set_grid(spec, options.comm.clone()).map_err(|e| {
-            RunError::NotAvailable(format!("{}: --grid {spec}: {e}", scene.source.display()))
-        })?;
-        world.set_balance(options.balance);
-    }
+    };
+    let decompose = Decompose {
+        grid,
+        balance: options.balance,
+        comm: options.comm.clone(),
+    };
+    let world = World::new(setup, &decompose).map_err(|e| {
+        let given = grid.map_or(String::new(), |g| format!(" --grid {g}:"));
+        RunError::NotAvailable(format!("{}:{given} {e}", scene.source.display()))
+    })?;
     Ok((world, n_inserted, n_body_particles))
 }
 
@@ -498,15 +493,15 @@ impl Driver<'_> {
         observers: &mut [Scheduled<'_, L, W>],
         warnings: &mut Warnings,
         loaded: &'r restart::RestartLoaded,
+        state: WorldState<L::History, W::History>,
+        grid: Option<GridSpec>,
     ) -> Result<(Resume<'r>, (usize, usize)), RunError> {
         let r = &loaded.restart;
         let bad = |e: String| RunError::Restart(format!("{}: {e}", loaded.path.display()));
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
         }
-        world
-            .set_state(decode(&r.world).map_err(bad)?)
-            .map_err(bad)?;
+        world.set_state(state, grid).map_err(bad)?;
         let d = &r.driver;
         self.refilled = d.refilled;
         self.particle_steps = d.particle_steps;
@@ -662,7 +657,7 @@ impl Driver<'_> {
                     .and_then(|s| s.iter().find(|(i, _, _)| i == k));
                 match saved {
                     Some(&(_, target, count)) => (*k, region, target, count),
-                    None => (*k, region, region.count(&world.particles), 0),
+                    None => (*k, region, region.count(world.particles()), 0),
                 }
             })
             .collect();
@@ -820,7 +815,7 @@ impl Driver<'_> {
                 *done += 1;
                 world.sync_particles();
                 let seed = ins.seed.wrapping_add(1_000_003 * *done);
-                let added = region.top_up(&world.particles, world.bodies(), *target, seed);
+                let added = region.top_up(world.particles(), world.bodies(), *target, seed);
                 let species = &self.scene.species[ins.species];
                 world.add_particles(ins.species as u16, &added, species.radius(), species.mass());
                 self.refilled += added.len() as u64;

@@ -17,6 +17,11 @@ pub mod state_file;
 pub use laws::hertz::{hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED};
 pub use laws::{seed_laws, with_laws, LawVisitor};
 pub use progress::{Progress, ProgressReporter, RunProgress};
+// The output format, where cgdem's runs (and the driver) have always found it.
+pub use crate::output_format::{
+    headline_sample, heap_profile, profile_csv, repose_csv, ReposeSample, RunSummary,
+    SampleTrigger, StageEnding, StageRecord, TIMESERIES_COLUMNS,
+};
 pub use setup::{
     build_bodies, initial_particles, initial_particles_clear_of_bodies,
     initial_particles_with_bodies, linear_contacts, scene_walls,
@@ -24,16 +29,10 @@ pub use setup::{
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
-
-use crate::analysis::conveying::ConveyingSummary;
-use crate::analysis::heap::{self, HeapProfile};
-use crate::analysis::PackingSummary;
 use crate::contact::PairLaw;
-use crate::guard::{GuardKind, GuardPeaks, GuardTrip};
+use crate::guard::GuardTrip;
 use crate::insertion::InsertionFailed;
-use crate::io::CsvBuffer;
-use crate::math::{Real, Vec3};
+use crate::math::Real;
 use crate::particles::Particles;
 use crate::scene::{ReposeSettings, Scene, StageEnd};
 use crate::timestep::{self, Timescales, UnstableTimeStep};
@@ -145,170 +144,6 @@ pub(crate) fn output_error(path: &Path, e: impl std::fmt::Display) -> RunError {
     }
 }
 
-/// What took a repose sample: a fixed time after the stage began, or the stage's own end.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum SampleTrigger {
-    #[serde(rename = "fixed time")]
-    FixedTime,
-    #[serde(rename = "stage end")]
-    StageEnd,
-}
-
-impl std::fmt::Display for SampleTrigger {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            SampleTrigger::FixedTime => "fixed time",
-            SampleTrigger::StageEnd => "stage end",
-        })
-    }
-}
-
-/// Why a stage ended; in `summary.json` as its sentence (`StageRecord::ended_by`).
-#[derive(Clone, Debug, PartialEq)]
-pub enum StageEnding {
-    /// It ran its whole duration (a settling stage: its `max_duration`, unsettled).
-    Duration(Real),
-    /// Its kinetic energy per mass fell below the threshold.
-    Settled {
-        kinetic_energy_per_mass: Real,
-        threshold: Real,
-    },
-    /// A guard stopped the run.
-    Guard(GuardKind),
-    /// The stop flag (SIGINT/SIGTERM) was raised: the run stopped at the end of a step.
-    Interrupted,
-}
-
-impl std::fmt::Display for StageEnding {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            StageEnding::Duration(d) => write!(f, "duration {d} s"),
-            StageEnding::Settled {
-                kinetic_energy_per_mass,
-                threshold,
-            } => write!(
-                f,
-                "kinetic energy per mass {kinetic_energy_per_mass:.3e} J/kg < {threshold:.3e} J/kg"
-            ),
-            StageEnding::Guard(kind) => write!(f, "stopped by the {} guard", kind.name()),
-            StageEnding::Interrupted => write!(f, "interrupted (SIGINT/SIGTERM)"),
-        }
-    }
-}
-
-impl StageEnding {
-    /// Whether `summary` (a summary.json) is that of a run SIGINT/SIGTERM ended: its last
-    /// stage ended so, and its outputs stop there. Such a run is not finished; `validate
-    /// --reuse` runs it again (or resumes it from its restart file).
-    pub fn interrupted_summary(summary: &serde_json::Value) -> bool {
-        summary["stages"]
-            .as_array()
-            .and_then(|stages| stages.last())
-            .and_then(|stage| stage["ended_by"].as_str())
-            == Some(StageEnding::Interrupted.to_string().as_str())
-    }
-}
-
-/// The angle measured at one time after the repose stage began.
-#[derive(Clone, Debug, Serialize, serde::Deserialize)]
-pub struct ReposeSample {
-    pub time_after_start_s: Real,
-    pub trigger: SampleTrigger,
-    pub repose_angle_deg: Option<Real>,
-    pub repose_fit_r2: Option<Real>,
-    pub runout_m: Real,
-    pub wall_height_m: Real,
-}
-
-impl ReposeSample {
-    /// Measures a heap profile by the scene's repose rule (the same for every code).
-    pub fn measure(
-        profile: &HeapProfile,
-        rule: &ReposeSettings,
-        max_diameter: Real,
-        time_after_start_s: Real,
-        trigger: SampleTrigger,
-    ) -> ReposeSample {
-        let fit = heap::repose_angle(
-            profile,
-            2.0 * max_diameter,
-            rule.exclude_wall_fraction,
-            rule.exclude_toe_fraction,
-        );
-        ReposeSample {
-            time_after_start_s,
-            trigger,
-            repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
-            repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
-            runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
-            wall_height_m: profile.wall_height(),
-        }
-    }
-}
-
-#[derive(Clone, Debug, Serialize, serde::Deserialize)]
-pub struct StageRecord {
-    pub name: String,
-    pub start_s: Real,
-    pub end_s: Real,
-    pub steps: u64,
-    pub ended_by: String,
-}
-
-/// Everything `summary.json` holds.
-#[derive(Clone, Debug, Serialize, serde::Deserialize)]
-pub struct RunSummary {
-    pub case: String,
-    pub code: String,
-    pub lambda: u32,
-    pub cg_rule: crate::coarse_graining::CoarseGrainRule,
-    pub n_particles: usize,
-    pub n_particles_inserted: usize,
-    /// Particles added by top-ups (`[[insert]] refill`).
-    pub n_particles_refilled: u64,
-    /// Particles that make up bodies built of particles (frozen, counted in `n_particles`).
-    pub n_body_particles: usize,
-    pub lost_particles: u64,
-    pub steps: u64,
-    pub dt_s: Real,
-    pub contact_period_s: Real,
-    pub stable_dt_s: Real,
-    pub simulated_s: Real,
-    pub wall_s: Real,
-    pub particle_steps: u64,
-    pub particle_steps_per_s: Real,
-    pub threads: usize,
-    pub repose_angle_deg: Option<Real>,
-    pub repose_fit_r2: Option<Real>,
-    pub repose_rule: Option<String>,
-    pub runout_m: Option<Real>,
-    pub repose_samples: Vec<ReposeSample>,
-    pub stages: Vec<StageRecord>,
-    /// Particles deleted in `[[delete]]` regions, and their mass.
-    pub deleted_particles: u64,
-    pub deleted_mass_kg: Real,
-    pub conveying: Option<ConveyingSummary>,
-    /// Porosity and pore sizes of the bed (`[packing]`), measured when its stage ends.
-    pub packing: Option<PackingSummary>,
-    pub warnings: Vec<String>,
-    /// The guard that stopped the run early, if one did.
-    pub stopped_by: Option<GuardTrip>,
-    /// How close the run came to the guards' thresholds (none for reference codes).
-    pub guard_peaks: Option<GuardPeaks>,
-    pub scene_file: String,
-    /// `Scene::digest` of the (coarse-grained) scene this run simulated.
-    pub scene_digest: String,
-    pub cgdem_version: String,
-    /// The particles at the end (with `RunOptions::keep_final_state`).
-    #[serde(skip)]
-    pub final_state: Option<Particles>,
-    /// The solver's arrays at the end (none for reference codes).
-    pub memory: Option<crate::memory_use::MemoryUse>,
-    /// The subdomains of a `--grid` run (absent otherwise).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub decomposition: Option<crate::decomposition::DecompositionSummary>,
-}
-
 /// Runs a (possibly coarse-grained) scene and writes its outputs into `options.out_dir`.
 pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunSummary, RunError> {
     check_memory(scene, options)?;
@@ -408,74 +243,4 @@ fn describe_end(end: &StageEnd) -> String {
             max_duration,
         } => format!("kinetic energy per mass below {kinetic_energy_per_mass:e} J/kg, after at least {min_duration} s and at most {max_duration} s"),
     }
-}
-
-/// The first columns of `timeseries.csv`, as cgdem and the reference post-processing write
-/// them.
-pub const TIMESERIES_COLUMNS: [&str; 7] = [
-    "time_s",
-    "stage",
-    "kinetic_energy_j",
-    "kinetic_energy_per_mass_j_kg",
-    "n_particles",
-    "front_m",
-    "wall_height_m",
-];
-
-/// The heap surface of `scene`'s `[repose]` section for particles at `position` of `radius`
-/// (None without one).
-pub fn heap_profile(scene: &Scene, position: &[Vec3], radius: &[Real]) -> Option<HeapProfile> {
-    scene.repose.as_ref().map(|r| {
-        heap::profile(
-            position,
-            radius,
-            r.wall_x,
-            scene.domain.hi.x,
-            scene.domain.lo.z,
-            r.bin_width_diameters * scene.max_diameter(),
-        )
-    })
-}
-
-/// `profile.csv`: the heap surface height per bin.
-pub fn profile_csv(profile: &HeapProfile) -> std::io::Result<Vec<u8>> {
-    let mut csv = CsvBuffer::new(["x_m", "height_m"]);
-    for (k, h) in profile.heights.iter().enumerate() {
-        csv.row([format!("{:.6e}", profile.bin_centre(k)), format!("{h:.6e}")]);
-    }
-    csv.bytes().map(<[u8]>::to_vec)
-}
-
-/// `repose.csv`: the angle at each measurement.
-pub fn repose_csv(samples: &[ReposeSample]) -> std::io::Result<Vec<u8>> {
-    let mut csv = CsvBuffer::new([
-        "time_after_start_s",
-        "trigger",
-        "repose_angle_deg",
-        "repose_fit_r2",
-        "runout_m",
-        "wall_height_m",
-    ]);
-    let opt = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6}"));
-    for s in samples {
-        csv.row([
-            s.time_after_start_s.to_string(),
-            s.trigger.to_string(),
-            opt(s.repose_angle_deg),
-            opt(s.repose_fit_r2),
-            format!("{:.6e}", s.runout_m),
-            format!("{:.6e}", s.wall_height_m),
-        ]);
-    }
-    csv.bytes().map(<[u8]>::to_vec)
-}
-
-/// The headline measurement: the stage-end sample when the scene asks for one, else the last
-/// fixed time.
-pub fn headline_sample(samples: &[ReposeSample]) -> Option<&ReposeSample> {
-    samples
-        .iter()
-        .rev()
-        .find(|s| s.trigger == SampleTrigger::StageEnd)
-        .or(samples.last())
 }

@@ -11,10 +11,13 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use crate::coarse_graining::CoarseGrainRule;
+use crate::decomposition::{BalanceSpec, GridSpec};
 use crate::guard::GuardKind;
 use crate::math::Real;
 
@@ -24,8 +27,9 @@ pub const RESTART_FILE: &str = "restart.cgr";
 pub const PREVIOUS_RESTART_FILE: &str = "restart.prev.cgr";
 const MAGIC: &[u8; 8] = b"CGDEMRST";
 /// Bumped whenever the payload's layout changes; an older file is refused by name (2: the
-/// world state holds the subdomains of a `--grid` run; 3: the driver keeps the wall time).
-pub const FORMAT_VERSION: u32 = 3;
+/// world state holds the subdomains of a `--grid` run; 3: the driver keeps the wall time; 4: every
+/// run is a grid, the world state is its subdomains).
+pub const FORMAT_VERSION: u32 = 4;
 const HEADER_LEN: usize = 32;
 
 /// Where in the stage list a checkpoint was taken.
@@ -243,6 +247,87 @@ pub fn read_latest(dir: &Path) -> Result<RestartLoaded, String> {
     ))
 }
 
+/// The command line of `cgdem run` that a restart file stores (as JSON in
+/// [`Restart::invocation`]), to rebuild the same scene on `--resume`; the scene's digest is
+/// checked against the stored one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunInvocation {
+    /// Absolute, so a resume from another directory finds it.
+    pub case: PathBuf,
+    pub lambda: u32,
+    pub cg_rule: CoarseGrainRule,
+    pub seed: Option<u64>,
+    pub set: Vec<String>,
+    pub variant: Option<String>,
+    pub force_dt: bool,
+    pub keep_going: bool,
+    /// `--grid` and `--balance` as given (absent in files of runs without them).
+    #[serde(default)]
+    pub grid: Option<String>,
+    #[serde(default)]
+    pub balance: Option<String>,
+}
+
+/// What a run continues from: the command line that rebuilds its scene and, with
+/// `--resume`, the restart file it goes on from.
+pub type Resumed = (RunInvocation, Option<Arc<RestartLoaded>>);
+
+impl RunInvocation {
+    /// What rebuilds the scene of `cgdem run`: `given` (this command line), or, with
+    /// `--resume DIR` and no scene file (`case_given` false), the command line the newest
+    /// usable restart file of DIR stored; with the restart file to go on from.
+    pub fn resolve(
+        given: RunInvocation,
+        case_given: bool,
+        resume: Option<&Path>,
+    ) -> Result<Resumed, String> {
+        let loaded = resume.map(read_latest).transpose()?;
+        let Some(loaded) = loaded else {
+            return Ok((given, None));
+        };
+        if case_given {
+            return Ok((given, Some(Arc::new(loaded))));
+        }
+        let stored = serde_json::from_str(&loaded.restart.invocation).map_err(|e| {
+            format!(
+                "{}: the stored command line does not decode: {e}",
+                loaded.path.display()
+            )
+        })?;
+        Ok((stored, Some(Arc::new(loaded))))
+    }
+
+    /// The grid and balance the run steps on: `grid` and `balance` as given, or, when no
+    /// grid is given, the ones this (resumed) command line stored; with the command line
+    /// naming them, so that the restart files the run writes from now on name the grid it
+    /// runs on. The error names the stored value that does not parse.
+    pub fn with_grid(
+        self,
+        grid: Option<GridSpec>,
+        balance: BalanceSpec,
+    ) -> Result<(RunInvocation, Option<GridSpec>, BalanceSpec), String> {
+        let (grid, balance) = match (grid, &self.grid) {
+            (None, Some(stored)) => {
+                let balance: Result<BalanceSpec, String> = self
+                    .balance
+                    .as_deref()
+                    .map_or(Ok(BalanceSpec::default()), str::parse);
+                stored
+                    .parse::<GridSpec>()
+                    .and_then(|g| Ok((Some(g), balance?)))
+                    .map_err(|e| format!("the stored --grid/--balance: {e}"))?
+            }
+            _ => (grid, balance),
+        };
+        let invocation = RunInvocation {
+            grid: grid.map(|g| g.to_string()),
+            balance: grid.map(|_| balance.to_string()),
+            ..self
+        };
+        Ok((invocation, grid, balance))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -327,6 +412,76 @@ mod tests {
                 && err.contains("checksum"),
             "{err}"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn invocation(grid: Option<&str>, balance: Option<&str>) -> RunInvocation {
+        RunInvocation {
+            case: PathBuf::from("/cases/heap.toml"),
+            lambda: 2,
+            cg_rule: CoarseGrainRule::Seed,
+            seed: None,
+            set: Vec::new(),
+            variant: None,
+            force_dt: false,
+            keep_going: false,
+            grid: grid.map(str::to_string),
+            balance: balance.map(str::to_string),
+        }
+    }
+
+    #[test]
+    fn a_resumed_run_keeps_its_stored_grid_unless_given_another() {
+        let stored = invocation(Some("2x1x1"), Some("1.2"));
+        let (kept, grid, balance) = stored
+            .clone()
+            .with_grid(None, BalanceSpec::default())
+            .unwrap();
+        assert_eq!(grid, Some("2x1x1".parse().unwrap()));
+        assert_eq!(balance, "1.2".parse().unwrap());
+        assert_eq!(kept, stored);
+        // Another grid: the stored one is replaced, in the command line too.
+        let other: GridSpec = "1x2x1".parse().unwrap();
+        let (moved, grid, balance) = stored
+            .with_grid(Some(other), BalanceSpec::default())
+            .unwrap();
+        assert_eq!(grid, Some(other));
+        assert_eq!(balance, BalanceSpec::default());
+        assert_eq!(moved.grid.as_deref(), Some("1x2x1"));
+        // No grid given or stored: none, and none recorded.
+        let (plain, grid, _) = invocation(None, None)
+            .with_grid(None, BalanceSpec::default())
+            .unwrap();
+        assert_eq!((grid, plain.grid, plain.balance), (None, None, None));
+    }
+
+    #[test]
+    fn a_stored_grid_that_does_not_parse_is_named() {
+        let err = invocation(Some("2y1"), None)
+            .with_grid(None, BalanceSpec::default())
+            .unwrap_err();
+        assert!(err.starts_with("the stored --grid/--balance:"), "{err}");
+        let err = invocation(Some("2x1x1"), Some("0.5"))
+            .with_grid(None, BalanceSpec::default())
+            .unwrap_err();
+        assert!(err.starts_with("the stored --grid/--balance:"), "{err}");
+    }
+
+    #[test]
+    fn resolve_takes_the_stored_command_line_only_without_a_scene_file() {
+        let dir = std::env::temp_dir().join(format!("cgdem-resolve-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let stored = invocation(Some("2x1x1"), Some("1.1"));
+        let mut restart = sample();
+        restart.invocation = serde_json::to_string(&stored).unwrap();
+        write(&dir, &restart).unwrap();
+        let given = invocation(None, None);
+        let (inv, loaded) = RunInvocation::resolve(given.clone(), false, Some(&dir)).unwrap();
+        assert_eq!((inv, loaded.is_some()), (stored, true));
+        let (inv, loaded) = RunInvocation::resolve(given.clone(), true, Some(&dir)).unwrap();
+        assert_eq!((inv, loaded.is_some()), (given.clone(), true));
+        let (inv, loaded) = RunInvocation::resolve(given.clone(), false, None).unwrap();
+        assert_eq!((inv, loaded.is_none()), (given, true));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

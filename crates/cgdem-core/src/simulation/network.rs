@@ -4,10 +4,11 @@
 
 use rayon::prelude::*;
 
-use super::{pair_force, Owner, ParticleState, World};
+use super::World;
 use crate::contact::PairLaw;
+use crate::force::{pair_force, Owner, ParticleState};
 use crate::math::{Real, Vec3};
-use crate::neighbor::VerletList;
+use crate::neighbor::pairs_within;
 use crate::walls::WallLaw;
 
 /// One pair the law acts on now (centre distance below its cut-off).
@@ -37,39 +38,29 @@ pub struct ContactNetwork {
 }
 
 impl<L: PairLaw, W: WallLaw> World<L, W> {
-    /// The pair contacts of the present positions and velocities, evaluated by the scene's
-    /// law on a copy of each pair's history, so the run itself is untouched. Read after a
-    /// step, the elastic part of each normal force is the one the step applied; the damping
-    /// part sees the velocities after the step's closing kick, where the step saw them half a
-    /// step earlier (a difference of order `dt` / contact time).
-    ///
-    /// While decomposed the world keeps no list of its own (the subdomains do): a list of
-    /// the gathered particles is built for the output, its pairs evaluated without their
-    /// tangential history, which the reported normal force does not depend on (the
-    /// tangential force is perpendicular to the normal).
+    /// The pair contacts of the gathered particles (`particles`, as of the last
+    /// `sync_particles`), evaluated by the scene's law. Read after a step, the elastic part
+    /// of each normal force is the one the step applied; the damping part sees the
+    /// velocities after the step's closing kick, where the step saw them half a step
+    /// earlier (a difference of order `dt` / contact time). The subdomains' lists hold
+    /// their pairs by subdomain, with ghosts: a pair search over the gathered particles
+    /// finds them for the output, evaluated without their tangential history, which the
+    /// reported normal force does not depend on (the tangential force is perpendicular to
+    /// the normal). The run itself is untouched.
     pub fn contact_network(&self) -> ContactNetwork {
-        let gathered = self.decomposition.is_some().then(|| {
-            // The build wraps periodic positions: the pairs' images are those of the copy.
-            let mut wrapped = self.particles.clone();
-            let mut fresh = VerletList::new(self.neighbor.skin);
-            fresh.build(&mut wrapped, &self.domain, self.law.reach(), false);
-            (wrapped, fresh)
-        });
-        let (p, list, history): (_, _, &[L::History]) = match &gathered {
-            Some((wrapped, fresh)) => (wrapped, fresh, &[]),
-            None => (&self.particles, &self.list, &self.history),
-        };
+        let mut p = self.particles().clone();
+        for x in p.position.iter_mut() {
+            *x = self.domain.wrap(*x);
+        }
+        let p = &p;
+        let list = pairs_within(p, &self.domain, self.law.reach() + self.neighbor.skin);
         let state = ParticleState::of(p);
-        let images: [Vec3; 27] = std::array::from_fn(|k| self.domain.image_shift(k as u8));
         let pairs: Vec<PairContact> = list
-            .pairs
             .par_iter()
-            .enumerate()
             .with_min_len(4096)
-            .filter_map(|(k, &pair)| {
-                let i = pair.i as usize;
+            .filter_map(|&pair| {
+                let (i, j) = (pair.i as usize, pair.j as usize);
                 let owner = Owner {
-                    index: i,
                     position: p.position[i],
                     velocity: p.velocity[i],
                     omega: p.angular.as_ref().map_or(Vec3::ZERO, |a| a.omega[i]),
@@ -77,23 +68,23 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     inv_mass: p.inv_mass[i],
                     species_row: p.species[i] as usize * self.n_species,
                 };
-                let mut history = history.get(k).copied().unwrap_or_default();
+                let shift = self.domain.image_shift(pair.image);
+                let mut history = L::History::default();
                 let (result, overlap, _) = pair_force(
                     &self.law,
                     &state,
-                    &images,
                     &owner,
-                    pair,
+                    j,
+                    p.position[j] + shift,
                     &mut history,
                     self.dt,
                 );
-                let shift = images[pair.image as usize];
-                let d = p.position[i] - (p.position[pair.j as usize] + shift);
+                let d = p.position[i] - (p.position[j] + shift);
                 let within = d.length()
                     < self.law.cutoff(
-                        owner.species_row + p.species[pair.j as usize] as usize,
+                        owner.species_row + p.species[j] as usize,
                         p.radius[i],
-                        p.radius[pair.j as usize],
+                        p.radius[j],
                     );
                 within.then(|| PairContact {
                     i: pair.i,
@@ -125,12 +116,16 @@ pub(crate) mod tests {
     use crate::contact::rolling::NoRolling;
     use crate::contact::tangential::Mindlin;
     use crate::contact::ContactLaw;
+    use crate::decomposition::GridSpec;
     use crate::domain::Domain;
     use crate::particles::Particles;
-    use crate::simulation::NeighborSettings;
-    use crate::walls::{HertzWall, WallSet};
+    use crate::simulation::{Decompose, NeighborSettings, WorldSetup};
+    use crate::walls::HertzWall;
 
     pub(crate) const R: Real = 1e-3;
+
+    type HertzWorld =
+        World<ContactLaw<Hertz, HertzDamping, Mindlin, NoRolling, NoCohesion>, HertzWall>;
 
     /// Spheres of radius `R` (Hertz, Mindlin, no gravity) in a box of half-width `half`.
     pub(crate) fn hertz_world(
@@ -139,7 +134,27 @@ pub(crate) mod tests {
         half: Real,
         periodic: bool,
         restitution: Real,
-    ) -> World<ContactLaw<Hertz, HertzDamping, Mindlin, NoRolling, NoCohesion>, HertzWall> {
+    ) -> HertzWorld {
+        let decompose = Decompose::default();
+        hertz_world_on(
+            positions,
+            velocities,
+            half,
+            periodic,
+            restitution,
+            decompose,
+        )
+    }
+
+    /// [`hertz_world`] on the grid `decompose` gives.
+    pub(crate) fn hertz_world_on(
+        positions: &[Vec3],
+        velocities: &[Vec3],
+        half: Real,
+        periodic: bool,
+        restitution: Real,
+        decompose: Decompose,
+    ) -> HertzWorld {
         let material = Material {
             youngs_modulus: 5e6,
             poisson_ratio: 0.3,
@@ -175,20 +190,12 @@ pub(crate) mod tests {
             hi: Vec3::splat(half),
             periodic: [periodic, false, false],
         };
-        World::new(
-            particles,
-            domain,
-            WallSet::default(),
-            law,
-            wall,
-            1,
-            Vec3::ZERO,
-            1e-7,
-            NeighborSettings {
-                skin: 0.5 * R,
-                resort_every: 0,
-            },
-        )
+        let neighbor = NeighborSettings {
+            skin: 0.5 * R,
+            resort_every: 0,
+        };
+        let setup = WorldSetup::new(particles, domain, law, wall, 1, Vec3::ZERO, 1e-7, neighbor);
+        World::new(setup, &decompose).expect("the particles fit the box")
     }
 
     #[test]
@@ -203,10 +210,11 @@ pub(crate) mod tests {
         // Undamped, so that the whole normal force is the one the step applied.
         let mut w = hertz_world(&x, &v, 0.01, false, 1.0);
         w.step();
+        w.sync_particles();
         let network = w.contact_network();
         assert_eq!(network.coordination, [1, 2, 1]);
         assert_eq!(network.pairs.len(), 2);
-        let p = &w.particles;
+        let p = w.particles();
         // Particle 0 has one contact: its normal force is its force along the line of centres.
         let c = network
             .pairs
@@ -220,15 +228,15 @@ pub(crate) mod tests {
         let distance = (p.position[0] - p.position[1]).length();
         assert_eq!(c.overlap, 2.0 * R - distance);
         // Reading the network leaves the run as it was.
-        let before = (p.force.clone(), w.history().to_vec());
+        let before = (p.force.clone(), w.pair_histories());
         let _ = w.contact_network();
-        assert_eq!((w.particles.force.clone(), w.history().to_vec()), before);
+        assert_eq!((w.particles().force.clone(), w.pair_histories()), before);
     }
 
     #[test]
-    fn a_decomposed_world_reports_the_contacts_of_its_gathered_particles() {
-        // The world's own list is empty while decomposed: the network must still hold the
-        // contacts, with the same normal forces (they do not depend on tangential history).
+    fn a_world_on_two_subdomains_reports_the_contacts_it_reports_on_one() {
+        // The network comes from the gathered particles, whatever the grid: the same
+        // contacts with the same normal forces (they do not depend on tangential history).
         let x = [
             Vec3::new(-1.9 * R, 0.0, 0.0),
             Vec3::ZERO,
@@ -236,13 +244,18 @@ pub(crate) mod tests {
         ];
         let v = [Vec3::new(0.1, 0.02, 0.0), Vec3::ZERO, Vec3::ZERO];
         let whole = hertz_world(&x, &v, 0.01, false, 1.0);
-        let mut split = hertz_world(&x, &v, 0.01, false, 1.0);
-        split
-            .set_grid(
-                crate::decomposition::GridSpec::Given([2, 1, 1]),
-                crate::decomposition::Comm::local(),
-            )
-            .expect("a 2x1x1 grid fits");
+        let split = hertz_world_on(
+            &x,
+            &v,
+            0.01,
+            false,
+            1.0,
+            Decompose {
+                grid: Some(GridSpec::Given([2, 1, 1])),
+                ..Decompose::default()
+            },
+        );
+        assert_eq!(split.grid(), [2, 1, 1]);
         let (a, b) = (whole.contact_network(), split.contact_network());
         assert_eq!(b.coordination, [1, 2, 1]);
         assert_eq!(a.coordination, b.coordination);
@@ -264,7 +277,7 @@ pub(crate) mod tests {
         let network = w.contact_network();
         assert_eq!(network.pairs.len(), 1);
         let c = network.pairs[0];
-        let p = &w.particles;
+        let p = w.particles();
         let line = p.position[c.i as usize] - (p.position[c.j as usize] + c.image_shift);
         assert!((line.length() - 1.9 * R).abs() < 1e-12);
         assert!((c.overlap - 0.1 * R).abs() < 1e-12);

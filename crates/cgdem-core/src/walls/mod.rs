@@ -97,6 +97,19 @@ pub struct WallParticle {
     pub mass: Real,
 }
 
+/// A set of walls by index, one bit each (walls from 64 on are always in it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct WallMask(pub u64);
+
+impl WallMask {
+    pub const ALL: WallMask = WallMask(u64::MAX);
+
+    #[inline(always)]
+    pub fn has(self, k: usize) -> bool {
+        k >= 64 || self.0 & (1 << k) != 0
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct Wall {
     pub name: String,
@@ -122,12 +135,38 @@ impl WallSet {
         }
     }
 
+    /// The walls a particle at `position` may reach before it moves `margin` (at most half
+    /// the skin until the next list build), as a bit per wall: those whose plane is closer
+    /// than its reach plus `margin`, or behind it (for the guard), whatever the wall's
+    /// extent. All walls when there are more than 64.
+    pub fn near<W: WallLaw>(&self, law: &W, particle: &WallParticle, margin: Real) -> WallMask {
+        if self.walls.len() > 64 {
+            return WallMask::ALL;
+        }
+        let reach = law.reach(particle.species, particle.radius) + margin;
+        let mut bits = 0u64;
+        for (k, wall) in self.walls.iter().enumerate() {
+            let plane = &wall.plane;
+            if (particle.position - plane.point).dot(plane.normal) < reach {
+                bits |= 1 << k;
+            }
+        }
+        WallMask(bits)
+    }
+
     /// Total force of the active walls on one particle, and its deepest overlap with one of
     /// them as a fraction of its radius (for the overlap guard, from the same distances).
+    /// Only the walls of `near` are looked at: the others are out of reach.
     #[inline(always)]
-    pub fn force_on<W: WallLaw>(&self, law: &W, particle: &WallParticle, dt: Real) -> (Vec3, Real) {
+    pub fn force_on<W: WallLaw>(
+        &self,
+        law: &W,
+        particle: &WallParticle,
+        near: WallMask,
+        dt: Real,
+    ) -> (Vec3, Real) {
         let (mut force, mut overlap) = (Vec3::ZERO, 0.0);
-        self.each_wall(law, particle, &mut overlap, |_, contact| {
+        self.each_wall(law, particle, near, &mut overlap, |_, contact| {
             if let Some(c) = contact {
                 force += law.force(&c, dt);
             }
@@ -137,47 +176,58 @@ impl WallSet {
 
     /// Total force and torque of the active walls on one spinning particle, and its deepest
     /// overlap fraction; `history` holds one entry per wall (index order), reset for walls
-    /// the particle does not touch.
+    /// of `near` the particle does not touch (those beyond `near` are at rest already).
     #[inline(always)]
     pub fn force_and_torque_on<W: WallLaw>(
         &self,
         law: &W,
         particle: &WallParticle,
+        near: WallMask,
         omega: Vec3,
         history: &mut [W::History],
         dt: Real,
     ) -> (Vec3, Vec3, Real) {
         let (mut force, mut torque, mut overlap) = (Vec3::ZERO, Vec3::ZERO, 0.0);
-        self.each_wall(law, particle, &mut overlap, |k, contact| match contact {
-            Some(c) => {
-                let (f, t) = law.force_and_torque_with_history(&c, omega, &mut history[k], dt);
-                force += f;
-                torque += t;
-            }
-            // Most particles are far from most walls: testing costs a read, an
-            // unconditional reset a write of every particle's history every step.
-            None => {
-                if history[k] != W::History::default() {
-                    history[k] = W::History::default();
+        self.each_wall(
+            law,
+            particle,
+            near,
+            &mut overlap,
+            |k, contact| match contact {
+                Some(c) => {
+                    let (f, t) = law.force_and_torque_with_history(&c, omega, &mut history[k], dt);
+                    force += f;
+                    torque += t;
                 }
-            }
-        });
+                // Most particles are far from most walls: testing costs a read, an
+                // unconditional reset a write of every particle's history every step.
+                None => {
+                    if history[k] != W::History::default() {
+                        history[k] = W::History::default();
+                    }
+                }
+            },
+        );
         (force, torque, overlap)
     }
 
-    /// Calls `act(k, contact)` for every wall k: the contact when the particle touches it
-    /// (an active wall, within reach, on its front side), None otherwise; keeps the deepest
-    /// overlap (a centre behind a wall counts, for the guard).
+    /// Calls `act(k, contact)` for every wall k of `near`: the contact when the particle
+    /// touches it (an active wall, within reach, on its front side), None otherwise; keeps
+    /// the deepest overlap (a centre behind a wall counts, for the guard).
     #[inline(always)]
     fn each_wall<W: WallLaw>(
         &self,
         law: &W,
         particle: &WallParticle,
+        near: WallMask,
         overlap: &mut Real,
         mut act: impl FnMut(usize, Option<WallContact>),
     ) {
         let reach = law.reach(particle.species, particle.radius);
         for (k, wall) in self.walls.iter().enumerate() {
+            if !near.has(k) {
+                continue;
+            }
             let distance = wall
                 .active
                 .then(|| wall.plane.distance(particle.position))

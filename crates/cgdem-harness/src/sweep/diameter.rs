@@ -233,12 +233,6 @@ pub fn diameter_sweep(
         .map(|&d| scale_to_diameter(scene, d).map(|s| (d, s)))
         .collect::<Result<Vec<_>, _>>()?;
     let published = published_porosity()?;
-    let published_at = |d: Real| {
-        published
-            .iter()
-            .find(|p| (p.diameter_um / (d * 1e6) - 1.0).abs() < 1e-6)
-            .map(|p| p.porosity)
-    };
     let write = |name: &str, table: &mut CsvBuffer| {
         table
             .bytes()
@@ -246,27 +240,7 @@ pub fn diameter_sweep(
             .map_err(|e| format!("cannot write {}: {e}", out.join(name).display()))
     };
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let mut csv = CsvBuffer::new([
-        "diameter_m",
-        "diameter_um",
-        "n_particles",
-        "steps",
-        "dt_s",
-        "contact_period_s",
-        "vdw_cutoff_gap_m",
-        "bond_number",
-        "simulated_s",
-        "settled",
-        "porosity",
-        "published_porosity",
-        "region_z_lo_m",
-        "region_z_hi_m",
-        "region_height_d",
-        "bed_height_d",
-        "mean_pore_diameter_m",
-        "median_pore_diameter_m",
-        "wall_s",
-    ]);
+    let mut csv = porosity_csv();
     let mut psd_csv = CsvBuffer::new([
         "diameter_um",
         "pore_diameter_lo_um",
@@ -288,59 +262,122 @@ pub fn diameter_sweep(
         let started = Instant::now();
         let summary = run(s, &options).map_err(|e| e.to_string())?;
         let wall = started.elapsed().as_secs_f64();
-        let p: Option<&PackingSummary> = summary.packing.as_ref();
-        let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-        let settled = summary
-            .stages
-            .last()
-            .is_some_and(|st| st.ended_by.starts_with("kinetic energy"));
-        csv.row([
-            format!("{d:e}"),
-            format_um(*d),
-            summary.n_particles.to_string(),
-            summary.steps.to_string(),
-            format!("{:.6e}", summary.dt_s),
-            format!("{:.6e}", summary.contact_period_s),
-            f(vdw_cutoff(s)),
-            f(bond_number(s)),
-            format!("{:.6e}", summary.simulated_s),
-            settled.to_string(),
-            p.map_or(String::new(), |p| format!("{:.5}", p.porosity)),
-            published_at(*d).map_or(String::new(), |v| format!("{v}")),
-            f(p.map(|p| p.region_z_m[0])),
-            f(p.map(|p| p.region_z_m[1])),
-            p.map_or(String::new(), |p| {
-                format!("{:.2}", p.region_height_diameters)
-            }),
-            p.map_or(String::new(), |p| format!("{:.2}", p.bed_height_diameters)),
-            f(p.map(|p| p.mean_pore_diameter_m)),
-            f(p.map(|p| p.median_pore_diameter_m)),
-            format!("{wall:.1}"),
-        ]);
+        let published_here = published
+            .iter()
+            .find(|p| (p.diameter_um / (d * 1e6) - 1.0).abs() < 1e-6)
+            .map(|p| p.porosity);
+        porosity_row(&mut csv, *d, s, &summary, wall, published_here);
         write("porosity_vs_diameter.csv", &mut csv)?;
-        if p.is_some() {
-            let path = run_dir.join("pore_size.csv");
-            let rows = CsvTable::read(&path)
-                .and_then(|t| t.numbers(&["diameter_lo", "diameter_hi", "fraction", "cumulative"]))
-                .map_err(|e| e.to_string())?;
-            let mut points = Vec::new();
-            for row in rows {
-                let (lo, hi, fraction, cumulative) = (row[0], row[1], row[2], row[3]);
-                psd_csv.row([
-                    format_um(*d),
-                    format!("{:.6}", lo * 1e6),
-                    format!("{:.6}", hi * 1e6),
-                    format!("{fraction:.6e}"),
-                    format!("{cumulative:.6e}"),
-                ]);
-                points.push((0.5 * (lo + hi) * 1e6, fraction));
-            }
+        if summary.packing.is_some() {
+            let points = pore_size_rows(&run_dir.join("pore_size.csv"), *d, &mut psd_csv)?;
             write("pore_size_vs_diameter.csv", &mut psd_csv)?;
             psd.push((*d, points));
         }
         results.push((*d, summary));
     }
+    write_porosity_figure(out, &results, &published)?;
+    if !psd.is_empty() {
+        write_pore_size_figure(out, &psd)?;
+    }
+    Ok(results)
+}
 
+/// `porosity_vs_diameter.csv` before its first row.
+fn porosity_csv() -> CsvBuffer {
+    CsvBuffer::new([
+        "diameter_m",
+        "diameter_um",
+        "n_particles",
+        "steps",
+        "dt_s",
+        "contact_period_s",
+        "vdw_cutoff_gap_m",
+        "bond_number",
+        "simulated_s",
+        "settled",
+        "porosity",
+        "published_porosity",
+        "region_z_lo_m",
+        "region_z_hi_m",
+        "region_height_d",
+        "bed_height_d",
+        "mean_pore_diameter_m",
+        "median_pore_diameter_m",
+        "wall_s",
+    ])
+}
+
+/// One run's row of `porosity_vs_diameter.csv`.
+fn porosity_row(
+    csv: &mut CsvBuffer,
+    d: Real,
+    s: &Scene,
+    summary: &RunSummary,
+    wall: f64,
+    published: Option<Real>,
+) {
+    let p: Option<&PackingSummary> = summary.packing.as_ref();
+    let f = |v: Option<Real>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+    let settled = summary
+        .stages
+        .last()
+        .is_some_and(|st| st.ended_by.starts_with("kinetic energy"));
+    csv.row([
+        format!("{d:e}"),
+        format_um(d),
+        summary.n_particles.to_string(),
+        summary.steps.to_string(),
+        format!("{:.6e}", summary.dt_s),
+        format!("{:.6e}", summary.contact_period_s),
+        f(vdw_cutoff(s)),
+        f(bond_number(s)),
+        format!("{:.6e}", summary.simulated_s),
+        settled.to_string(),
+        p.map_or(String::new(), |p| format!("{:.5}", p.porosity)),
+        published.map_or(String::new(), |v| format!("{v}")),
+        f(p.map(|p| p.region_z_m[0])),
+        f(p.map(|p| p.region_z_m[1])),
+        p.map_or(String::new(), |p| {
+            format!("{:.2}", p.region_height_diameters)
+        }),
+        p.map_or(String::new(), |p| format!("{:.2}", p.bed_height_diameters)),
+        f(p.map(|p| p.mean_pore_diameter_m)),
+        f(p.map(|p| p.median_pore_diameter_m)),
+        format!("{wall:.1}"),
+    ]);
+}
+
+/// Reads a run's `pore_size.csv` (at `path`) into `psd_csv`'s rows for diameter `d`; returns
+/// the distribution as (bin centre in um, fraction).
+fn pore_size_rows(
+    path: &Path,
+    d: Real,
+    psd_csv: &mut CsvBuffer,
+) -> Result<Vec<(Real, Real)>, String> {
+    let rows = CsvTable::read(path)
+        .and_then(|t| t.numbers(&["diameter_lo", "diameter_hi", "fraction", "cumulative"]))
+        .map_err(|e| e.to_string())?;
+    let mut points = Vec::new();
+    for row in rows {
+        let (lo, hi, fraction, cumulative) = (row[0], row[1], row[2], row[3]);
+        psd_csv.row([
+            format_um(d),
+            format!("{:.6}", lo * 1e6),
+            format!("{:.6}", hi * 1e6),
+            format!("{fraction:.6e}"),
+            format!("{cumulative:.6e}"),
+        ]);
+        points.push((0.5 * (lo + hi) * 1e6, fraction));
+    }
+    Ok(points)
+}
+
+/// `porosity_vs_diameter_plot`: the runs' porosity against diameter with the published points.
+fn write_porosity_figure(
+    out: &Path,
+    results: &[(Real, RunSummary)],
+    published: &[PublishedPorosity],
+) -> Result<(), String> {
     let measured: Vec<(Real, Real)> = results
         .iter()
         .filter_map(|(d, s)| s.packing.as_ref().map(|p| (d * 1e6, p.porosity)))
@@ -364,7 +401,12 @@ pub fn diameter_sweep(
         .y_err(published.iter().map(|p| p.read_uncertainty).collect()),
     );
     write_figure(out, "porosity_vs_diameter_plot", &fig).map_err(|e| e.to_string())?;
+    Ok(())
+}
 
+/// `pore_size_distribution_plot`: the runs at paper B's Fig. 2(b) diameters, or every run if
+/// none of them was swept.
+fn write_pore_size_figure(out: &Path, psd: &[(Real, Vec<(Real, Real)>)]) -> Result<(), String> {
     let at_paper: Vec<&(Real, Vec<(Real, Real)>)> = psd
         .iter()
         .filter(|(d, _)| {
@@ -390,10 +432,8 @@ pub fn diameter_sweep(
                 .style(SeriesStyle::LineMarkers),
         );
     }
-    if !psd.is_empty() {
-        write_figure(out, "pore_size_distribution_plot", &fig).map_err(|e| e.to_string())?;
-    }
-    Ok(results)
+    write_figure(out, "pore_size_distribution_plot", &fig).map_err(|e| e.to_string())?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -14,9 +14,11 @@ use cgdem_core::run::{run, Progress, RunOptions, RunSummary, StageEnding};
 use cgdem_core::scene::{Scene, StageEnd};
 
 mod diameter;
+mod dispatch;
 pub use diameter::{
     diameter_sweep, published_porosity, scale_to_diameter, PublishedPorosity, PAPER_PSD_DIAMETERS,
 };
+pub use dispatch::{SweepOutcome, SweepSettings};
 
 /// A parsed `--sweep KEY=V1,V2,...`.
 #[derive(Clone, Debug, PartialEq)]

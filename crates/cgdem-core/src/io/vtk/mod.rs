@@ -194,7 +194,7 @@ impl VtkOutput {
                 &title,
                 d.lo,
                 d.hi,
-                &world.particles,
+                world.particles(),
                 &d.diameters,
                 &d.densities,
                 d.diameters.len(),
@@ -245,7 +245,7 @@ pub fn particles_vtu<L: PairLaw, W: WallLaw>(
     world: &World<L, W>,
     network: &ContactNetwork,
 ) -> [Vec<u8>; 3] {
-    let p = &world.particles;
+    let p = world.particles();
     let n = p.len();
     let spin = p.angular.as_ref();
     let per_particle = 8 * (3 + 1 + 3 + 3 + if spin.is_some() { 6 } else { 0 }) + 4 + 2 + 4 + 9;
@@ -308,7 +308,7 @@ pub fn contacts_vtu<L: PairLaw, W: WallLaw>(
     world: &World<L, W>,
     network: &ContactNetwork,
 ) -> [Vec<u8>; 3] {
-    let p = &world.particles;
+    let p = world.particles();
     let pairs = &network.pairs;
     let m = pairs.len();
     let mut vtu = Vtu::new(2 * m, m, 72 * m + 1024);
@@ -363,7 +363,7 @@ mod tests {
             .map(|k| Vec3::new(1e-3 * (k % 7) as Real, 0.0, -1e-3))
             .collect();
         let world = hertz_world(&x, &v, half, false, 0.5);
-        let n = world.particles.len() as Real;
+        let n = world.particles().len() as Real;
         let contacts = world.contact_network().pairs.len() as Real;
         let mut medians = Vec::new();
         for network in [false, true] {

@@ -20,7 +20,7 @@ pub(crate) fn conveying_sample<L: PairLaw, W: WallLaw>(
     body: &Body,
     world: &World<L, W>,
 ) -> ConveyingSample {
-    let p = &world.particles;
+    let p = world.particles();
     let mobile: Vec<usize> = (0..p.len()).filter(|&k| !p.is_frozen(k)).collect();
     let position: Vec<Vec3> = mobile.iter().map(|&k| p.position[k]).collect();
     let radius: Vec<Real> = mobile.iter().map(|&k| p.radius[k]).collect();

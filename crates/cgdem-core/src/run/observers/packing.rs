@@ -53,8 +53,8 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for PackingMeter<'_> {
         let (lo, hi) = (self.scene.domain.lo, self.scene.domain.hi);
         let pk = self.settings;
         match measure_packing(
-            &world.particles.position,
-            &world.particles.radius,
+            &world.particles().position,
+            &world.particles().radius,
             [lo.x, lo.y],
             [hi.x, hi.y],
             lo.z,

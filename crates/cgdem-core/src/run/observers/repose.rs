@@ -105,7 +105,7 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ReposeMeter<'_> {
     fn observe(&mut self, world: &World<L, W>, _clock: &StageClock) -> Result<Flow, RunError> {
         let t = self.times[self.next];
         self.next += 1;
-        self.sample(&world.particles, t, SampleTrigger::FixedTime)?;
+        self.sample(world.particles(), t, SampleTrigger::FixedTime)?;
         Ok(Flow::Continue)
     }
 
@@ -117,7 +117,7 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ReposeMeter<'_> {
     ) -> Result<(), RunError> {
         if self.rule.stage == clock.stage.name && self.rule.at_stage_end {
             self.sample(
-                &world.particles,
+                world.particles(),
                 world.time - clock.start,
                 SampleTrigger::StageEnd,
             )?;
@@ -143,7 +143,7 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ReposeMeter<'_> {
     ) -> Result<(), RunError> {
         // A run that never reached a measurement still leaves its final profile.
         if !self.measured && !stopped {
-            if let Some(profile) = heap_profile(self.scene, &world.particles) {
+            if let Some(profile) = heap_profile(self.scene, world.particles()) {
                 self.write(&profile)?;
             }
         }

@@ -109,8 +109,8 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
         let elapsed = world.time - clock.start;
         self.next_row += self.scene.output.timeseries_interval;
         let ke = world.kinetic_energy();
-        let mass = world.particles.mobile_mass();
-        let profile = heap_profile(self.scene, &world.particles);
+        let mass = world.particles().mobile_mass();
+        let profile = heap_profile(self.scene, world.particles());
         let max_diameter = self.scene.max_diameter();
         let front = profile.as_ref().map(|p| p.front(2.0 * max_diameter));
         let wall_height = profile.as_ref().map(|p| p.wall_height());
@@ -120,7 +120,7 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for TimeSeries<'_> {
             clock.stage.name.clone(),
             format!("{ke:.9e}"),
             format!("{:.9e}", ke / mass.max(Real::MIN_POSITIVE)),
-            world.particles.len().to_string(),
+            world.particles().len().to_string(),
             opt(front),
             opt(wall_height),
             format!("{:.9e}", world.deleted_mass),

@@ -1,0 +1,595 @@
+//! The LAMMPS input for a Hertz scene (`damping = "hertz"`, `tangential = "history"`,
+//! `rolling = "none" | "epsd2"`), written from the scene alone, for small collision cases.
+//!
+//! The mapping onto `pair_style granular` is derived in `reference/MAPPING.md`:
+//! `hertz/material E q nu damping tsuji` with `q = P^-1(sqrt(5) |beta(e)|)` ([`tsuji_q`]),
+//! `tangential mindlin NULL x mu` with `x = sqrt(4 G_eff / Y_eff)` ([`tangential_damping_ratio`]),
+//! and for epsd2 `rolling sds k_roll 0 mu_r` with a *constant* `k_roll` (LAMMPS has no
+//! overlap-dependent rolling stiffness): `k_roll = 8 G_eff sqrt(R_eff delta_max)`, the
+//! Hertz tangential stiffness at the largest overlap of an undamped impact at the scene's
+//! `characteristic_velocity`. Walls are axis-aligned planes, `fix wall/gran granular` with
+//! the same sub-models (`zplane lo NULL` for a floor), their E and Mindlin stiffness chosen
+//! to give the particle-wall `Y_eff`, `G_eff` (see the wall lines below: the wall fix of this
+//! LAMMPS does not use `1 - nu^2`).
+//!
+//! Stages, wall removal (`unfix w_NAME`) and repose samples are written by `decks::stages`,
+//! as for the seed's deck and LIGGGHTS's, so the run goes through the same post-processing.
+
+use std::fmt::Write as _;
+
+use super::bodies::body_lines;
+use super::{removal_pads, DIALECT};
+use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use crate::decks::lines::{
+    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
+};
+use crate::decks::stages::{stage_lines, trajectory_lines, Periodic, StageHooks};
+use crate::decks::{Deck, DeckError, DeckPlan};
+use cgdem_core::contact::damping::restitution_beta;
+use cgdem_core::contact::normal::{Hertz, Material};
+use cgdem_core::math::Real;
+use cgdem_core::particles::Particles;
+use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
+
+/// LAMMPS's Tsuji polynomial `P(q)`: `damping tsuji q` gives `gamma_n = P(q) sqrt(m_eff k_n)`.
+pub fn tsuji_polynomial(q: Real) -> Real {
+    let c = [1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218];
+    c.iter().rev().fold(0.0, |acc, &a| acc * q + a)
+}
+
+/// The `damping tsuji` number that reproduces LIGGGHTS's `model hertz` dashpot for
+/// restitution `e`: `P(q) = sqrt(5) |beta(e)|` (P decreases on [0, 1]); None below e ~ 0.114,
+/// where `sqrt(5) |beta| > P(0)`, and near e = 1, where it is below `P(1)`.
+pub fn tsuji_q(restitution: Real) -> Option<Real> {
+    let target = 5.0_f64.sqrt() * restitution_beta(restitution).abs();
+    if target > tsuji_polynomial(0.0) || target < tsuji_polynomial(1.0) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if tsuji_polynomial(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// `gamma_t / gamma_n` of LIGGGHTS `model hertz` = `sqrt(S_t / S_n) = sqrt(4 G_eff / Y_eff)`,
+/// the `x` of LAMMPS `tangential mindlin NULL x mu`.
+pub fn tangential_damping_ratio(y_eff: Real, g_eff: Real) -> Real {
+    (4.0 * g_eff / y_eff).sqrt()
+}
+
+/// `k_roll` for LAMMPS `rolling sds`: the Hertz tangential stiffness `8 G_eff sqrt(R delta)` at
+/// the largest overlap of an undamped impact at `v`.
+pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: Real) -> Real {
+    let delta = Hertz::max_overlap(y_eff, r_eff, m_eff, v);
+    8.0 * g_eff * (r_eff * delta).sqrt()
+}
+
+/// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
+/// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
+pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
+    let h = hertz_settings(scene, "LAMMPS", true)?;
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
+    let m = material(h);
+    let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
+
+    let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
+    let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
+    let data = data_file(
+        scene,
+        particles,
+        &diameters,
+        &densities,
+        scene.species.len(),
+    );
+
+    let mut files = Vec::new();
+    let mut d = written_by(&DIALECT, scene);
+    d += "): Hertz, reference/MAPPING.md.\n";
+    d += &preamble(&DIALECT, scene);
+    d += &pair_lines(scene, h, m)?;
+    d += &neighbor_lines(&DIALECT, scene);
+    let (integrated, freeze) = frozen_lines(scene);
+    d += &freeze;
+    d += &integration_lines(scene, integrated, dt);
+    let wall_model = wall_model(scene, h, m)?;
+    d += &wall_fix_lines(scene, &wall_model)?;
+    let bodies = body_lines(scene, integrated, &wall_model)?;
+    d += &bodies.setup;
+    // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
+    // polynomial to its wall fixes' coefficient; the body region's fix is defined anew
+    // before each, planar walls cannot be.
+    let later_setups = scene.bodies.iter().any(|b| b.start_stage.is_some())
+        || scene.insertions.iter().any(|i| i.refill.is_some());
+    if later_setups && !scene.walls.is_empty() {
+        return Err(unsupported("planar walls with a top-up or a body that starts later: LAMMPS would re-apply its Tsuji polynomial to the walls' damping at each setup (reference/HERTZ_COLLAPSE.md)".into()));
+    }
+    for (start, motion) in &bodies.motions {
+        if start.is_none() {
+            d += motion;
+        }
+    }
+    d += &removal_pads(scene, 1);
+    d += &deletion_lines(scene, integrated, dump_every);
+    let top_ups = top_up_lines(scene, integrated, dt, &mut files);
+    d += &top_ups.setup;
+    let dumps = trajectory_lines(
+        &mut d,
+        dump_every,
+        true,
+        HERTZ_COLUMNS,
+        "format float %.17g sort id",
+    );
+    let begin = |stage: &str| {
+        let mut lines = String::new();
+        for (start, motion) in &bodies.motions {
+            if start.as_deref() == Some(stage) {
+                lines += motion;
+            }
+        }
+        lines += &top_ups.begin(stage);
+        if !lines.is_empty() {
+            lines += &bodies.refix_walls;
+            lines += "run             0 post no\n";
+        }
+        lines
+    };
+    let periodic = |stage: &str| top_ups.periodic(stage, &bodies.refix_walls);
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &dumps,
+        &StageHooks {
+            unfix: &unfix_wall,
+            begin: &begin,
+            periodic: &periodic,
+        },
+    );
+    let mut notes = bodies.notes;
+    if !bodies.refix_walls.is_empty() && later_setups {
+        notes.push("LAMMPS: the body region's wall fix is defined anew at each setup (when the screw starts, at each top-up), so grains sliding on the casing lose their tangential history then".into());
+    }
+    notes.extend(model_notes(scene, h, dump_every));
+    Ok(Deck {
+        input: d,
+        data,
+        files,
+        plan: DeckPlan {
+            code: DIALECT.code.name(),
+            log_file: DIALECT.log_file,
+            notes,
+            dt,
+            dump_every,
+            repose_dumps,
+        },
+    })
+}
+
+/// LAMMPS's Tsuji coefficient `q` for restitution `e`, or why this LAMMPS cannot damp so.
+fn tsuji_q_of(scene: &Scene, e: Real) -> Result<Real, DeckError> {
+    tsuji_q(e).ok_or_else(|| {
+        DeckError::unsupported(scene, if e < 0.5 {
+            format!("restitution {e}: damping tsuji cannot reach LIGGGHTS's dashpot below e ~ 0.114")
+        } else {
+            format!("restitution {e}: damping tsuji cannot damp as little as LIGGGHTS's dashpot does (its least damping, q = 1, is more)")
+        })
+    })
+}
+
+/// `pair_style granular` with the particle-particle `pair_coeff` (Hertz, Tsuji damping,
+/// Mindlin, and `rolling sds` for epsd2 at the scene's characteristic speed, first species).
+fn pair_lines(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, DeckError> {
+    let (y_eff, g_eff) = (Material::y_eff(m, m), Material::g_eff(m, m));
+    let s0 = &scene.species[0];
+    let rolling = match h.rolling {
+        RollingKind::Epsd2 => format!(
+            " rolling sds {} 0.0 {}",
+            g(rolling_stiffness(
+                y_eff,
+                g_eff,
+                s0.radius() * 0.5,
+                s0.mass() * 0.5,
+                h.characteristic_velocity
+            )),
+            g(h.rolling_friction)
+        ),
+        _ => String::new(),
+    };
+    let mut d = String::from("pair_style      granular\n");
+    let _ = writeln!(
+        d,
+        "# q = P^-1(sqrt(5)|beta(e)|) for e = {}; x = sqrt(4 G*/Y*)",
+        h.restitution
+    );
+    let _ = writeln!(
+        d,
+        "pair_coeff      * * hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {}{}",
+        g(m.youngs_modulus),
+        g(tsuji_q_of(scene, h.restitution)?),
+        g(m.poisson_ratio),
+        g(tangential_damping_ratio(y_eff, g_eff)),
+        g(h.friction),
+        rolling
+    );
+    Ok(d)
+}
+
+/// Time integration of the `integrated` group, gravity and the time step.
+fn integration_lines(scene: &Scene, integrated: &str, dt: Real) -> String {
+    let mut d = String::new();
+    let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
+    if scene.gravity.length() > 0.0 {
+        let dir = scene.gravity / scene.gravity.length();
+        let _ = writeln!(
+            d,
+            "fix             grav all gravity {} vector {} {} {}",
+            g(scene.gravity.length()),
+            g(dir.x),
+            g(dir.y),
+            g(dir.z)
+        );
+    }
+    let _ = writeln!(d, "timestep        {}", g(dt));
+    d
+}
+
+/// The particle-wall model of `fix wall/gran granular` (planar walls and body regions),
+/// empty for a scene with neither.
+fn wall_model(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, DeckError> {
+    let s0 = &scene.species[0];
+    // Particle-wall pair values, passed so that this LAMMPS computes them exactly: its
+    // fix wall/gran hertz/material takes k_n = (4/3) E/(2(1 - nu)) sqrt(R delta) (measured:
+    // contact 10% short with E itself, (1 + nu)^(-2/5)), so E is given as 2 (1 - nu) Y_eff;
+    // the Mindlin stiffness is given explicitly (8 G_eff) rather than NULL.
+    let wm = wall_material(scene, h);
+    let (y_w, g_w) = (Material::y_eff(m, wm), Material::g_eff(m, wm));
+    let w = &scene.wall_contact;
+    // The wall acts as a particle of infinite radius and mass: R_eff = r, m_eff = m.
+    let wall_rolling = if h.rolling == RollingKind::Epsd2 {
+        format!(
+            " rolling sds {} 0.0 {}",
+            g(rolling_stiffness(
+                y_w,
+                g_w,
+                s0.radius(),
+                s0.mass(),
+                h.characteristic_velocity
+            )),
+            g(w.rolling_friction)
+        )
+    } else {
+        String::new()
+    };
+    if scene.walls.is_empty() && scene.bodies.is_empty() {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{wall_rolling}",
+        g(2.0 * (1.0 - m.poisson_ratio) * y_w),
+        g(tsuji_q_of(scene, w.restitution)?),
+        g(m.poisson_ratio),
+        g(8.0 * g_w),
+        g(tangential_damping_ratio(y_w, g_w)),
+        g(w.friction),
+    ))
+}
+
+/// One `fix wall/gran` per planar wall, with the particle-wall `model`.
+fn wall_fix_lines(scene: &Scene, wall_model: &str) -> Result<String, DeckError> {
+    let mut lines = String::new();
+    for wall in &scene.walls {
+        let (axis, up) = wall_axis(scene, wall)?;
+        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
+        let (lo, hi) = if up {
+            (at, "NULL".to_string())
+        } else {
+            ("NULL".to_string(), at)
+        };
+        let _ = writeln!(
+            lines,
+            "fix             w_{} all wall/gran granular {wall_model} {}plane {lo} {hi}",
+            wall.name,
+            ["x", "y", "z"][axis]
+        );
+    }
+    Ok(lines)
+}
+
+/// `[[delete]]` boxes: grains whose centres enter one are removed, checked every output
+/// interval.
+fn deletion_lines(scene: &Scene, integrated: &str, dump_every: u64) -> String {
+    let mut d = String::new();
+    for (k, (lo, hi)) in scene.deletions.iter().enumerate() {
+        d += &block_region(&format!("delete_{k}"), *lo, *hi);
+        let _ = writeln!(
+            d,
+            "fix             delete_{k} {integrated} evaporate {dump_every} 1000000 delete_{k} {}",
+            DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()]
+        );
+    }
+    d
+}
+
+/// Where this LAMMPS deck's model differs from cgdem's and LIGGGHTS's.
+fn model_notes(scene: &Scene, h: &HertzSettings, dump_every: u64) -> Vec<String> {
+    let mut notes = Vec::new();
+    if !scene.deletions.is_empty() {
+        notes.push(format!("LAMMPS deletes grains in a [[delete]] box every {dump_every} steps (fix evaporate), cgdem every step"));
+    }
+    if h.rolling == RollingKind::Epsd2 {
+        notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
+    }
+    notes.push("LAMMPS tangential mindlin is not LIGGGHTS tangential history: full radii in the contact-point velocity, spring + dashpot capped at the Coulomb limit (reference/MAPPING.md)".into());
+    notes
+}
+
+/// Seeds of LAMMPS's random deletions and top-ups (primes; any positive integer will do).
+const DEPOSIT_SEEDS: [u64; 4] = [1000003, 2000003, 3000017, 4000037];
+
+/// The top-ups of a LAMMPS deck (`[[insert]] refill`): as cgdem, every `interval` of the
+/// refill stage the insertion box is filled back to the count it held when the stage began.
+/// LAMMPS's `create_atoms random` has no overlap check here, so each top-up is a `fix deposit`
+/// of the missing count (one atom per step, none closer to another than the two radii),
+/// whose one-atom molecule template carries the species' diameter and mass.
+struct TopUps {
+    setup: String,
+    entries: Vec<TopUp>,
+}
+
+struct TopUp {
+    insertion: usize,
+    stage: String,
+    every: u64,
+    near: Real,
+    group: String,
+}
+
+fn top_up_lines(
+    scene: &Scene,
+    integrated: &str,
+    dt: Real,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> TopUps {
+    let mut out = TopUps {
+        setup: String::new(),
+        entries: Vec::new(),
+    };
+    let max_radius = 0.5 * scene.max_diameter();
+    for (k, ins) in scene.insertions.iter().enumerate() {
+        let Some(refill) = &ins.refill else { continue };
+        let species = &scene.species[ins.species];
+        out.setup += &block_region(&format!("top_{k}"), ins.lo, ins.hi);
+        let file = format!("top_{k}.mol");
+        let _ = writeln!(out.setup, "molecule        top_{k} {file}");
+        let template = format!(
+            "# one {} grain (written by cgdem)\n\n1 atoms\n\nCoords\n\n1 0.0 0.0 0.0\n\nTypes\n\n1 {}\n\nDiameters\n\n1 {}\n\nMasses\n\n1 {}\n",
+            species.name,
+            ins.species + 1,
+            g(species.diameter),
+            g(species.mass())
+        );
+        files.push((file, template.into_bytes()));
+        out.entries.push(TopUp {
+            insertion: k,
+            stage: refill.stage.clone(),
+            every: ((refill.interval / dt).round() as u64).max(1),
+            near: species.radius() + max_radius,
+            group: integrated.to_string(),
+        });
+    }
+    out
+}
+
+impl TopUps {
+    /// At the start of `stage`: the count each of its top-ups keeps.
+    fn begin(&self, stage: &str) -> String {
+        let mut d = String::new();
+        for t in self.entries.iter().filter(|t| t.stage == stage) {
+            let k = t.insertion;
+            let _ = writeln!(
+                d,
+                "variable        top_target_{k} equal $(count(all,top_{k}))"
+            );
+        }
+        d
+    }
+
+    /// Every top-up interval of `stage`: deposit what each box lacks, define the walls anew
+    /// (`refix_walls`) and set up. Top-ups of one stage share the first one's interval.
+    fn periodic(&self, stage: &str, refix_walls: &str) -> Option<Periodic> {
+        let entries: Vec<(usize, Real, String)> = self
+            .entries
+            .iter()
+            .filter(|t| t.stage == stage)
+            .map(|t| (t.insertion, t.near, t.group.clone()))
+            .collect();
+        let every = self.entries.iter().find(|t| t.stage == stage)?.every;
+        let refix_walls = refix_walls.to_string();
+        Some(Periodic {
+            every,
+            lines: Box::new(move |n| {
+                let mut d = String::new();
+                for (k, near, group) in &entries {
+                    let add = format!("top_add_{k}_{n}");
+                    let _ = writeln!(
+                        d,
+                        "variable        {add} equal $((v_top_target_{k}-count(all,top_{k}))*(v_top_target_{k}>count(all,top_{k})))"
+                    );
+                    let seed = DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()] + 7919 * n as u64;
+                    let _ = writeln!(
+                        d,
+                        "if              \"${{{add}}} > 0\" then \"fix {add} {group} deposit ${{{add}}} 0 1 {seed} region top_{k} near {} attempt 200 mol top_{k} id max\"",
+                        g(*near)
+                    );
+                }
+                d += &refix_walls;
+                d += "run             0 post no\n";
+                d
+            }),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decks::hertz::{at, collapse_scene_and_particle};
+
+    #[test]
+    fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {
+        let (scene, particles) = collapse_scene_and_particle();
+        let deck = write_hertz_deck(&scene, &particles, 5e-5).unwrap();
+        let d = &deck.input;
+        assert_eq!(deck.plan.code, "lammps");
+        assert_eq!(deck.plan.dump_every, 200);
+        for wall in ["floor", "back", "gate", "end"] {
+            at(
+                d,
+                &format!("fix             w_{wall} all wall/gran granular hertz/material"),
+            );
+        }
+        at(d, "xplane NULL 1.00000000000000006e-1");
+        // One zero-force pad after the last wall fix, for the one wall unfixed.
+        assert!(
+            at(d, "fix             w_end")
+                < at(d, "fix             pad_0 all addforce 0.0 0.0 0.0")
+        );
+        assert!(!d.contains("pad_1"));
+        // Kinetic energy with the spins, as cgdem counts it.
+        at(d, "variable        kepm equal (c_ke+c_rke)/mass(all)");
+        // Settle: chunks of 0.01 s, at least 0.4 s (40), at most 2 s (200).
+        let settle = at(d, "variable        chunk0 loop 200");
+        at(d, &format!("${{chunk0}} >= 40 && ${{kepm}} < {}", g(1e-5)));
+        let settle_end = at(d, "label           end_stage0");
+        // The gate goes between the stages, and only the gate.
+        let unfix = at(d, "unfix           w_gate");
+        assert!(!d.contains("unfix           w_floor"));
+        let collapse = at(d, "CGDEM_STAGE collapse start");
+        assert!(settle < settle_end && settle_end < unfix && unfix < collapse);
+        // Collapse: at least 1 s, at most 3 s, samples at chunks 25, 50, 100 with spins.
+        at(d, "variable        chunk1 loop 300");
+        at(d, &format!("${{chunk1}} >= 100 && ${{kepm}} < {}", g(1e-5)));
+        let sample = at(d, "if              \"${chunk1} == 25\" then \"write_dump all custom repose_0.dump id type x y z vx vy vz omegax omegay omegaz radius modify format float %.17g sort id\"");
+        assert!(collapse < sample);
+        let times: Vec<Real> = deck.plan.repose_dumps.iter().map(|r| r.1).collect();
+        assert_eq!(times, [0.25, 0.5, 1.0]);
+        assert!(deck.plan.notes.iter().any(|n| n.contains("rolling sds")));
+    }
+
+    #[test]
+    fn screw_deck_turns_the_particle_screw_from_the_conveying_stage_inside_the_casing_region() {
+        crate::at_repo_root();
+        let scene = Scene::load(std::path::Path::new(
+            "validation/cases/screw_feeder_hertz_particles.toml",
+        ))
+        .unwrap();
+        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let screw_atoms = (0..particles.len())
+            .filter(|&k| particles.species[k] == 1)
+            .count();
+        assert!(screw_atoms > 1000, "{screw_atoms}");
+        let deck = write_hertz_deck(&scene, &particles, 6e-5).unwrap();
+        let d = &deck.input;
+        // The screw's atoms: frozen (effective mass the grain's), grouped, their pairs excluded.
+        at(d, "fix             freeze frozen freeze");
+        at(d, "neigh_modify    exclude type 2 2");
+        at(d, "group           body_screw type 2");
+        assert_eq!(
+            deck.data
+                .lines()
+                .filter(|l| l.split_whitespace().nth(1) == Some("2")
+                    && l.split_whitespace().count() == 7)
+                .count(),
+            screw_atoms
+        );
+        // Casing and hopper: one union region, felt by the mobile grains.
+        let walls = at(
+            d,
+            "fix             w_casing_hopper mobile wall/gran/region granular hertz/material",
+        );
+        at(d, "region          casing_hopper union 5");
+        // rpm -100 about +x: counter-clockwise about -x, 0.6 s per turn, from `convey` on,
+        // with the wall fix defined anew before the setup that starts it.
+        let settle_end = at(d, "CGDEM_STAGE settle end");
+        let turn = at(d, "fix             move_screw body_screw move rotate 0.00000000000000000e0 0.00000000000000000e0 0.00000000000000000e0 -1.00000000000000000e0 -0.00000000000000000e0 -0.00000000000000000e0 5.99999999999999978e-1");
+        let target = at(d, "variable        top_target_0 equal $(count(all,top_0))");
+        let refix = at(d, "unfix           w_casing_hopper");
+        let convey = at(d, "CGDEM_STAGE convey start");
+        assert!(
+            walls < settle_end
+                && settle_end < turn
+                && turn < target
+                && target < refix
+                && refix < convey
+        );
+        assert!(d[refix..convey].contains("run             0 post no"));
+        // Top-ups every 0.1 s (1667 steps): deposit what the box lacks, refix, set up.
+        let first = at(d, "variable        top_add_0_0 equal");
+        assert!(first > convey);
+        at(d, "fix top_add_0_0 mobile deposit ${top_add_0_0} 0 1 1000003 region top_0 near 2.16000000000000011e-2 attempt 200 mol top_0 id max");
+        let runs: Vec<&str> = d[convey..first]
+            .lines()
+            .filter(|l| l.starts_with("run"))
+            .collect();
+        assert_eq!(runs, ["run             1667 pre no post no"]);
+        // 1.8 s = 30000 steps: 17 top-ups, the last chunk 30000 - 17 * 1667 = 1661 steps.
+        assert!(d.contains("top_add_0_16 ") && !d.contains("top_add_0_17 "));
+        at(d, "run             1661 pre no post no");
+        let template = deck
+            .files
+            .iter()
+            .find(|(name, _)| name == "top_0.mol")
+            .unwrap();
+        let template = String::from_utf8_lossy(&template.1);
+        assert!(
+            template.contains("Diameters\n\n1 2.16000000000000011e-2"),
+            "{template}"
+        );
+        // The outlet's deletion box.
+        at(d, "region          delete_0 block 4.50000000000000011e-1");
+        at(d, "fix             delete_0 mobile evaporate");
+    }
+
+    #[test]
+    fn planar_walls_are_refused_with_a_top_up() {
+        let (mut scene, particles) = collapse_scene_and_particle();
+        scene.insertions[0].refill = Some(cgdem_core::scene::Refill {
+            interval: 0.1,
+            stage: "collapse".into(),
+        });
+        let e = write_hertz_deck(&scene, &particles, 5e-5)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("planar walls with a top-up"), "{e}");
+    }
+
+    #[test]
+    fn tsuji_q_matches_the_mapping_table() {
+        // reference/MAPPING.md, from hertz_mapping.py.
+        for (e, q) in [
+            (0.3, 0.158329946363),
+            (0.5, 0.366651361569),
+            (0.9, 0.862122151068),
+        ] {
+            assert!((tsuji_q(e).unwrap() - q).abs() < 1e-11, "e = {e}");
+        }
+        assert!(tsuji_q(0.1).is_none());
+    }
+
+    #[test]
+    fn tangential_ratio_is_0_907_for_nu_0_3() {
+        let m = Material {
+            youngs_modulus: 5e6,
+            poisson_ratio: 0.3,
+        };
+        let x = tangential_damping_ratio(Material::y_eff(m, m), Material::g_eff(m, m));
+        assert!((x - 0.907485212973).abs() < 1e-11);
+    }
+}

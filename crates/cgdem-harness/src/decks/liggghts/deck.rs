@@ -1,0 +1,486 @@
+//! The LIGGGHTS input for a Hertz scene, written from the scene alone: `pair_style gran model
+//! hertz tangential history [rolling_friction epsd2]`, the keywords cgdem's Hertz slots are
+//! named after, so no mapping is needed; walls are `fix wall/gran` primitives (axis-aligned
+//! planes) of their own atom type (`n_species + 1`), whose material and pair coefficients
+//! with every species come from `[wall_contact]`.
+//!
+//! LIGGGHTS needs `newton off`, `communicate single vel yes`, Young's modulus >= 5e6 Pa in SI
+//! units (it refuses softer materials), and an explicit dump format (default: 6 digits).
+//! Supported: the Hertz settings of `decks::hertz`; stages, wall removal (`unfix w_NAME`) and
+//! repose samples come from `decks::stages`, the same lines as the LAMMPS decks (LIGGGHTS
+//! takes LAMMPS's loop, if, print and write_dump commands), so both go through one
+//! post-processing.
+
+use std::fmt::Write as _;
+
+use super::DIALECT;
+use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use crate::decks::lines::{
+    block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
+};
+use crate::decks::stages::{stage_lines, trajectory_lines, StageHooks};
+use crate::decks::{Deck, DeckError, DeckPlan};
+use cgdem_core::math::Real;
+use cgdem_core::particles::Particles;
+use cgdem_core::scene::{HertzSettings, RollingKind, Scene};
+
+/// LIGGGHTS 3.8 rejects a Young's modulus below this in SI units.
+pub const MIN_YOUNGS_MODULUS: Real = 5e6;
+
+/// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
+/// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
+pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
+    let h = hertz_settings(scene, "LIGGGHTS", true)?;
+    let n = scene.species.len();
+    // Planar walls and meshes share one atom type, whose material is `[wall_contact]`.
+    let types = AtomTypes {
+        particles: n,
+        wall: !scene.walls.is_empty() || !scene.bodies.is_empty(),
+    };
+    let (m, wm) = (material(h), wall_material(scene, h));
+    for (what, e) in [
+        ("contact.youngs_modulus", m.youngs_modulus),
+        ("wall_contact.youngs_modulus", wm.youngs_modulus),
+    ] {
+        if e < MIN_YOUNGS_MODULUS {
+            return Err(DeckError::Unsupported {
+                file: scene.source.display().to_string(),
+                reason: format!("{what} = {e} Pa: LIGGGHTS refuses E < 5e6 Pa in SI units"),
+            });
+        }
+    }
+    let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
+
+    let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
+    let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
+    let data = data_file(scene, particles, &diameters, &densities, types.count());
+
+    let mut d = written_by(&DIALECT, scene);
+    d += ").\n";
+    d += &preamble(&DIALECT, scene);
+    d += &neighbor_lines(&DIALECT, scene);
+    let (integrated, freeze) = frozen_lines(scene);
+    d += &freeze;
+    let (materials, rolling) = material_lines(scene, h, &types);
+    d += &materials;
+    let _ = writeln!(
+        d,
+        "pair_style      gran model hertz tangential history{rolling}"
+    );
+    d += "pair_coeff      * *\n";
+    let _ = writeln!(d, "timestep        {}", g(dt));
+    let _ = writeln!(d, "fix             integ {integrated} nve/sphere");
+    if scene.gravity.length() > 0.0 {
+        let dir = scene.gravity / scene.gravity.length();
+        let _ = writeln!(
+            d,
+            "fix             grav all gravity {} vector {} {} {}",
+            g(scene.gravity.length()),
+            g(dir.x),
+            g(dir.y),
+            g(dir.z)
+        );
+    }
+    d += &wall_lines(scene, n + 1, rolling)?;
+    let meshes = mesh_lines(scene, n + 1, rolling)?;
+    d += &meshes.setup;
+    // LIGGGHTS's dump_modify format is one C format for the whole line (default: 6 digits).
+    let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
+    let dumps = trajectory_lines(&mut d, dump_every, true, HERTZ_COLUMNS, &modify);
+    let begin = |stage: &str| stage_start_lines(scene, &meshes.pieces, stage, dt);
+    let repose_dumps = stage_lines(
+        &mut d,
+        scene,
+        dt,
+        dump_every,
+        &dumps,
+        &StageHooks {
+            unfix: &unfix_wall,
+            begin: &begin,
+            periodic: &|_| None,
+        },
+    );
+    Ok(Deck {
+        input: d,
+        data,
+        plan: DeckPlan {
+            code: DIALECT.code.name(),
+            log_file: DIALECT.log_file,
+            notes: meshes.notes,
+            dt,
+            dump_every,
+            repose_dumps,
+        },
+        files: meshes.files,
+    })
+}
+
+/// LIGGGHTS's atom types: one per species, then one for all walls and meshes when the scene
+/// has any (it pairs with particles only).
+struct AtomTypes {
+    particles: usize,
+    wall: bool,
+}
+
+impl AtomTypes {
+    fn count(&self) -> usize {
+        self.particles + usize::from(self.wall)
+    }
+
+    /// A `peratomtype` table: `particle` for every species, `wall` for the wall type.
+    fn per_type(&self, particle: Real, wall: Real) -> String {
+        let mut v = vec![g(particle); self.particles];
+        if self.wall {
+            v.push(g(wall));
+        }
+        v.join(" ")
+    }
+
+    /// A `peratomtypepair` table: `wall` for pairs with the wall type, else `particle`.
+    fn per_pair(&self, particle: Real, wall: Real) -> String {
+        let (n, n_types) = (self.particles, self.count());
+        let mut v = Vec::new();
+        for a in 0..n_types {
+            for b in 0..n_types {
+                v.push(g(if a == n || b == n { wall } else { particle }));
+            }
+        }
+        format!("{n_types} {}", v.join(" "))
+    }
+}
+
+/// The material tables (`fix property/global`), and the `pair_style` suffix for rolling
+/// friction (empty without it).
+fn material_lines(scene: &Scene, h: &HertzSettings, types: &AtomTypes) -> (String, &'static str) {
+    let w = &scene.wall_contact;
+    let (m, wm) = (material(h), wall_material(scene, h));
+    let mut d = String::new();
+    // LIGGGHTS refuses E > 1e9 Pa in SI units unless told the particles are hard (steel).
+    if m.youngs_modulus.max(wm.youngs_modulus) > 1e9 {
+        d += "hard_particles  yes\n";
+    }
+    for (fix, property, table) in [
+        (
+            "m1",
+            "youngsModulus peratomtype",
+            types.per_type(m.youngs_modulus, wm.youngs_modulus),
+        ),
+        (
+            "m2",
+            "poissonsRatio peratomtype",
+            types.per_type(m.poisson_ratio, wm.poisson_ratio),
+        ),
+        (
+            "m3",
+            "coefficientRestitution peratomtypepair",
+            types.per_pair(h.restitution, w.restitution),
+        ),
+        (
+            "m4",
+            "coefficientFriction peratomtypepair",
+            types.per_pair(h.friction, w.friction),
+        ),
+    ] {
+        let _ = writeln!(
+            d,
+            "fix             {fix} all property/global {property} {table}"
+        );
+    }
+    let rolling = if h.rolling == RollingKind::Epsd2 {
+        let _ = writeln!(
+            d,
+            "fix             m5 all property/global coefficientRollingFriction peratomtypepair {}",
+            types.per_pair(h.rolling_friction, w.rolling_friction)
+        );
+        " rolling_friction epsd2"
+    } else {
+        ""
+    };
+    (d, rolling)
+}
+
+/// One `fix wall/gran ... primitive` per planar wall, of atom type `wall_type`.
+fn wall_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<String, DeckError> {
+    let mut d = String::new();
+    for wall in &scene.walls {
+        let (axis, _) = wall_axis(scene, wall)?;
+        let at = [wall.point.x, wall.point.y, wall.point.z][axis];
+        let _ = writeln!(
+            d,
+            "fix             w_{} all wall/gran model hertz tangential history{rolling} primitive type {wall_type} {}plane {}",
+            wall.name,
+            ["x", "y", "z"][axis],
+            g(at)
+        );
+    }
+    Ok(d)
+}
+
+/// The deck lines of the scene's bodies: one `fix mesh/surface` per body from an ASCII STL
+/// of the same triangles cgdem builds its SDF from (metres), all in one `fix wall/gran ...
+/// mesh`; the STL files; and notes on what differs from cgdem.
+struct MeshLines {
+    setup: String,
+    /// Per body, the names of its pieces (`b_NAME` is the mesh fix).
+    pieces: Vec<Vec<String>>,
+    files: Vec<(String, Vec<u8>)>,
+    notes: Vec<String>,
+}
+
+fn mesh_lines(scene: &Scene, wall_type: usize, rolling: &str) -> Result<MeshLines, DeckError> {
+    let unsupported = |reason: String| DeckError::unsupported(scene, reason);
+    let mut out = MeshLines {
+        setup: String::new(),
+        pieces: Vec::new(),
+        files: Vec::new(),
+        notes: Vec::new(),
+    };
+    if scene.bodies.is_empty() {
+        return Ok(out);
+    }
+    let mut names = Vec::new();
+    let mut body_pieces = Vec::new();
+    for (k, b) in scene.bodies.iter().enumerate() {
+        let mut pieces = Vec::new();
+        if b.particles.is_some() {
+            return Err(unsupported(format!(
+                "body[{k}] `{}` is built of particles; LIGGGHTS decks take mesh bodies",
+                b.name
+            )));
+        }
+        if b.velocity.length() > 0.0 {
+            return Err(unsupported(format!(
+                "body[{k}] `{}` translates; LIGGGHTS decks rotate bodies only",
+                b.name
+            )));
+        }
+        let mesh = b
+            .mesh
+            .load()
+            .map_err(|e| unsupported(format!("body[{k}].mesh: {e}")))?;
+        // One mesh fix per separate solid of the body (see `TriMesh::components`).
+        for (j, piece) in mesh.components().into_iter().enumerate() {
+            let (piece, dropped, area) = without_slivers(piece);
+            if dropped > 0 {
+                out.notes.push(format!(
+                    "body `{}` piece {j}: {dropped} sliver triangle(s) (smallest angle < {SLIVER_ANGLE_DEG} deg, {area:.1e} m2 in all) left out of the LIGGGHTS mesh, which refuses them",
+                    b.name
+                ));
+            }
+            let piece = &piece;
+            let name = format!("{}_{j}", b.name);
+            let file = format!("{name}.stl");
+            let text = cgdem_core::geometry::stl::stl_ascii(piece, &name);
+            out.files.push((file.clone(), text.into_bytes()));
+            let _ = writeln!(
+                out.setup,
+                "fix             b_{name} all mesh/surface file {file} type {wall_type} curvature 1e-5"
+            );
+            names.push(format!("b_{name}"));
+            pieces.push(name);
+        }
+        body_pieces.push(pieces);
+    }
+    for (b, pieces) in scene.bodies.iter().zip(&body_pieces) {
+        if b.start_stage.is_none() {
+            out.setup += &move_lines(b, pieces);
+        }
+    }
+    out.pieces = body_pieces;
+    let _ = writeln!(
+        out.setup,
+        "fix             bodies all wall/gran model hertz tangential history{rolling} mesh n_meshes {} meshes {}",
+        names.len(),
+        names.join(" ")
+    );
+    if !scene.deletions.is_empty() {
+        out.notes.push("LIGGGHTS 3.8 has no `fix evaporate`: grains in a [[delete]] box are not deleted there; they fall on and leave through the box's lower face (`thermo_modify lost ignore`), which changes nothing upstream of the box".into());
+    }
+    Ok(out)
+}
+
+/// `fix move/mesh ... rotate` for each piece of a turning body: LIGGGHTS turns
+/// counter-clockwise about `axis` once per `period`; a negative rpm turns about the reversed
+/// axis.
+fn move_lines(b: &cgdem_core::scene::BodySettings, pieces: &[String]) -> String {
+    if b.rpm == 0.0 {
+        return String::new();
+    }
+    let axis = if b.rpm < 0.0 { -b.axis } else { b.axis };
+    let mut d = String::new();
+    for name in pieces {
+        let _ = writeln!(
+            d,
+            "fix             move_{name} all move/mesh mesh b_{name} rotate origin {} {} {} axis {} {} {} period {}",
+            g(b.point.x),
+            g(b.point.y),
+            g(b.point.z),
+            g(axis.x),
+            g(axis.y),
+            g(axis.z),
+            g(60.0 / b.rpm.abs())
+        );
+    }
+    d
+}
+
+/// LIGGGHTS 3.8 aborts on a mesh element whose smallest angle is below about 0.01 deg
+/// (measured: the casing's gables, fan-triangulated, have two at 0.0093 deg).
+const SLIVER_ANGLE_DEG: Real = 0.02;
+
+/// The mesh without its sliver triangles: the mesh, how many were dropped and their area (a
+/// sliver's area is tiny, so the surface grains meet is the same).
+fn without_slivers(
+    mut mesh: cgdem_core::geometry::TriMesh,
+) -> (cgdem_core::geometry::TriMesh, usize, Real) {
+    let smallest_angle = |[a, b, c]: [cgdem_core::math::Vec3; 3]| {
+        [(a, b, c), (b, c, a), (c, a, b)]
+            .iter()
+            .map(|&(p, q, r)| (q - p).angle_between(r - p))
+            .fold(Real::INFINITY, Real::min)
+    };
+    let n = mesh.triangles.len();
+    let mut area = 0.0;
+    let keep: Vec<bool> = (0..n)
+        .map(|t| {
+            let tri = mesh.triangle(t);
+            let sliver = smallest_angle(tri).to_degrees() < SLIVER_ANGLE_DEG;
+            if sliver {
+                area += 0.5 * (tri[1] - tri[0]).cross(tri[2] - tri[0]).length();
+            }
+            !sliver
+        })
+        .collect();
+    let mut k = 0;
+    mesh.triangles.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    let dropped = n - mesh.triangles.len();
+    (mesh, dropped, area)
+}
+
+/// What starts with `stage`: the motion of the bodies that start then, and the top-ups of the
+/// insertions refilled during it (`fix insert/pack ... particles_in_region N`, N the count in
+/// the insertion box when the stage begins, first after one interval, as cgdem does). A
+/// `run 0` sets the new fixes up.
+fn stage_start_lines(scene: &Scene, pieces: &[Vec<String>], stage: &str, dt: Real) -> String {
+    let mut d = String::new();
+    for (b, pieces) in scene.bodies.iter().zip(pieces) {
+        if b.start_stage.as_deref() == Some(stage) {
+            d += &move_lines(b, pieces);
+        }
+    }
+    for (k, ins) in scene.insertions.iter().enumerate() {
+        let Some(refill) = ins.refill.as_ref().filter(|r| r.stage == stage) else {
+            continue;
+        };
+        let species = &scene.species[ins.species];
+        let every = ((refill.interval / dt).round() as u64).max(1);
+        d += &block_region(&format!("top_{k}"), ins.lo, ins.hi);
+        let _ = writeln!(
+            d,
+            "fix             pts_{k} all particletemplate/sphere {} atom_type {} density constant {} radius constant {}",
+            PRIMES[(2 * k) % PRIMES.len()],
+            ins.species + 1,
+            g(species.density),
+            g(species.radius())
+        );
+        let _ = writeln!(
+            d,
+            "fix             pdd_{k} all particledistribution/discrete {} 1 pts_{k} 1.0",
+            PRIMES[(2 * k + 1) % PRIMES.len()]
+        );
+        let _ = writeln!(d, "variable        top_n_{k} equal count(all,top_{k})");
+        let _ = writeln!(
+            d,
+            "fix             top_{k} all insert/pack seed {} distributiontemplate pdd_{k} maxattempt 200 insert_every {every} start $(step+{every}) overlapcheck yes all_in no particles_in_region ${{top_n_{k}}} region top_{k}",
+            PRIMES[(2 * k + 2) % PRIMES.len()]
+        );
+    }
+    if !d.is_empty() {
+        d += "run             0 post no\n";
+    }
+    d
+}
+
+/// Primes above 10000 for LIGGGHTS's random seeds.
+const PRIMES: [u64; 6] = [15485863, 32452843, 49979687, 67867967, 86028121, 104395301];
+
+#[cfg(test)]
+mod tests {
+    use super::super::LOG_FILE;
+    use super::*;
+    use crate::decks::hertz::{at, collapse_scene_and_particle};
+
+    #[test]
+    fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {
+        let (scene, particles) = collapse_scene_and_particle();
+        let deck = write_deck(&scene, &particles, 5e-5).unwrap();
+        let d = &deck.input;
+        assert_eq!((deck.plan.code, deck.plan.log_file), ("liggghts", LOG_FILE));
+        // Walls are primitives of the extra atom type 2, each removable on its own.
+        let gate = at(d, "fix             w_gate all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 2 xplane 1.00000000000000006e-1");
+        let settle = at(d, "variable        chunk0 loop 200");
+        let settle_end = at(d, "label           end_stage0");
+        let unfix = at(d, "unfix           w_gate");
+        assert!(!d.contains("unfix           w_floor"));
+        let collapse = at(d, "CGDEM_STAGE collapse start");
+        assert!(gate < settle && settle < settle_end && settle_end < unfix && unfix < collapse);
+        at(d, "variable        kepm equal (c_ke+c_rke)/mass(all)");
+        // LIGGGHTS takes one C format per line; inside an `if`, in single quotes.
+        let format = format!("format '%d %d{}'", " %.17g".repeat(10));
+        let sample = at(d, &format!("if              \"${{chunk1}} == 25\" then \"write_dump all custom repose_0.dump id type x y z vx vy vz omegax omegay omegaz radius modify sort id {format}\""));
+        assert!(collapse < sample);
+        assert_eq!(deck.plan.repose_dumps.len(), 3);
+    }
+
+    #[test]
+    fn screw_deck_turns_the_screw_mesh_from_the_conveying_stage_and_tops_up_the_hopper() {
+        crate::at_repo_root();
+        let scene = Scene::load(std::path::Path::new(
+            "validation/cases/screw_feeder_hertz.toml",
+        ))
+        .unwrap();
+        let deck = write_deck(&scene, &Particles::new(true), 6e-5).unwrap();
+        let d = &deck.input;
+        // Meshes of the same triangles cgdem builds its SDF from, one fix per solid, as walls.
+        at(
+            d,
+            "fix             b_screw_0 all mesh/surface file screw_0.stl type 2",
+        );
+        at(
+            d,
+            "fix             b_hopper_0 all mesh/surface file hopper_0.stl type 2",
+        );
+        let walls = at(d, "fix             bodies all wall/gran model hertz tangential history mesh n_meshes 12 meshes b_screw_0 b_screw_1 b_casing_0");
+        assert!(deck.files.iter().any(|(name, text)| name == "casing_0.stl"
+            && String::from_utf8_lossy(text).starts_with("solid casing_0")));
+        // rpm -100 about +x: counter-clockwise about -x, 0.6 s per turn, from `convey` on.
+        let settle = at(d, "CGDEM_STAGE settle start");
+        let turn = at(d, "fix             move_screw_0 all move/mesh mesh b_screw_0 rotate origin 0.00000000000000000e0 0.00000000000000000e0 0.00000000000000000e0 axis -1.00000000000000000e0");
+        assert!(d[turn..].contains("period 5.99999999999999978e-1"));
+        let top_up = at(d, "fix             top_0 all insert/pack seed");
+        assert!(d[top_up..].contains("insert_every 1667 start $(step+1667) overlapcheck yes all_in no particles_in_region ${top_n_0} region top_0"));
+        let convey = at(d, "CGDEM_STAGE convey start");
+        assert!(walls < settle && settle < turn && turn < top_up && top_up < convey);
+        assert!(!d.contains("move_casing"));
+        at(d, "dump            traj all custom");
+        assert!(deck.plan.notes.iter().any(|n| n.contains("fix evaporate")));
+    }
+
+    #[test]
+    fn a_soft_material_is_refused_with_the_field_named() {
+        let (mut scene, particles) = collapse_scene_and_particle();
+        if let cgdem_core::scene::ContactSettings::Hertz(h) = &mut scene.contact {
+            h.youngs_modulus = 1e6;
+        }
+        let e = write_deck(&scene, &particles, 5e-5)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("aor_hertz.toml") && e.contains("contact.youngs_modulus = 1000000 Pa"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,150 @@
+//! `cgdem validate`: run a suite, compare the runs, write `summary.json` and `index.html`.
+//!
+//! Every run, whatever the code, leaves the same files in its own directory (`summary.json`,
+//! `profile.csv`, `timeseries.csv`); the comparisons and plots read only those, so the
+//! reference codes go through exactly the same post-processing as cgdem.
+//!
+//! Its phases, one file each: `runs` (every code, level, rule and seed of a case),
+//! `measurement` (the comparisons and their verdicts) and `report` (the first screen and a
+//! section per case). The suite file is read by `crate::suite`; its accuracy sweeps and
+//! stability cases are suite kinds of their own (`crate::accuracy`, `crate::stability`),
+//! which this command runs after the cases.
+
+mod measurement;
+mod report;
+mod runs;
+#[cfg(test)]
+mod tests;
+
+pub use crate::runs::{Outcome, RunRecord, ValidateError, ValidateOptions};
+pub use measurement::Comparison;
+pub(crate) use report::machine_provenance;
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::report::Report;
+use crate::runs::output_error;
+use crate::suite::{Suite, SuiteCase};
+use cgdem_core::io::write_atomic;
+use cgdem_core::scene::Scene;
+use measurement::compare;
+use report::{provenance, write_case_section, write_intro};
+use runs::run_case;
+
+/// What `cgdem validate` found, as `summary.json` holds it.
+#[derive(Clone, Debug, Serialize)]
+pub struct ValidationSummary {
+    pub suite: String,
+    pub provenance: BTreeMap<String, String>,
+    pub runs: Vec<RunRecord>,
+    pub comparisons: Vec<Comparison>,
+    /// Error against run time (the suite's `[[accuracy]]` sweeps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<super::accuracy::AccuracySummary>,
+    /// The `[[stability]]` cases' verdicts, one per case and code.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stability: Vec<super::stability::StabilityRecord>,
+}
+
+/// Runs every case of the suite with every code, level, rule and seed; a run that fails is
+/// recorded with its reason and the suite goes on.
+pub fn validate(options: &ValidateOptions) -> Result<ValidationSummary, ValidateError> {
+    validate_suite(&Suite::load(&options.suite)?, options)
+}
+
+/// As [`validate`], for a suite already loaded (`options.suite` names its file in the
+/// provenance): `cgdem advise --run` hands it the sweeps of one case.
+pub fn validate_suite(
+    suite: &Suite,
+    options: &ValidateOptions,
+) -> Result<ValidationSummary, ValidateError> {
+    std::fs::create_dir_all(&options.out).map_err(|e| output_error(&options.out, e))?;
+    let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
+    let provenance = provenance(suite, options);
+    let (runs, comparisons) = run_cases(suite, options, &mut report)?;
+    let accuracy =
+        super::accuracy::run_sweeps(&suite.accuracy, &suite.source, options, &mut report)?;
+    let stability = super::stability::run_stability(&suite.stability, options, &mut report)
+        .map_err(|message| ValidateError::Case {
+            file: suite.source.clone(),
+            message,
+        })?;
+    let summary = ValidationSummary {
+        suite: suite.name.clone(),
+        provenance,
+        runs,
+        comparisons,
+        accuracy,
+        stability,
+    };
+    write_intro(&mut report, &summary, suite, options);
+    let json_path = options.out.join("summary.json");
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&json_path, e))?;
+    write_atomic(&json_path, json.as_bytes()).map_err(|e| output_error(&json_path, e))?;
+    let html_path = options.out.join("index.html");
+    report
+        .write(&html_path)
+        .map_err(|e| output_error(&html_path, e))?;
+    Ok(summary)
+}
+
+/// Runs and judges the suite's cases, each scene's in one section of `report`; returns every
+/// run and comparison.
+fn run_cases(
+    suite: &Suite,
+    options: &ValidateOptions,
+    report: &mut Report,
+) -> Result<(Vec<RunRecord>, Vec<Comparison>), ValidateError> {
+    let mut runs = Vec::new();
+    let mut comparisons = Vec::new();
+    // Cases of one scene (e.g. its two coarse-graining rules) are compared and reported
+    // together: one section, one set of figures, judged by the first case's tolerances and
+    // by the known differences any of them declares.
+    let mut scenes: Vec<(Scene, SuiteCase, Vec<RunRecord>)> = Vec::new();
+    for case in &suite.cases {
+        let scene = case.load_scene().map_err(|e| ValidateError::Case {
+            file: case.file.clone(),
+            message: e.to_string(),
+        })?;
+        let case_runs = run_case(&scene, case, options)?;
+        match scenes.iter_mut().find(|(s, _, _)| s.name == scene.name) {
+            Some((_, first, earlier)) => {
+                earlier.extend(case_runs);
+                first
+                    .known_differences
+                    .extend(case.known_differences.iter().cloned());
+            }
+            None => scenes.push((scene, case.clone(), case_runs)),
+        }
+    }
+    let screws: Vec<(&Scene, &[RunRecord])> = scenes
+        .iter()
+        .filter(|(s, _, _)| s.conveying.is_some())
+        .map(|(s, _, r)| (s, r.as_slice()))
+        .collect();
+    if screws.len() > 1 {
+        super::screw::write_screw_overview(report, &screws, &options.out)?;
+    }
+    for (scene, case, case_runs) in scenes {
+        if scene.conveying.is_some() {
+            // A screw case is judged by its mass flow against Eq. (7), code by code.
+            super::screw::write_screw_section(report, &scene, &case, &case_runs, &options.out)?;
+            runs.extend(case_runs);
+            continue;
+        }
+        let case_comparisons = compare(&scene, &case, &case_runs);
+        write_case_section(
+            report,
+            &scene,
+            &case,
+            &case_runs,
+            &case_comparisons,
+            &options.out,
+        )?;
+        runs.extend(case_runs);
+        comparisons.extend(case_comparisons);
+    }
+    Ok((runs, comparisons))
+}

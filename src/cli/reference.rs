@@ -1,0 +1,162 @@
+//! `cgdem reference lammps|liggghts`: a scene run in a reference code.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Subcommand};
+
+use super::{install_interrupt, interrupted, load_scene, SceneArgs};
+use cgdem_core::coarse_graining::coarse_grain_by;
+use cgdem_harness::code::Code;
+use cgdem_harness::decks::{
+    run_reference, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
+};
+
+#[derive(Subcommand)]
+pub(super) enum ReferenceCommand {
+    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP): the seed's WCA model (reference/lammps/SEED_MODEL.md)
+    /// and Hertz scenes (reference/MAPPING.md).
+    Lammps(ReferenceArgs),
+    /// LIGGGHTS (`liggghts` on PATH or $CGDEM_LIGGGHTS): Hertz scenes with LIGGGHTS's keywords.
+    Liggghts(ReferenceArgs),
+}
+
+#[derive(Args)]
+pub(super) struct ReferenceArgs {
+    /// The scene file, e.g. validation/cases/aor_collapse.toml.
+    case: PathBuf,
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output directory (default: runs/CASE-lambdaN-CODE).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp|liggghts`); default: serial.
+    #[arg(long)]
+    np: Option<u32>,
+    /// Kill the code after this many seconds.
+    #[arg(long, default_value_t = 7200)]
+    timeout: u64,
+    /// Write the deck even if the time step exceeds the stable limit.
+    #[arg(long)]
+    force_dt: bool,
+    /// Do not run: post-process the outputs already in --out (e.g. of a run that
+    /// was stopped; the samples it reached are used).
+    #[arg(long)]
+    postprocess_only: bool,
+}
+
+pub(super) fn execute(command: ReferenceCommand) -> ExitCode {
+    match reference_run(command) {
+        Ok(code) => code,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn reference_run(command: ReferenceCommand) -> Result<ExitCode, String> {
+    let (code, args) = match command {
+        ReferenceCommand::Lammps(args) => (Code::Lammps, args),
+        ReferenceCommand::Liggghts(args) => (Code::Liggghts, args),
+    };
+    let SceneArgs {
+        lambda,
+        cg_rule,
+        seed,
+        set,
+        variant,
+    } = args.scene;
+    let scene = load_scene(&args.case, &set, variant.as_deref(), seed)?;
+    let scene = coarse_grain_by(&scene, lambda, cg_rule.into()).map_err(|e| e.to_string())?;
+    let out = args.out.unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!(
+            "{}-lambda{}-{}",
+            scene.name,
+            scene.lambda,
+            code.label().to_lowercase()
+        ))
+    });
+    let interrupt = install_interrupt();
+    let options = ReferenceOptions {
+        code,
+        runner: RunnerOptions {
+            np: args.np,
+            timeout: std::time::Duration::from_secs(args.timeout),
+            stop: interrupt.as_ref().map(|i| i.flag()),
+        },
+        force_dt: args.force_dt,
+        postprocess_only: args.postprocess_only,
+    };
+    let run = run_reference(&scene, &out, &options);
+    if let Some(code) = interrupted(&interrupt, &out) {
+        if let Err(e) = &run {
+            eprintln!("{e}");
+        }
+        return Ok(code);
+    }
+    let run = run?;
+    if let Some(w) = &run.dt_warning {
+        eprintln!("warning: {w}");
+    }
+    if !args.postprocess_only {
+        println!(
+            "deck for {} at lambda = {} ({} particles, dt = {:.4e} s) in {}",
+            scene.name,
+            scene.lambda,
+            run.n_particles,
+            run.dt,
+            out.display()
+        );
+    }
+    report(code, run, &out)
+}
+
+/// What the reference run did: its figures, a skip, or the failure with its log's tail.
+fn report(code: Code, run: ReferenceRun, out: &std::path::Path) -> Result<ExitCode, String> {
+    let name = code.label();
+    match run.status {
+        RunStatus::Completed { .. } => {
+            let summary = run.summary.expect("a completed run is post-processed");
+            println!(
+                "{name}: {} steps, {:.1} s wall time, {:.3e} particle-steps/s (loop time)",
+                summary.steps, summary.wall_s, summary.particle_steps_per_s
+            );
+            for s in &summary.repose_samples {
+                println!(
+                    "  t = {} s after `{}` start: repose angle {} deg, run-out {:.4} m",
+                    s.time_after_start_s,
+                    summary.stages.last().map_or("", |st| st.name.as_str()),
+                    s.repose_angle_deg.map_or("-".into(), |a| format!("{a:.2}")),
+                    s.runout_m
+                );
+            }
+            println!("outputs in {}", out.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        RunStatus::Skipped {
+            reason,
+            install_hint,
+        } => {
+            println!("skipped: {reason}; install with `{install_hint}`");
+            Ok(ExitCode::SUCCESS)
+        }
+        RunStatus::Failed {
+            exit_code,
+            log_tail,
+        } => Err(format!(
+            "{name} failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}",
+            out.display()
+        )),
+        RunStatus::TimedOut { after_s, log_tail } => {
+            // The partial outputs are kept, with a summary that says so when it could be made.
+            let partial = run.partial_error.map_or(String::new(), |e| {
+                format!(" (post-processing the partial run failed: {e})")
+            });
+            Err(format!(
+                "{name} killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}",
+                out.display()
+            ))
+        }
+    }
+}
