@@ -19,7 +19,7 @@
 //! - **Building blocks**: [`suite`] and [`suite_entry`] (suite files), [`runs`] (one run of
 //!   any code, reuse, concurrency), [`decks`] (the reference codes: a LAMMPS and a LIGGGHTS
 //!   dialect, runner, dump parser, post-processing), [`ranks`] (cgdem as MPI ranks),
-//!   [`verdict`], [`dynamics`], [`screw`], [`report`] (figures and HTML), [`csv_table`],
+//!   [`verdict`], [`dynamics`], [`screw`], [`silo`], [`report`] (figures and HTML), [`csv_table`],
 //!   [`code`].
 
 // Commands.
@@ -40,6 +40,7 @@ pub mod ranks;
 pub mod report;
 pub mod runs;
 pub mod screw;
+pub mod silo;
 pub mod suite;
 pub mod suite_entry;
 pub mod verdict;

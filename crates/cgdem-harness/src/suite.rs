@@ -52,6 +52,8 @@ pub struct SuiteCase {
     /// feeder's tip clearance is narrower than a grain); the warnings stay in each run's
     /// summary, and the reference codes, which have no such guard, run it alike.
     pub keep_going: bool,
+    /// Measured as a silo discharge (`[case.discharge]`, `crate::silo`).
+    pub discharge: Option<crate::silo::DischargeSettings>,
 }
 
 impl SuiteCase {
@@ -110,6 +112,7 @@ struct RawCase {
     rpms: Vec<f64>,
     #[serde(default)]
     keep_going: bool,
+    discharge: Option<crate::silo::RawDischarge>,
 }
 
 #[derive(Deserialize)]
@@ -275,6 +278,10 @@ fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError
         variant: c.variant,
         rpms: c.rpms,
         keep_going: c.keep_going,
+        discharge: c
+            .discharge
+            .map(|d| crate::silo::parse_discharge(d, k, path))
+            .transpose()?,
     })
 }
 

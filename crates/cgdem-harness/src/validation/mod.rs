@@ -127,7 +127,36 @@ fn run_cases(
     if screws.len() > 1 {
         super::screw::write_screw_overview(report, &screws, &options.out)?;
     }
+    // Silo cases (`[case.discharge]`) are measured once, shown across orifices, then each.
+    let silos: Vec<_> = scenes
+        .iter()
+        .filter_map(|(s, c, r)| {
+            let d = c.discharge.as_ref()?;
+            Some((s, d, super::silo::measure_runs(s, d, r)))
+        })
+        .collect();
+    if !silos.is_empty() {
+        super::silo::write_silo_overview(report, &silos, &options.out)?;
+    }
+    let silos: Vec<(String, Vec<super::silo::SiloRun>)> = silos
+        .into_iter()
+        .map(|(s, _, m)| (s.name.clone(), m))
+        .collect();
     for (scene, case, case_runs) in scenes {
+        if let Some(settings) = &case.discharge {
+            let measured = silos.iter().find(|(n, _)| *n == scene.name).map(|(_, m)| m);
+            let measured = measured.map_or(&[][..], |m| m.as_slice());
+            super::silo::write_silo_section(
+                report,
+                &scene,
+                &case,
+                settings,
+                measured,
+                &options.out,
+            )?;
+            runs.extend(case_runs);
+            continue;
+        }
         if scene.conveying.is_some() {
             // A screw case is judged by its mass flow against Eq. (7), code by code.
             super::screw::write_screw_section(report, &scene, &case, &case_runs, &options.out)?;

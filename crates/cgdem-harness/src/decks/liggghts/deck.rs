@@ -83,6 +83,16 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
     let modify = format!("sort id format \"%d %d{}\"", " %.17g".repeat(10));
     let dumps = trajectory_lines(&mut d, dump_every, true, HERTZ_COLUMNS, &modify);
     let begin = |stage: &str| stage_start_lines(scene, &meshes.pieces, stage, dt);
+    // With a mesh wall, a `run pre no` right after an `unfix` stops LIGGGHTS with "internal
+    // error (fix_contact_history_mesh.cpp:479)" (measured on the silo, reference/silo/PLAN.md
+    // C): such a removal sets the run up once more (LIGGGHTS re-applies nothing in a setup).
+    let unfix = |name: &str| {
+        let mut lines = unfix_wall(name);
+        if !scene.bodies.is_empty() {
+            lines += "run             0 post no\n";
+        }
+        lines
+    };
     let repose_dumps = stage_lines(
         &mut d,
         scene,
@@ -90,7 +100,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         dump_every,
         &dumps,
         &StageHooks {
-            unfix: &unfix_wall,
+            unfix: &unfix,
             begin: &begin,
             periodic: &|_| None,
         },
@@ -595,6 +605,19 @@ mod tests {
             at(d, &format!("fix             w_{wall} all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 3 xplane"));
         }
         assert!(deck.data.contains("\n4 atom types\n"), "{:.400}", deck.data);
+    }
+
+    #[test]
+    fn the_silo_deck_sets_up_again_after_the_gate_is_removed() {
+        crate::at_repo_root();
+        let scene =
+            Scene::load(std::path::Path::new("validation/cases/silo_reduced.toml")).unwrap();
+        let deck = write_deck(&scene, &Particles::new(true), 1.25e-5).unwrap();
+        let d = &deck.input;
+        let mesh = at(d, "fix             bodies all wall/gran model hertz tangential history mesh n_meshes 1 meshes b_silo_0");
+        let unfix = at(d, "unfix           w_gate\nrun             0 post no\n");
+        let discharge = at(d, "CGDEM_STAGE discharge start");
+        assert!(mesh < unfix && unfix < discharge);
     }
 
     #[test]

@@ -1,0 +1,173 @@
+use std::path::Path;
+
+use super::*;
+
+/// A steady discharge at `rate` from `start` on, sampled every `dt` up to `end`, with a
+/// deterministic ripple of amplitude `ripple` kg on the mass.
+fn steady(rate: f64, start: f64, dt: f64, end: f64, ripple: f64) -> DischargeSeries {
+    let n = (end / dt).round() as usize;
+    let time_s: Vec<f64> = (0..=n).map(|i| i as f64 * dt).collect();
+    let mass_kg = time_s
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| rate * (t - start).max(0.0) + ripple * ((i * i % 7) as f64 - 3.0))
+        .collect();
+    DischargeSeries { time_s, mass_kg }
+}
+
+#[test]
+fn a_steady_discharge_gives_its_rate_and_no_error_without_noise() {
+    let r = discharge_rate(&steady(0.7, 0.05, 0.01, 0.6, 0.0), 0.1, 5).unwrap();
+    assert!((r.rate_kg_s - 0.7).abs() < 1e-12, "{r:?}");
+    assert!(r.std_error_kg_s < 1e-12);
+    assert_eq!(r.window_s, [0.1, 0.6]);
+    assert_eq!(r.block_rates_kg_s.len(), 5);
+    assert!(!r.drifts);
+}
+
+#[test]
+fn the_start_up_before_the_window_does_not_bias_the_rate() {
+    // Flow begins at 0.08 s: a window from 0 would see a lower slope.
+    let s = steady(2.0, 0.08, 0.01, 0.6, 0.0);
+    assert!((discharge_rate(&s, 0.1, 5).unwrap().rate_kg_s - 2.0).abs() < 1e-9);
+    assert!(discharge_rate(&s, 0.0, 5).unwrap().rate_kg_s < 1.95);
+}
+
+#[test]
+fn the_standard_error_is_the_block_rates_spread_over_root_blocks() {
+    let s = steady(1.0, 0.0, 0.01, 0.5, 0.002);
+    let r = discharge_rate(&s, 0.0, 5).unwrap();
+    let mean = r.block_rates_kg_s.iter().sum::<f64>() / 5.0;
+    let sd = (r
+        .block_rates_kg_s
+        .iter()
+        .map(|b| (b - mean).powi(2))
+        .sum::<f64>()
+        / 4.0)
+        .sqrt();
+    assert!(sd > 0.0);
+    assert!((r.std_error_kg_s - sd / 5f64.sqrt()).abs() < 1e-12);
+    // The blocks' mean is the window's end-to-end rate.
+    let end_to_end = (s.mass_kg[50] - s.mass_kg[0]) / 0.5;
+    assert!((mean - end_to_end).abs() < 1e-12);
+}
+
+#[test]
+fn a_rate_falling_through_the_window_is_flagged_as_a_drift() {
+    // Mass m = a t - b t^2: the rate falls from 1.0 to 0.5 kg/s over the window.
+    let time_s: Vec<f64> = (0..=50).map(|i| i as f64 * 0.01).collect();
+    let mass_kg = time_s.iter().map(|t| t - 0.5 * t * t).collect();
+    let mut s = DischargeSeries { time_s, mass_kg };
+    // A little noise so the drift has an error to be judged against.
+    for (i, m) in s.mass_kg.iter_mut().enumerate() {
+        *m += 1e-4 * ((i * 3 % 7) as f64 - 3.0);
+    }
+    let r = discharge_rate(&s, 0.0, 5).unwrap();
+    assert!(r.drifts && r.drift_kg_s < -0.3, "{r:?}");
+    let steady_run = discharge_rate(&steady(1.0, 0.0, 0.01, 0.5, 1e-4), 0.0, 5).unwrap();
+    assert!(!steady_run.drifts, "{steady_run:?}");
+}
+
+#[test]
+fn too_short_a_window_or_too_few_blocks_is_refused_with_the_reason() {
+    let s = steady(1.0, 0.0, 0.01, 0.12, 0.0);
+    let e = discharge_rate(&s, 0.1, 5).unwrap_err();
+    assert!(e.contains("5 blocks need at least 6"), "{e}");
+    assert!(discharge_rate(&s, 0.0, 1)
+        .unwrap_err()
+        .contains("at least 2"));
+}
+
+#[test]
+fn beverloo_c_inverts_the_law_and_k_free_recovers_both_constants() {
+    let (rho, d) = (1500.0, 0.004);
+    let w40 = beverloo_rate(0.6, rho, 0.04, d, 1.5).unwrap();
+    let w60 = beverloo_rate(0.6, rho, 0.06, d, 1.5).unwrap();
+    // 0.6 x 1500 x sqrt(9.81) x 0.034^2.5
+    assert!((w40 - 0.6 * 1500.0 * 9.81f64.sqrt() * 0.034f64.powf(2.5)).abs() < 1e-12);
+    let (c, se) = beverloo_c(w40, 0.01, rho, 0.04, d, 1.5).unwrap();
+    assert!((c - 0.6).abs() < 1e-12 && (se / c - 0.01 / w40).abs() < 1e-12);
+    let (c, k) = fit_c_and_k((0.04, w40), (0.06, w60), d, rho).unwrap();
+    assert!((c - 0.6).abs() < 1e-9 && (k - 1.5).abs() < 1e-9, "{c} {k}");
+    // With k = 2.5 the same rates need another C.
+    let (c, k) = fit_c_and_k(
+        (0.04, beverloo_rate(0.5, rho, 0.04, d, 2.5).unwrap()),
+        (0.06, beverloo_rate(0.5, rho, 0.06, d, 2.5).unwrap()),
+        d,
+        rho,
+    )
+    .unwrap();
+    assert!((c - 0.5).abs() < 1e-9 && (k - 2.5).abs() < 1e-9);
+    assert!(beverloo_rate(0.58, rho, 0.005, d, 1.5).is_none());
+}
+
+#[test]
+fn combined_c_weights_by_inverse_variance_and_reports_disagreement() {
+    let (c, se, chi2) = combined_c(&[(0.6, 0.01), (0.6, 0.02)]).unwrap();
+    assert!((c - 0.6).abs() < 1e-12 && chi2 < 1e-12);
+    assert!((se - (1.0f64 / (1e4 + 2.5e3)).sqrt()).abs() < 1e-12);
+    let (c, _, chi2) = combined_c(&[(0.5, 0.01), (0.7, 0.01)]).unwrap();
+    assert!((c - 0.6).abs() < 1e-12 && (chi2 - 200.0).abs() < 1e-9);
+    assert!(combined_c(&[(0.5, 0.0)]).is_none());
+}
+
+#[test]
+fn bulk_density_counts_the_grains_centred_in_the_box() {
+    let grains = [
+        ([0.5, 0.5, 0.5], 2.0),
+        ([0.1, 0.9, 0.2], 3.0),
+        ([1.5, 0.5, 0.5], 7.0),
+    ];
+    let rho = bulk_density(grains, [0.0; 3], [1.0, 1.0, 0.5]);
+    assert!((rho - 3.0 / 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn the_series_counts_grains_gone_since_the_gate_opened() {
+    let dir = std::env::temp_dir().join(format!("cgdem-silo-series-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("timeseries.csv"),
+        "time_s,stage,kinetic_energy_j,kinetic_energy_per_mass_j_kg,n_particles\n\
+         0.29,fill,0,0,1000\n0.30,fill,0,0,1000\n0.31,discharge,0,0,990\n0.32,discharge,0,0,970\n",
+    )
+    .unwrap();
+    let s = discharge_series(&dir, "discharge", 0.30, 0.5).unwrap();
+    let t: Vec<f64> = s.time_s.iter().map(|t| (t * 1e6).round() / 1e6).collect();
+    assert_eq!(t, [0.0, 0.01, 0.02]);
+    assert_eq!(s.mass_kg, [0.0, 5.0, 15.0]);
+    let e = discharge_series(&dir, "drain", 0.30, 0.5).unwrap_err();
+    assert!(
+        e.contains("timeseries.csv") && e.contains("no row of stage `drain`"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_suite_case_with_a_bad_discharge_table_names_the_field() {
+    crate::at_repo_root();
+    let base = "[[case]]\nfile = \"validation/cases/silo_reduced.toml\"\ncodes = [\"cgdem\"]\nlambdas = [1]\nseeds = [1]\n";
+    let table = |blocks: u32, d0: f64| {
+        format!("{base}discharge = {{ stage = \"discharge\", orifice_diameter = {d0}, discard = 0.1, blocks = {blocks}, bulk_lo = [-0.028, -0.028, 0.03], bulk_hi = [0.028, 0.028, 0.07] }}\n")
+    };
+    let suite = crate::suite::Suite::parse(
+        &format!("name = \"s\"\ndescription = \"d\"\n{}", table(5, 0.04)),
+        Path::new("s.toml"),
+    )
+    .unwrap();
+    let d = suite.cases[0].discharge.as_ref().unwrap();
+    assert_eq!((d.blocks, d.orifice_diameter_m), (5, 0.04));
+    for (text, field) in [
+        (table(1, 0.04), "discharge.blocks"),
+        (table(5, -0.04), "discharge.orifice_diameter"),
+    ] {
+        let e = crate::suite::Suite::parse(
+            &format!("name = \"s\"\ndescription = \"d\"\n{text}"),
+            Path::new("s.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("s.toml") && e.contains(field), "{e}");
+    }
+}
