@@ -243,7 +243,7 @@ pub fn beverloo_c(
 /// One C from several orifices' (C, se): the mean weighted by 1/se^2, its error, and
 /// chi^2 over n - 1 degrees of freedom (do the orifices agree with the fixed k?).
 pub fn combined_c(points: &[(f64, f64)]) -> Option<(f64, f64, f64)> {
-    if points.is_empty() || points.iter().any(|&(_, se)| !(se > 0.0)) {
+    if points.is_empty() || points.iter().any(|&(_, se)| se.is_nan() || se <= 0.0) {
         return None;
     }
     let w: Vec<f64> = points.iter().map(|&(_, se)| 1.0 / (se * se)).collect();

@@ -481,9 +481,10 @@ pub fn write_silo_overview(
                 )
                 .style(SeriesStyle::Dashed),
             );
-        let list = |f: &dyn Fn(&(f64, f64, f64, f64, f64)) -> String| {
-            points.iter().map(f).collect::<Vec<_>>().join(", ")
-        };
+        // One orifice's point: (D0, rate, its error, bulk density, grain diameter).
+        type Point = (f64, f64, f64, f64, f64);
+        let list =
+            |f: &dyn Fn(&Point) -> String| points.iter().map(f).collect::<Vec<_>>().join(", ");
         table.row([
             Cell::text(code.name()),
             Cell::num(lambda.to_string()),
