@@ -15,7 +15,6 @@ use super::DischargeSettings;
 use crate::code::Code;
 use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
 use crate::runs::{output_error, Outcome, RunRecord, ValidateError};
-use crate::suite::SuiteCase;
 use cgdem_core::coarse_graining::coarse_grain_by;
 use cgdem_core::io::write_atomic;
 use cgdem_core::output_format::RunSummary;
@@ -218,11 +217,11 @@ fn num(v: Option<f64>, digits: usize) -> Cell {
     Cell::num(v.map_or("-".into(), |x| format!("{x:.digits$}")))
 }
 
-/// The section of one discharge case.
+/// The section of one discharge case: its scene, its suite file and seeds, its settings.
 pub fn write_silo_section(
     report: &mut Report,
     scene: &Scene,
-    case: &SuiteCase,
+    (file, seeds): (&Path, &[u64]),
     settings: &DischargeSettings,
     runs: &[SiloRun],
     out: &Path,
@@ -232,8 +231,8 @@ pub fn write_silo_section(
     section.paragraph(format!(
         "{} Scene file: {}. Seeds: {:?}. Discharged mass: the grains gone from the scene since the gate opened (stage `{}`) times the grain's mass, from every code's timeseries.csv (LIGGGHTS and LAMMPS: the atoms of each dump frame); grains leave 0.02 m below the orifice, a constant lag. Rate: least-squares slope from {} s after the gate opens to the stage's end; standard error: {} equal blocks (their standard deviation over sqrt({})); drift: the block rates' fitted change across the window, flagged beyond two of its standard errors. Beverloo: W = C rho_b sqrt(g) (D0 - k d)^(5/2), D0 = {} m, k = {PUBLISHED_K} fixed, rho_b from the grains whose centres lie in {:?} .. {:?} m at the gate's opening; published C = {PUBLISHED_C} for a flat-bottomed silo (the hopper raises the rate: reference/silo/PLAN.md 3).",
         scene.description,
-        case.file.display(),
-        case.seeds,
+        file.display(),
+        seeds,
         settings.stage,
         settings.discard_s,
         settings.blocks,

@@ -149,7 +149,7 @@ fn run_cases(
             super::silo::write_silo_section(
                 report,
                 &scene,
-                &case,
+                (&case.file, &case.seeds),
                 settings,
                 measured,
                 &options.out,
