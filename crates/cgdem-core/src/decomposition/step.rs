@@ -597,7 +597,14 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 + bytes(&l.history)
                 + bytes(&l.image_pairs)
                 + bytes(&l.image_history)
-                + bytes(&sub.within_reach);
+                // The force pass's scratch for laws with history, as it will be sized
+                // (counted from the list, so a resumed run reports what the
+                // uninterrupted one does).
+                + if std::mem::size_of::<H>() > 0 {
+                    l.pairs.len() * std::mem::size_of::<u32>()
+                } else {
+                    0
+                };
             m.history_entries += l.len();
         }
         m.particle_bytes += self
@@ -917,8 +924,9 @@ fn within_reach<L: PairLaw, W: WallLaw>(
 ) -> usize {
     let listed = list.pairs.len();
     if within.len() != listed {
-        within.clear();
-        within.resize(listed, 0);
+        // Sized exactly, not grown (the reported memory must not depend on the run's
+        // history: a resumed run reports what the uninterrupted one does).
+        *within = vec![0; listed];
     }
     let (mut count, mut back) = (0, listed);
     for (k, &[a, b]) in list.pairs.iter().enumerate() {
