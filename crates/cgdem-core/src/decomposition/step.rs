@@ -600,7 +600,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 // The force pass's scratch for laws with history, as it will be sized
                 // (counted from the list, so a resumed run reports what the
                 // uninterrupted one does).
-                + if std::mem::size_of::<H>() > 0 {
+                + if compacts_touching_pairs::<H>() {
                     l.pairs.len() * std::mem::size_of::<u32>()
                 } else {
                     0
@@ -822,7 +822,7 @@ fn forces<L: PairLaw, W: WallLaw>(
         }};
     }
     let list = &mut sub.list;
-    if std::mem::size_of::<L::History>() == 0 {
+    if !compacts_touching_pairs::<L::History>() {
         // A law without contact history (the seed model) is cheap per pair: a filter first
         // would cost more than it spares (the main job 11% slower, reports/PERFORMANCE.md).
         for (&[a, b], history) in list.pairs.iter().zip(&mut list.history) {
@@ -908,6 +908,12 @@ fn forces<L: PairLaw, W: WallLaw>(
         body_loads,
         kinematic_loads: Vec::new(),
     }
+}
+
+/// Whether the force pass compacts the touching pairs: for laws with contact history only
+/// (the seed model's law is cheaper than the filter; reports/PERFORMANCE.md).
+fn compacts_touching_pairs<H>() -> bool {
+    std::mem::size_of::<H>() > 0
 }
 
 /// Touching pairs compacted, for laws with contact history: a cheap distance filter over the
