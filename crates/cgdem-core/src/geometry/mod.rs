@@ -1,5 +1,5 @@
 //! Shapes particles collide with: analytic walls, STL meshes and their signed distance
-//! grids, analytic SDFs, and the seed's screw-feeder geometry.
+//! grids, analytic SDFs, the seed's screw-feeder geometry and the benchmark silo.
 
 pub mod aabb;
 pub mod accuracy;
@@ -10,6 +10,7 @@ pub mod mesh;
 mod mesh_builder;
 pub mod screw_feeder;
 pub mod sdf_grid;
+pub mod silo;
 pub mod stl;
 pub mod triangle_distance;
 pub mod winding_number;

@@ -20,8 +20,8 @@ use crate::timestep::Timescales;
 use crate::walls::WallLaw;
 
 use super::observers::{
-    ConveyingMeter, Flow, Observer, PackingMeter, ReposeMeter, Scheduled, StageClock, TimeSeries,
-    VtkFrames, Warnings,
+    ConveyingMeter, Flow, Observer, PackingMeter, ReposeMeter, Scheduled, StageClock, StageEndData,
+    TimeSeries, VtkFrames, Warnings,
 };
 use super::refill::RefillRegion;
 use super::restart::{self, decode, encode, DriverState, Position, Restart};
@@ -373,6 +373,9 @@ fn observers<'s, L: PairLaw, W: WallLaw>(
             settings,
             out.to_path_buf(),
         )));
+    }
+    if !scene.output.data_at_stage_ends.is_empty() {
+        list.push(Box::new(StageEndData::new(scene, out.to_path_buf())));
     }
     Ok(list.into_iter().map(Scheduled::new).collect())
 }

@@ -18,6 +18,7 @@ pub use laws::hertz::{
     hertz_coulomb_wall, hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED,
 };
 pub use laws::{seed_laws, with_laws, LawVisitor};
+pub use observers::stage_end_data_path;
 pub use progress::{Progress, ProgressReporter, RunProgress};
 // The output format, where cgdem's runs (and the driver) have always found it.
 pub use crate::output_format::{

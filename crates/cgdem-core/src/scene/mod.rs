@@ -383,11 +383,20 @@ pub struct BodyParticles {
 /// Where a triangle mesh comes from: an STL file (path relative to the scene file) or, with
 /// the prefix `screw-feeder:`, one part of the seed's screw feeder generated with the default
 /// [`ScrewFeederSpec`](crate::geometry::screw_feeder::ScrewFeederSpec): `screw`, `casing`,
-/// `hopper` or `insertion`.
+/// `hopper` or `insertion`, or with the prefix `silo:`, the scene's `[silo]`
+/// ([`SiloSpec`](crate::geometry::silo::SiloSpec)): its `wall` or its `fill` region.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum MeshSource {
     Stl(PathBuf),
     ScrewFeeder(String),
+    Silo(SiloPart, crate::geometry::silo::SiloSpec),
+}
+
+/// A part of the built-in silo (`silo:wall`, `silo:fill`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum SiloPart {
+    Wall,
+    Fill,
 }
 
 impl MeshSource {
@@ -407,6 +416,9 @@ impl MeshSource {
                     other => return Err(format!("no screw-feeder part `{other}`")),
                 })
             }
+            MeshSource::Silo(SiloPart::Wall, spec) => Ok(crate::geometry::silo::wall_mesh(spec)),
+            MeshSource::Silo(SiloPart::Fill, spec) => crate::geometry::silo::fill_mesh(spec)
+                .ok_or_else(|| "silo:fill needs [silo] fill_height".to_string()),
         }
     }
 }
@@ -538,7 +550,7 @@ pub struct Stage {
     pub end: StageEnd,
 }
 
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct OutputSettings {
     /// Simulated seconds between VTK frames; 0 = none.
     pub vtk_interval: Real,
@@ -547,8 +559,26 @@ pub struct OutputSettings {
     /// Also write each VTK frame's particles as a LAMMPS data file
     /// (`vtk/particles_NNNNNN.data`), from which a scene can start (`read_data`).
     pub write_data: bool,
+    /// Stages at whose end the particles are written as a LAMMPS data file
+    /// (`stage_<name>_end.data`).
+    #[serde(default)]
+    pub data_at_stage_ends: Vec<String>,
     /// Simulated seconds between time-series rows.
     pub timeseries_interval: Real,
+}
+
+/// The derived text of the fields as before (the scene digest), `data_at_stage_ends` only
+/// when not empty.
+impl std::fmt::Debug for OutputSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("OutputSettings");
+        s.field("vtk_interval", &self.vtk_interval)
+            .field("vtk_contact_network", &self.vtk_contact_network)
+            .field("write_data", &self.write_data);
+        optional_field(&mut s, "data_at_stage_ends", &self.data_at_stage_ends);
+        s.field("timeseries_interval", &self.timeseries_interval);
+        s.finish()
+    }
 }
 
 /// How and when the repose angle of a collapsed heap is measured (see `analysis::heap`).

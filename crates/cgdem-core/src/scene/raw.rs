@@ -42,6 +42,24 @@ pub struct RawScene {
     pub conveying: Option<RawConveying>,
     #[serde(default)]
     pub packing: Option<RawPacking>,
+    /// The built-in silo's dimensions, for `mesh = "silo:wall"` / `"silo:fill"`.
+    #[serde(default)]
+    pub silo: Option<RawSilo>,
+}
+
+/// `[silo]`: every field defaults to the benchmark silo's (`SiloSpec::default`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSilo {
+    pub silo_diameter: Option<f64>,
+    pub orifice_diameter: Option<f64>,
+    pub hopper_half_angle: Option<f64>,
+    pub cylinder_height: Option<f64>,
+    pub orifice_z: Option<f64>,
+    pub wall_thickness: Option<f64>,
+    pub segments: Option<u32>,
+    pub max_edge: Option<f64>,
+    pub fill_height: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -287,6 +305,8 @@ pub struct RawOutput {
     pub vtk_interval: Option<f64>,
     pub vtk_contact_network: Option<bool>,
     pub write_data: Option<bool>,
+    #[serde(default)]
+    pub data_at_stage_ends: Vec<String>,
     pub timeseries_interval: Option<f64>,
 }
 

@@ -8,12 +8,15 @@
 mod conveying;
 mod packing;
 mod repose;
+mod stage_data;
 mod timeseries;
 mod vtk;
 
 pub(crate) use conveying::ConveyingMeter;
 pub(crate) use packing::PackingMeter;
 pub(crate) use repose::ReposeMeter;
+pub use stage_data::stage_end_data_path;
+pub(crate) use stage_data::StageEndData;
 pub(crate) use timeseries::TimeSeries;
 pub(crate) use vtk::VtkFrames;
 

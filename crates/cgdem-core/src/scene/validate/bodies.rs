@@ -78,7 +78,7 @@ pub(super) fn bodies(
         bodies.push(BodySettings {
             material,
             name: b.name.clone(),
-            mesh: mesh_source(&b.mesh, c.file),
+            mesh: mesh_source(c, &format!("body[{k}].mesh"), &b.mesh)?,
             cell_size,
             particles,
             padding: b

@@ -50,7 +50,11 @@ pub(super) fn insertions(
             species: species_index,
             lo: ilo,
             hi: ihi,
-            mesh: ins.mesh.as_deref().map(|m| mesh_source(m, c.file)),
+            mesh: ins
+                .mesh
+                .as_deref()
+                .map(|m| mesh_source(c, &format!("insert[{k}].mesh"), m))
+                .transpose()?,
             amount,
             seed: ins.seed,
             velocity: c.vector(

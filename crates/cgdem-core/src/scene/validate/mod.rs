@@ -19,6 +19,8 @@ use super::*;
 
 struct Checker<'a> {
     file: &'a Path,
+    /// `[silo]`, checked: the built-in silo the `silo:` meshes are made from.
+    silo: Option<crate::geometry::silo::SiloSpec>,
 }
 
 impl Checker<'_> {
@@ -81,7 +83,8 @@ impl Checker<'_> {
 }
 
 pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
-    let c = Checker { file };
+    let silo = raw.silo.as_ref().map(|s| silo(file, s)).transpose()?;
+    let c = Checker { file, silo };
     if raw.name.trim().is_empty() {
         return Err(c.invalid("name", "\"\"", "a non-empty case name"));
     }
@@ -98,7 +101,7 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     let insertions = insertion::insertions(&c, &raw, &domain, &species)?;
     let particles = particles::given_particles(&c, &raw, &domain, &species)?;
     let stages = stages::stages(&c, &raw.stages, &walls)?;
-    let output = stages::output(&c, raw.output.as_ref())?;
+    let output = stages::output(&c, raw.output.as_ref(), &stages)?;
     let repose = raw
         .repose
         .as_ref()
@@ -146,12 +149,62 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
     })
 }
 
-/// `screw-feeder:<part>` or an STL path relative to the scene file.
-fn mesh_source(text: &str, file: &Path) -> MeshSource {
-    match text.strip_prefix("screw-feeder:") {
-        Some(part) => MeshSource::ScrewFeeder(part.to_string()),
-        None => MeshSource::Stl(file.parent().unwrap_or(Path::new(".")).join(text)),
+/// `[silo]` over the benchmark silo's defaults, checked.
+fn silo(file: &Path, raw: &RawSilo) -> Result<crate::geometry::silo::SiloSpec, SceneError> {
+    let d = crate::geometry::silo::SiloSpec::default();
+    let spec = crate::geometry::silo::SiloSpec {
+        silo_diameter: raw.silo_diameter.unwrap_or(d.silo_diameter),
+        orifice_diameter: raw.orifice_diameter.unwrap_or(d.orifice_diameter),
+        hopper_half_angle: raw.hopper_half_angle.unwrap_or(d.hopper_half_angle),
+        cylinder_height: raw.cylinder_height.unwrap_or(d.cylinder_height),
+        orifice_z: raw.orifice_z.unwrap_or(d.orifice_z),
+        wall_thickness: raw.wall_thickness.unwrap_or(d.wall_thickness),
+        segments: raw.segments.unwrap_or(d.segments),
+        max_edge: raw.max_edge.unwrap_or(d.max_edge),
+        fill_height: raw.fill_height,
+    };
+    match spec.problem() {
+        None => Ok(spec),
+        Some((field, value, allowed)) => Err(SceneError::Invalid {
+            file: file.to_path_buf(),
+            field: format!("silo.{field}"),
+            value,
+            allowed: allowed.into(),
+        }),
     }
+}
+
+/// `screw-feeder:<part>`, `silo:wall` or `silo:fill` (from `[silo]`), or an STL path relative
+/// to the scene file; `field` names the value in errors.
+fn mesh_source(c: &Checker, field: &str, text: &str) -> Result<MeshSource, SceneError> {
+    if let Some(part) = text.strip_prefix("screw-feeder:") {
+        return Ok(MeshSource::ScrewFeeder(part.to_string()));
+    }
+    let Some(part) = text.strip_prefix("silo:") else {
+        return Ok(MeshSource::Stl(
+            c.file.parent().unwrap_or(Path::new(".")).join(text),
+        ));
+    };
+    let part = match part {
+        "wall" => SiloPart::Wall,
+        "fill" => SiloPart::Fill,
+        _ => return Err(c.invalid(field, text, "`silo:wall` or `silo:fill`")),
+    };
+    let Some(spec) = &c.silo else {
+        return Err(c.invalid(
+            field,
+            text,
+            "a `silo:` mesh with a [silo] table giving the silo's dimensions",
+        ));
+    };
+    if part == SiloPart::Fill && spec.fill_height.is_none() {
+        return Err(c.invalid(
+            "silo.fill_height",
+            "missing",
+            "the fill region's top above the hopper's top, m (needed by `silo:fill`)",
+        ));
+    }
+    Ok(MeshSource::Silo(part, spec.clone()))
 }
 
 fn names<'a>(list: impl Iterator<Item = &'a String>) -> String {

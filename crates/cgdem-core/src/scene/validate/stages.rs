@@ -55,6 +55,7 @@ fn stage_end(c: &Checker, k: usize, s: &RawStage) -> Result<StageEnd, SceneError
 pub(super) fn output(
     c: &Checker,
     output: Option<&RawOutput>,
+    stages: &[Stage],
 ) -> Result<OutputSettings, SceneError> {
     let vtk_interval = c.non_negative(
         "output.vtk_interval",
@@ -64,10 +65,20 @@ pub(super) fn output(
         "output.timeseries_interval",
         output.and_then(|o| o.timeseries_interval).unwrap_or(0.01),
     )?;
+    let data_at_stage_ends = output.map_or(Vec::new(), |o| o.data_at_stage_ends.clone());
+    for (k, name) in data_at_stage_ends.iter().enumerate() {
+        c.one_of(
+            format!("output.data_at_stage_ends[{k}]"),
+            name,
+            "stages",
+            stages.iter().map(|s| &s.name),
+        )?;
+    }
     Ok(OutputSettings {
         vtk_interval,
         vtk_contact_network: output.and_then(|o| o.vtk_contact_network).unwrap_or(false),
         write_data: output.and_then(|o| o.write_data).unwrap_or(false),
+        data_at_stage_ends,
         timeseries_interval,
     })
 }
