@@ -9,7 +9,10 @@ revolution about the z axis (a cylinder on a conical hopper, open at the top and
 orifice), the same triangles for cgdem (an SDF body) and LIGGGHTS (`fix mesh/surface`). With
 --fill-top Z it also writes DIR/NAME_fill.stl, the silo's inside from the orifice plane to
 z = Z, closed: cgdem's `[[insert]] mesh` (positions inside it by one radius). `--preset
-cases` writes the meshes of validation/cases/silo*.toml (both orifices, full and reduced).
+cases` writes the meshes validation/cases/silo*.toml used before the silo was built in: the
+cases now take `silo:wall` / `silo:fill` from their `[silo]` table
+(crates/cgdem-core/src/geometry/silo.rs), whose test checks that it gives these files'
+triangles (validation/cases/silo/*.stl, kept as that reference).
 
 Dimensions (defaults: the benchmark's, reference/silo/SOURCE.md): inner radius R, hopper
 half-angle 45 deg from the vertical down to the orifice radius r0 at z = z0, cylinder of

@@ -214,6 +214,22 @@ pub fn dump_bulk_density(
     ))
 }
 
+/// The bulk density of a cgdem run from a LAMMPS data file it wrote (`[output]
+/// data_at_stage_ends`: the fill at rest when the gate opens), each atom's mass from its
+/// diameter and density.
+pub fn data_bulk_density(path: &Path, lo: [f64; 3], hi: [f64; 3]) -> Result<f64, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let data = cgdem_core::lammps_data::parse_data(&text, path).map_err(|e| e.to_string())?;
+    Ok(bulk_density(
+        data.atoms.iter().map(|a| {
+            let mass = a.density * std::f64::consts::PI / 6.0 * a.diameter.powi(3);
+            ([a.position.x, a.position.y, a.position.z], mass)
+        }),
+        lo,
+        hi,
+    ))
+}
+
 /// Beverloo's rate, kg/s: `C rho_b sqrt(g) (D0 - k d)^(5/2)`; None when the orifice is no
 /// wider than `k d` (the law predicts no flow).
 pub fn beverloo_rate(

@@ -10,9 +10,9 @@ mod report;
 mod tests;
 
 pub use measurement::{
-    beverloo_c, beverloo_rate, bulk_density, combined_c, discharge_rate, discharge_series,
-    dump_bulk_density, fit_c_and_k, DischargeRate, DischargeSeries, PUBLISHED_C, PUBLISHED_K,
-    STANDARD_GRAVITY,
+    beverloo_c, beverloo_rate, bulk_density, combined_c, data_bulk_density, discharge_rate,
+    discharge_series, dump_bulk_density, fit_c_and_k, DischargeRate, DischargeSeries, PUBLISHED_C,
+    PUBLISHED_K, STANDARD_GRAVITY,
 };
 pub use report::{measure_runs, write_silo_overview, write_silo_section, SiloRun};
 

@@ -8,8 +8,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::measurement::{
-    beverloo_c, beverloo_rate, combined_c, discharge_rate, discharge_series, dump_bulk_density,
-    fit_c_and_k, DischargeRate, DischargeSeries, PUBLISHED_C, PUBLISHED_K,
+    beverloo_c, beverloo_rate, combined_c, data_bulk_density, discharge_rate, discharge_series,
+    dump_bulk_density, fit_c_and_k, DischargeRate, DischargeSeries, PUBLISHED_C, PUBLISHED_K,
 };
 use super::DischargeSettings;
 use crate::code::Code;
@@ -31,8 +31,9 @@ pub struct SiloRun {
     pub grain_diameter_m: f64,
     pub series: Option<DischargeSeries>,
     pub rate: Option<DischargeRate>,
-    /// kg/m3, and the code whose fill it was measured in (cgdem writes no positions at the
-    /// gate's opening: it takes a reference code's of the same seed).
+    /// kg/m3, and the code whose fill it was measured in (cgdem's own from the data file it
+    /// writes at the fill's end when the scene asks for it, else a reference code's of the
+    /// same seed).
     pub bulk_density: Option<(f64, Code)>,
     /// Beverloo's C with k = 1.5 and its standard error.
     pub c_fixed_k: Option<(f64, f64)>,
@@ -54,6 +55,19 @@ fn measure_one(
             coarse.species.len()
         ));
     };
+    // A built-in silo's orifice is the scene's; the suite's value must be the same.
+    for b in &scene.bodies {
+        if let cgdem_core::scene::MeshSource::Silo(_, spec) = &b.mesh {
+            if (spec.orifice_diameter - settings.orifice_diameter_m).abs() > 1e-9 {
+                return Err(format!(
+                    "{}: the silo's orifice_diameter is {} m, the suite's discharge.orifice_diameter {} m",
+                    scene.source.display(),
+                    spec.orifice_diameter,
+                    settings.orifice_diameter_m
+                ));
+            }
+        }
+    }
     let path = r.dir.join("summary.json");
     let summary: RunSummary = std::fs::read_to_string(&path)
         .map_err(|e| format!("{}: {e}", path.display()))
@@ -73,7 +87,7 @@ fn measure_one(
     let rate = discharge_rate(&series, settings.discard_s, settings.blocks)?;
     let gate_step = (stage.start_s / summary.dt_s).round() as u64;
     let bulk_density = match r.code {
-        Code::Cgdem => None,
+        Code::Cgdem => cgdem_bulk_density(&coarse, settings, &r.dir)?,
         _ => Some((
             dump_bulk_density(
                 &r.dir,
@@ -102,8 +116,32 @@ fn measure_one(
     ))
 }
 
-/// Every finished run of a discharge case measured; cgdem's runs take the bulk density of a
-/// reference code's run of the same level and seed (LIGGGHTS first).
+/// cgdem's bulk density at the gate's opening, from the particles it wrote at the end of the
+/// stage before the discharge (`[output] data_at_stage_ends`); None when the scene does not
+/// write them.
+fn cgdem_bulk_density(
+    scene: &Scene,
+    settings: &DischargeSettings,
+    dir: &Path,
+) -> Result<Option<(f64, Code)>, String> {
+    let k = scene
+        .stages
+        .iter()
+        .position(|s| s.name == settings.stage)
+        .ok_or_else(|| format!("{}: no stage `{}`", scene.source.display(), settings.stage))?;
+    let Some(before) = k.checked_sub(1).map(|j| &scene.stages[j].name) else {
+        return Ok(None);
+    };
+    if !scene.output.data_at_stage_ends.contains(before) {
+        return Ok(None);
+    }
+    let path = cgdem_core::run::stage_end_data_path(dir, before);
+    data_bulk_density(&path, settings.bulk_lo, settings.bulk_hi).map(|rho| Some((rho, Code::Cgdem)))
+}
+
+/// Every finished run of a discharge case measured; cgdem's runs whose scene writes no data
+/// file at the fill's end take the bulk density of a reference code's run of the same level
+/// and seed (LIGGGHTS first).
 pub fn measure_runs(
     scene: &Scene,
     settings: &DischargeSettings,

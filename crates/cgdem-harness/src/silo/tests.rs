@@ -171,3 +171,33 @@ fn a_suite_case_with_a_bad_discharge_table_names_the_field() {
         assert!(e.contains("s.toml") && e.contains(field), "{e}");
     }
 }
+
+#[test]
+fn cgdems_bulk_density_comes_from_the_data_file_it_writes_at_the_fills_end() {
+    use cgdem_core::math::Vec3;
+    use cgdem_core::particles::Particles;
+    let dir = std::env::temp_dir().join(format!("cgdem-silo-data-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Two grains of d = 4 mm, 2500 kg/m3 in the unit-volume box, one outside it.
+    let grain = 2500.0 * std::f64::consts::PI / 6.0 * 0.004f64.powi(3);
+    let mut p = Particles::new(false);
+    for z in [0.25, 0.5, 1.5] {
+        p.push(0, Vec3::new(0.5, 0.5, z), 0.002, grain);
+    }
+    let path = dir.join("stage_fill_end.data");
+    let text = cgdem_core::lammps_data::data_text(
+        "t",
+        Vec3::ZERO,
+        Vec3::splat(2.0),
+        &p,
+        &[0.004],
+        &[2500.0],
+        1,
+    );
+    std::fs::write(&path, text).unwrap();
+    let rho = data_bulk_density(&path, [0.0; 3], [1.0; 3]).unwrap();
+    assert!((rho - 2.0 * grain).abs() < 1e-12 * grain, "{rho}");
+    let e = data_bulk_density(&dir.join("none.data"), [0.0; 3], [1.0; 3]);
+    assert!(e.unwrap_err().contains("none.data"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -6,6 +6,9 @@
 //! - the seed's casing and hopper (`screw-feeder:casing` and `screw-feeder:hopper`, both
 //!   fixed) are one union region of analytic pieces from the same `ScrewFeederSpec`, felt
 //!   through `fix wall/gran/region` with the deck's wall model ([`casing_and_hopper_region`]);
+//! - the built-in silo's wall (`silo:wall`, fixed) is a union region of a cone (the hopper)
+//!   and a cylinder above it, both with open ends, from the same `SiloSpec`
+//!   ([`silo_region`]);
 //! - any other mesh body is refused, naming it.
 //!
 //! A union region keeps a piece's surface only where it does not lie inside another piece,
@@ -17,7 +20,8 @@ use std::fmt::Write as _;
 use crate::decks::lines::g;
 use crate::decks::DeckError;
 use cgdem_core::geometry::screw_feeder::{hopper_inner_rect, ScrewFeederSpec};
-use cgdem_core::scene::{MeshSource, Scene};
+use cgdem_core::geometry::silo::SiloSpec;
+use cgdem_core::scene::{MeshSource, Scene, SiloPart};
 
 /// The deck lines of the scene's bodies.
 pub(crate) struct BodyLines {
@@ -49,6 +53,7 @@ pub(crate) fn body_lines(
         notes: Vec::new(),
     };
     let mut static_parts = Vec::new();
+    let mut silos = Vec::new();
     for (k, b) in scene.bodies.iter().enumerate() {
         if let Some(bp) = &b.particles {
             // The body's atoms are its species' atoms: no other body or insertion may use it.
@@ -100,9 +105,12 @@ pub(crate) fn body_lines(
             {
                 static_parts.push(part.as_str());
             }
+            MeshSource::Silo(SiloPart::Wall, spec) if b.rpm == 0.0 && b.velocity.length() == 0.0 => {
+                silos.push((b.name.as_str(), spec));
+            }
             _ => {
                 return Err(unsupported(format!(
-                    "body[{k}] `{}`: LAMMPS has no mesh walls; its decks take bodies built of particles and the seed's fixed casing and hopper (`screw-feeder:casing`, `screw-feeder:hopper`) only",
+                    "body[{k}] `{}`: LAMMPS has no mesh walls; its decks take bodies built of particles, the seed's fixed casing and hopper (`screw-feeder:casing`, `screw-feeder:hopper`) and the fixed built-in silo (`silo:wall`) only",
                     b.name
                 )))
             }
@@ -123,7 +131,57 @@ pub(crate) fn body_lines(
         out.refix_walls = format!("unfix           w_{CASING_REGION}\n{fix}");
         out.notes.push("LAMMPS: the casing and hopper are one union region of a cylinder, blocks and planes (the same dimensions as the STL meshes, whose bore is a 128-gon); below the outlet the region is a vertical box, above the casing's end open space, as in cgdem where grains fall freely".into());
     }
+    if !static_parts.is_empty() && !silos.is_empty() || silos.len() > 1 {
+        return Err(unsupported(
+            "the LAMMPS deck writes one region wall: the seed's casing and hopper, or one silo"
+                .into(),
+        ));
+    }
+    if let Some((name, spec)) = silos.first() {
+        let region = format!("silo_{name}");
+        out.setup += &silo_region(spec, &region);
+        let fix = format!(
+            "fix             w_{region} {integrated} wall/gran/region granular {wall_model} region {region}\n"
+        );
+        out.setup += &fix;
+        out.refix_walls = format!("unfix           w_{region}\n{fix}");
+        out.notes.push(format!("LAMMPS: the silo is one union region of a cone (the hopper) and a cylinder, open at both ends, the same dimensions as cgdem's mesh (a {}-gon in cgdem, true circles here); it has no orifice lip: a grain whose centre has passed below the orifice plane no longer feels the rim, where cgdem's grains still touch the lip's edge", spec.segments));
+    }
     Ok(out)
+}
+
+/// The built-in silo's inside as one LAMMPS region named `name` (inside = where grains may
+/// be): the hopper, a cone from the orifice (radius r0) to the hopper's top (radius R), and
+/// the cylinder from there to the rim, each with its end faces open, so the orifice and the
+/// top are open and the two pieces join without a face between them. Below the orifice a
+/// grain is outside the region and feels no wall (`fix wall/gran/region` skips it).
+pub(crate) fn silo_region(spec: &SiloSpec, name: &str) -> String {
+    let l = spec.layout();
+    let mut d = String::new();
+    let _ = writeln!(
+        d,
+        "# The built-in silo (SiloSpec, reference/silo/SOURCE.md) as a union region."
+    );
+    let _ = writeln!(
+        d,
+        "region          {name}_hopper cone z 0.0 0.0 {} {} {} {} side in open 1 open 2",
+        g(l.orifice_radius),
+        g(l.radius),
+        g(l.orifice_z),
+        g(l.hopper_top_z)
+    );
+    let _ = writeln!(
+        d,
+        "region          {name}_cylinder cylinder z 0.0 0.0 {} {} {} side in open 1 open 2",
+        g(l.radius),
+        g(l.hopper_top_z),
+        g(l.rim_z)
+    );
+    let _ = writeln!(
+        d,
+        "region          {name} union 2 {name}_hopper {name}_cylinder side in"
+    );
+    d
 }
 
 /// The seed's casing and hopper as one LAMMPS region named `name` (inside = where grains may
@@ -267,6 +325,80 @@ mod tests {
         assert!(d.contains(
             "region          c union 5 c_bore c_chute c_outlet c_beyond c_hopper side in"
         ));
+    }
+
+    /// The numbers of the region line `region NAME STYLE ...` (after the style's axis).
+    fn region_numbers(deck: &str, name: &str) -> Vec<f64> {
+        let line = deck
+            .lines()
+            .find(|l| l.split_whitespace().nth(1) == Some(name))
+            .unwrap_or_else(|| panic!("no region {name} in\n{deck}"));
+        line.split_whitespace()
+            .skip(4)
+            .map_while(|w| w.parse().ok())
+            .collect()
+    }
+
+    #[test]
+    fn the_silo_region_is_the_cases_hopper_and_cylinder_through_the_meshs_inner_rims() {
+        crate::at_repo_root();
+        let scene = Scene::load_with_overrides(
+            std::path::Path::new("validation/cases/silo_reduced.toml"),
+            &[cgdem_core::scene::Override::parse(
+                "silo.orifice_diameter=0.06",
+                std::path::Path::new("test"),
+            )
+            .unwrap()],
+        )
+        .unwrap();
+        let lines = body_lines(&scene, "all", "hertz/material").unwrap();
+        let MeshSource::Silo(SiloPart::Wall, spec) = &scene.bodies[0].mesh else {
+            panic!("{:?}", scene.bodies[0].mesh)
+        };
+        // cone: c1 c2 radlo radhi lo hi; cylinder: c1 c2 radius lo hi.
+        let cone = region_numbers(&lines.setup, "silo_silo_hopper");
+        let cylinder = region_numbers(&lines.setup, "silo_silo_cylinder");
+        let near = |a: &[f64], b: &[f64]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15)
+        };
+        assert!(near(&cone, &[0.0, 0.0, 0.03, 0.1, 0.0, 0.07]), "{cone:?}");
+        assert!(
+            near(&cylinder, &[0.0, 0.0, 0.1, 0.07, 0.19]),
+            "{cylinder:?}"
+        );
+        // Every vertex of the mesh below the rim lies on the cone or the cylinder (its inner
+        // surface: the 96-gon's corners lie on the circles) or the wall's thickness outside it.
+        let mesh = cgdem_core::geometry::silo::wall_mesh(spec);
+        let mut inner = 0;
+        for v in &mesh.vertices {
+            let r = v.x.hypot(v.y);
+            if v.z > cylinder[4] - 1e-12 {
+                continue;
+            }
+            let surface = if v.z <= cone[5] {
+                cone[2] + (v.z - cone[4]) * (cone[3] - cone[2]) / (cone[5] - cone[4])
+            } else {
+                cylinder[2]
+            };
+            if (r - surface).abs() < 1e-12 {
+                inner += 1;
+            } else {
+                assert!(
+                    (r - surface - spec.wall_thickness).abs() < 1e-12,
+                    "vertex {v:?} (r = {r})"
+                );
+            }
+        }
+        assert!(inner > 1000, "{inner}");
+        assert!(lines.setup.contains(
+            "region          silo_silo union 2 silo_silo_hopper silo_silo_cylinder side in"
+        ));
+        assert!(lines
+            .setup
+            .contains("wall/gran/region granular hertz/material region silo_silo"));
+        assert!(lines
+            .refix_walls
+            .starts_with("unfix           w_silo_silo\n"));
     }
 
     #[test]
