@@ -366,13 +366,17 @@ mod tests {
             near(&cylinder, &[0.0, 0.0, 0.1, 0.07, 0.19]),
             "{cylinder:?}"
         );
-        // Every vertex of the mesh below the rim lies on the cone or the cylinder (its inner
-        // surface: the 96-gon's corners lie on the circles) or the wall's thickness outside it.
+        // Every vertex of the mesh below the rim and off the orifice's lip lies on the cone or
+        // the cylinder (its inner surface: the 96-gon's corners lie on the circles) or the
+        // wall's thickness outside it.
         let mesh = cgdem_core::geometry::silo::wall_mesh(spec);
         let mut inner = 0;
         for v in &mesh.vertices {
             let r = v.x.hypot(v.y);
-            if v.z > cylinder[4] - 1e-12 {
+            let lip = v.z.abs() < 1e-12
+                && r > cone[2] + 1e-12
+                && r < cone[2] + spec.wall_thickness - 1e-12;
+            if v.z > cylinder[4] - 1e-12 || lip {
                 continue;
             }
             let surface = if v.z <= cone[5] {
