@@ -168,7 +168,10 @@ pub fn wall_mesh(spec: &SiloSpec) -> TriMesh {
 /// without it).
 pub fn fill_mesh(spec: &SiloSpec) -> Option<TriMesh> {
     let l = spec.layout();
-    let top = l.hopper_top_z + spec.fill_height?;
+    // On a whole nanometre: the sum's last bit (0.08 + 0.08 = 0.16000000000000003) would
+    // otherwise add a ring to a height that is a whole number of ring spacings, and the
+    // scripts/silo_geometry.py meshes were made with the top written to 6 digits.
+    let top = ((l.hopper_top_z + spec.fill_height?) * 1e9).round() / 1e9;
     let outline = [
         (0.0, l.orifice_z),
         (l.orifice_radius, l.orifice_z),
@@ -388,8 +391,9 @@ duration = 0.1
             scene.insertions[0].mesh,
             Some(MeshSource::Silo(SiloPart::Fill, _))
         ));
+        // The insertions are checked before the bodies.
         let e = silo_scene(None, "silo:fill").unwrap_err();
-        assert!(e.contains("body[0].mesh") && e.contains("[silo]"), "{e}");
+        assert!(e.contains("insert[0].mesh") && e.contains("[silo]"), "{e}");
         let e = silo_scene(Some("cylinder_height = 0.12"), "silo:fill").unwrap_err();
         assert!(e.contains("silo.fill_height"), "{e}");
         let e = silo_scene(Some("fill_height = 0.08"), "silo:top").unwrap_err();
