@@ -77,6 +77,9 @@ fi
 # nor the harness's.
 stage module-graph python3 scripts/module-graph.py crates/cgdem-core/src
 python3 scripts/module-graph.py crates/cgdem-harness/src
+# No core file of 1,000 lines, no harness file over 800 or function over 120, no command
+# function over 80 (issue 39).
+stage sizes python3 scripts/check-sizes.py
 # Every relative link of the README and the guide (docs/) resolves; the CLI reference
 # (docs/cli.md) is checked against --help by the tests (cli_reference).
 stage links python3 scripts/check-links.py

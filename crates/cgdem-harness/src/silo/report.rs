@@ -518,8 +518,6 @@ pub fn write_silo_overview(
                 )
                 .style(SeriesStyle::Dashed),
             );
-        // One orifice's point: (D0, rate, its error, bulk density, grain diameter).
-        type Point = (f64, f64, f64, f64, f64);
         let list =
             |f: &dyn Fn(&Point) -> String| points.iter().map(f).collect::<Vec<_>>().join(", ");
         table.row([
@@ -540,25 +538,7 @@ pub fn write_silo_overview(
             ),
             Cell::num(free.map_or("-".into(), |(c, k)| format!("C = {c:.3}, k = {k:.2}"))),
         ]);
-        let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
-        for (p, c) in points.iter().zip(&cs) {
-            let _ = writeln!(
-                csv,
-                "{},{lambda},{},{},{},{},{},{},{},{},{},{},{}",
-                code.name(),
-                p.0,
-                f(Some(p.1)),
-                f(Some(p.2)),
-                f(Some(p.3)),
-                f(c.map(|c| c.0)),
-                f(c.map(|c| c.1)),
-                f(all.map(|a| a.0)),
-                f(all.map(|a| a.1)),
-                f(all.filter(|_| points.len() > 1).map(|a| a.2)),
-                f(free.map(|x| x.0)),
-                f(free.map(|x| x.1)),
-            );
-        }
+        beverloo_rows(&mut csv, (code, lambda), &points, &cs, all, free);
     }
     if !figure.series.is_empty() {
         let files =
@@ -576,6 +556,41 @@ pub fn write_silo_overview(
     let path = dir.join("beverloo.csv");
     write_atomic(&path, csv.as_bytes()).map_err(|e| output_error(&path, e))?;
     Ok(())
+}
+
+/// One orifice's point: (D0, rate, its error, bulk density, grain diameter).
+type Point = (f64, f64, f64, f64, f64);
+
+/// `beverloo.csv`'s rows of one code and level: per orifice its point and C at k = 1.5,
+/// then the level's C over all orifices (`all`: C, its error, chi^2 per degree of freedom)
+/// and C, k free (`free`).
+fn beverloo_rows(
+    csv: &mut String,
+    (code, lambda): (Code, u32),
+    points: &[Point],
+    cs: &[Option<(f64, f64)>],
+    all: Option<(f64, f64, f64)>,
+    free: Option<(f64, f64)>,
+) {
+    let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
+    for (p, c) in points.iter().zip(cs) {
+        let _ = writeln!(
+            csv,
+            "{},{lambda},{},{},{},{},{},{},{},{},{},{},{}",
+            code.name(),
+            p.0,
+            f(Some(p.1)),
+            f(Some(p.2)),
+            f(Some(p.3)),
+            f(c.map(|c| c.0)),
+            f(c.map(|c| c.1)),
+            f(all.map(|a| a.0)),
+            f(all.map(|a| a.1)),
+            f(all.filter(|_| points.len() > 1).map(|a| a.2)),
+            f(free.map(|x| x.0)),
+            f(free.map(|x| x.1)),
+        );
+    }
 }
 
 /// Per orifice of `cases`, one code and level's (D0, mean rate over seeds, its combined

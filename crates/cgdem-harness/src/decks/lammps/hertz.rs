@@ -2,8 +2,8 @@
 //! `rolling = "none" | "epsd2"`), written from the scene alone, for small collision cases.
 //!
 //! The mapping onto `pair_style granular` is derived in `reference/MAPPING.md`:
-//! `hertz/material E q nu damping tsuji` with `q = P^-1(sqrt(5) |beta(e)|)` ([`tsuji_q`]),
-//! `tangential mindlin NULL x mu` with `x = sqrt(4 G_eff / Y_eff)` ([`tangential_damping_ratio`]),
+//! `hertz/material E q nu damping tsuji` with `q = P^-1(sqrt(5) |beta(e)|)` ([`super::coefficients::tsuji_q`]),
+//! `tangential mindlin NULL x mu` with `x = sqrt(4 G_eff / Y_eff)` ([`super::coefficients::tangential_damping_ratio`]),
 //! and for epsd2 `rolling sds k_roll 0 mu_r` with a *constant* `k_roll` (LAMMPS has no
 //! overlap-dependent rolling stiffness): `k_roll = 8 G_eff sqrt(R_eff delta_max)`, the
 //! Hertz tangential stiffness at the largest overlap of an undamped impact at the scene's
@@ -13,7 +13,7 @@
 //! LAMMPS does not use `1 - nu^2`).
 //!
 //! A scene with material tables (`scene::ContactTables`) gets one `pair_coeff I J` per species
-//! pair ([`table_pair_lines`]) and, `fix wall/gran` having one model, one wall fix per wall
+//! pair ([`super::tables`]) and, `fix wall/gran` having one model, one wall fix per wall
 //! and mobile species; scenes with one material keep the one `pair_coeff * *`.
 //!
 //! Stages, wall removal (`unfix w_NAME`) and repose samples are written by `decks::stages`,
@@ -22,6 +22,8 @@
 use std::fmt::Write as _;
 
 use super::bodies::body_lines;
+use super::coefficients::{rolling_stiffness, tangential_damping_ratio, tsuji_q_of};
+use super::tables::{table_pair_lines, wall_fixes, WallGroup};
 use super::{removal_pads, DIALECT};
 use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
 use crate::decks::lines::{
@@ -29,50 +31,10 @@ use crate::decks::lines::{
 };
 use crate::decks::stages::{stage_lines, trajectory_lines, Periodic, StageHooks};
 use crate::decks::{Deck, DeckError, DeckPlan};
-use cgdem_core::contact::damping::restitution_beta;
-use cgdem_core::contact::normal::{Hertz, Material};
+use cgdem_core::contact::normal::Material;
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{ContactTables, HertzSettings, PairProperties, RollingKind, Scene};
-
-/// LAMMPS's Tsuji polynomial `P(q)`: `damping tsuji q` gives `gamma_n = P(q) sqrt(m_eff k_n)`.
-pub fn tsuji_polynomial(q: Real) -> Real {
-    let c = [1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218];
-    c.iter().rev().fold(0.0, |acc, &a| acc * q + a)
-}
-
-/// The `damping tsuji` number that reproduces LIGGGHTS's `model hertz` dashpot for
-/// restitution `e`: `P(q) = sqrt(5) |beta(e)|` (P decreases on [0, 1]); None below e ~ 0.114,
-/// where `sqrt(5) |beta| > P(0)`, and near e = 1, where it is below `P(1)`.
-pub fn tsuji_q(restitution: Real) -> Option<Real> {
-    let target = 5.0_f64.sqrt() * restitution_beta(restitution).abs();
-    if target > tsuji_polynomial(0.0) || target < tsuji_polynomial(1.0) {
-        return None;
-    }
-    let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if tsuji_polynomial(mid) > target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(0.5 * (lo + hi))
-}
-
-/// `gamma_t / gamma_n` of LIGGGHTS `model hertz` = `sqrt(S_t / S_n) = sqrt(4 G_eff / Y_eff)`,
-/// the `x` of LAMMPS `tangential mindlin NULL x mu`.
-pub fn tangential_damping_ratio(y_eff: Real, g_eff: Real) -> Real {
-    (4.0 * g_eff / y_eff).sqrt()
-}
-
-/// `k_roll` for LAMMPS `rolling sds`: the Hertz tangential stiffness `8 G_eff sqrt(R delta)` at
-/// the largest overlap of an undamped impact at `v`.
-pub fn rolling_stiffness(y_eff: Real, g_eff: Real, r_eff: Real, m_eff: Real, v: Real) -> Real {
-    let delta = Hertz::max_overlap(y_eff, r_eff, m_eff, v);
-    8.0 * g_eff * (r_eff * delta).sqrt()
-}
+use cgdem_core::scene::{ContactTables, HertzSettings, RollingKind, Scene};
 
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
@@ -80,7 +42,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     // A scene with material tables: one `pair_coeff I J` per species pair and one wall fix
-    // per wall and mobile species (`table_pair_lines`, `table_wall_fix_lines`); without, the
+    // per wall and mobile species (`super::tables`); without, the
     // one material of `[contact]`.
     let tables = if scene.gives_material_tables() {
         if !scene.bodies.is_empty() {
@@ -116,21 +78,11 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     d += &freeze;
     d += &integration_lines(scene, integrated, dt);
     let wall_model = wall_model(scene, h, m)?;
-    let wall_groups = match &tables {
-        Some(t) => {
-            let groups = wall_groups(scene);
-            d += &table_wall_fix_lines(scene, h, t, &groups)?;
-            groups
-        }
-        None => {
-            d += &wall_fix_lines(scene, &wall_model)?;
-            vec![WallGroup {
-                species: None,
-                suffix: String::new(),
-                group: "all".into(),
-            }]
-        }
+    let (wall_lines, wall_groups) = match &tables {
+        Some(t) => wall_fixes(scene, h, t)?,
+        None => (wall_fix_lines(scene, &wall_model)?, vec![WallGroup::all()]),
     };
+    d += &wall_lines;
     let bodies = body_lines(scene, integrated, &wall_model)?;
     d += &bodies.setup;
     // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
@@ -207,17 +159,6 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     })
 }
 
-/// LAMMPS's Tsuji coefficient `q` for restitution `e`, or why this LAMMPS cannot damp so.
-fn tsuji_q_of(scene: &Scene, e: Real) -> Result<Real, DeckError> {
-    tsuji_q(e).ok_or_else(|| {
-        DeckError::unsupported(scene, if e < 0.5 {
-            format!("restitution {e}: damping tsuji cannot reach LIGGGHTS's dashpot below e ~ 0.114")
-        } else {
-            format!("restitution {e}: damping tsuji cannot damp as little as LIGGGHTS's dashpot does (its least damping, q = 1, is more)")
-        })
-    })
-}
-
 /// `pair_style granular` with the particle-particle `pair_coeff` (Hertz, Tsuji damping,
 /// Mindlin, and `rolling sds` for epsd2 at the scene's characteristic speed, first species).
 fn pair_lines(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, DeckError> {
@@ -254,152 +195,6 @@ fn pair_lines(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, D
         rolling
     );
     Ok(d)
-}
-
-/// `pair_style granular` with one `pair_coeff I J` per species pair of the scene's tables.
-/// `hertz/material E q nu` takes `E` and `nu` as one material for both sides
-/// (`Y* = E/(2 (1 - nu^2))`), so each pair is given the one material with its own `Y*` and
-/// `G*` ([`one_material`]); `q`, `mu` and `mu_r` are the pair's own, `k_roll` is that of
-/// its `R*` and `m*` (reference/MAPPING.md). Every pair is written: LAMMPS's mixing of an
-/// unset pair is not LIGGGHTS's.
-pub fn table_pair_lines(
-    scene: &Scene,
-    h: &HertzSettings,
-    t: &ContactTables,
-) -> Result<String, DeckError> {
-    let mut d = String::from("pair_style      granular\n");
-    d += "# per species pair: E, nu of one material with the pair's Y*, G*; q = P^-1(sqrt(5)|beta(e)|); x = sqrt(4 G*/Y*)\n";
-    let n = t.n_species();
-    for a in 0..n {
-        for b in a..n {
-            let (y, g_eff) = (t.y_eff(a, b), t.g_eff(a, b));
-            let (sa, sb) = (&scene.species[a], &scene.species[b]);
-            let r_eff = sa.radius() * sb.radius() / (sa.radius() + sb.radius());
-            let m_eff = sa.mass() * sb.mass() / (sa.mass() + sb.mass());
-            let (e, nu) = one_material(y, g_eff);
-            let p = t.pair(a, b);
-            let _ = writeln!(
-                d,
-                "pair_coeff      {} {} hertz/material {} {} {} damping tsuji tangential mindlin NULL {} {}{}",
-                a + 1,
-                b + 1,
-                g(e),
-                g(tsuji_q_of(scene, p.restitution)?),
-                g(nu),
-                g(tangential_damping_ratio(y, g_eff)),
-                g(p.friction),
-                rolling_args(h, p, y, g_eff, r_eff, m_eff)
-            );
-        }
-    }
-    Ok(d)
-}
-
-/// The one material `(E, nu)` with `Y* = y_eff` and `G* = g_eff` against itself:
-/// `G*/Y* = r = (1 - nu)/(2 (2 - nu))` for one material, so `nu = (1 - 4r)/(1 - 2r)` and
-/// `E = 2 (1 - nu^2) Y*`.
-pub fn one_material(y_eff: Real, g_eff: Real) -> (Real, Real) {
-    let r = g_eff / y_eff;
-    let nu = (1.0 - 4.0 * r) / (1.0 - 2.0 * r);
-    (2.0 * (1.0 - nu * nu) * y_eff, nu)
-}
-
-/// ` rolling sds k_roll 0 mu_r` of pair coefficients `p` for epsd2, else nothing.
-fn rolling_args(
-    h: &HertzSettings,
-    p: &PairProperties,
-    y_eff: Real,
-    g_eff: Real,
-    r_eff: Real,
-    m_eff: Real,
-) -> String {
-    if h.rolling != RollingKind::Epsd2 {
-        return String::new();
-    }
-    let k_roll = rolling_stiffness(y_eff, g_eff, r_eff, m_eff, h.characteristic_velocity);
-    format!(" rolling sds {} 0.0 {}", g(k_roll), g(p.rolling_friction))
-}
-
-/// The particles one wall fix acts on: `fix wall/gran` has one model, so with material
-/// tables and several mobile species each species gets its own fix of each wall
-/// (`w_NAME_T` on group `grains_T`, T its atom type); one mobile species takes `w_NAME`.
-struct WallGroup {
-    /// The species whose wall coefficients the fix takes (None: the uniform deck's).
-    species: Option<usize>,
-    /// Appended to the fix's name `w_NAME`.
-    suffix: String,
-    group: String,
-}
-
-fn wall_groups(scene: &Scene) -> Vec<WallGroup> {
-    let mobile: Vec<usize> = (0..scene.species.len())
-        .filter(|&a| !scene.species[a].frozen)
-        .collect();
-    match mobile[..] {
-        [a] => vec![WallGroup {
-            species: Some(a),
-            suffix: String::new(),
-            group: "all".into(),
-        }],
-        _ => mobile
-            .iter()
-            .map(|&a| WallGroup {
-                species: Some(a),
-                suffix: format!("_{}", a + 1),
-                group: format!("grains_{}", a + 1),
-            })
-            .collect(),
-    }
-}
-
-/// The wall fixes of a scene with material tables: for each planar wall and each of
-/// `groups`, the model of that species against the wall's material. The wall fix of this
-/// LAMMPS takes `k_n = (4/3) E/(2 (1 - nu)) sqrt(R delta)`, so `E = 2 (1 - nu) Y*` with the
-/// species' `nu`, and the Mindlin stiffness `8 G*` explicitly (as `wall_model`); the wall is
-/// a particle of infinite radius and mass, so `R* = r`, `m* = m`.
-fn table_wall_fix_lines(
-    scene: &Scene,
-    h: &HertzSettings,
-    t: &ContactTables,
-    groups: &[WallGroup],
-) -> Result<String, DeckError> {
-    let mut lines = String::new();
-    for w in groups.iter().filter(|w| w.group != "all") {
-        let a = w.species.expect("a table wall group names its species");
-        let _ = writeln!(lines, "group           {} type {}", w.group, a + 1);
-    }
-    for wall in &scene.walls {
-        let (axis, up) = wall_axis(scene, wall)?;
-        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
-        let (lo, hi) = if up {
-            (at, "NULL".to_string())
-        } else {
-            ("NULL".to_string(), at)
-        };
-        for w in groups {
-            let a = w.species.expect("a table wall group names its species");
-            let k = wall.material;
-            let (s, nu) = (&scene.species[a], t.species[a].poisson_ratio);
-            let (y, g_eff) = (t.wall_y_eff(a, k), t.wall_g_eff(a, k));
-            let p = t.wall_pair(a, k);
-            let _ = writeln!(
-                lines,
-                "fix             w_{}{} {} wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {}plane {lo} {hi}",
-                wall.name,
-                w.suffix,
-                w.group,
-                g(2.0 * (1.0 - nu) * y),
-                g(tsuji_q_of(scene, p.restitution)?),
-                g(nu),
-                g(8.0 * g_eff),
-                g(tangential_damping_ratio(y, g_eff)),
-                g(p.friction),
-                rolling_args(h, p, y, g_eff, s.radius(), s.mass()),
-                ["x", "y", "z"][axis]
-            );
-        }
-    }
-    Ok(lines)
 }
 
 /// Time integration of the `integrated` group, gravity and the time step.
@@ -622,6 +417,8 @@ impl TopUps {
 mod tests {
     use super::*;
     use crate::decks::hertz::{at, collapse_scene_and_particle};
+    use crate::decks::lammps::coefficients::tsuji_q;
+    use crate::decks::lammps::tables::one_material;
 
     #[test]
     fn collapse_deck_settles_then_unfixes_the_gate_then_samples_the_collapse() {

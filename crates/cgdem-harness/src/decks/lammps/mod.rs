@@ -4,7 +4,9 @@
 //! reproduce: `reference/lammps/SEED_MODEL.md` and `reference/MAPPING.md`.
 
 mod bodies;
+pub mod coefficients;
 pub mod hertz;
+pub mod tables;
 pub mod wca;
 
 pub use hertz::write_hertz_deck;
