@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use cgdem_core::coarse_graining::coarse_grain;
-use cgdem_core::scene::{InsertAmount, Scene};
+use cgdem_core::scene::{InsertAmount, Override, Scene};
 
 #[test]
 fn shipped_cases_validate_and_coarse_grain_to_lambda_2() {
@@ -140,4 +140,22 @@ fn every_bad_scene_gives_its_named_error() {
         checked += 1;
     }
     assert!(checked >= 10, "only {checked} bad scenes");
+}
+
+#[test]
+fn a_screw_measured_in_fewer_than_two_blocks_is_refused_by_name() {
+    let file = Path::new("validation/cases/screw_feeder.toml");
+    for (blocks, refused) in [(0, true), (1, true), (2, false)] {
+        let set =
+            Override::parse(&format!("conveying.blocks={blocks}"), Path::new("--set")).unwrap();
+        let result = Scene::load_with_overrides(file, &[set]);
+        assert_eq!(result.is_err(), refused, "blocks = {blocks}");
+        if let Err(e) = result {
+            let message = e.to_string();
+            assert!(
+                message.contains("conveying.blocks") && message.contains("at least 2"),
+                "{message}"
+            );
+        }
+    }
 }

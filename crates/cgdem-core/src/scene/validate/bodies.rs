@@ -191,6 +191,15 @@ pub(super) fn conveying(
     if let Some(x) = cv.flow_x.filter(|x| !x.is_finite()) {
         return Err(c.invalid("conveying.flow_x", x, "a finite axial position in m"));
     }
+    // A standard error needs at least two blocks.
+    let blocks = cv.blocks.unwrap_or(5);
+    if blocks < 2 {
+        return Err(c.invalid(
+            "conveying.blocks",
+            blocks,
+            "at least 2 (the mass flow's standard error is taken over the blocks)",
+        ));
+    }
     let bulk_lo = c.vector("conveying.bulk_lo", cv.bulk_lo)?;
     let bulk_hi = c.vector("conveying.bulk_hi", cv.bulk_hi)?;
     if bulk_lo.cmpge(bulk_hi).any() {
@@ -204,7 +213,7 @@ pub(super) fn conveying(
         stage: cv.stage.clone(),
         body: cv.body.clone(),
         discard: c.non_negative("conveying.discard", cv.discard)?,
-        blocks: cv.blocks.unwrap_or(5).max(2),
+        blocks,
         outer_diameter,
         shaft_diameter,
         pitch: c.positive("conveying.pitch", cv.pitch)?,
