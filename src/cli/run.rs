@@ -65,11 +65,11 @@ pub(super) struct RunArgs {
     /// At each list rebuild, when the imbalance (most particles in one subdomain over
     /// the mean) passes this threshold, move the cut planes so that each slab along each
     /// axis holds the same number of particles (LAMMPS `fix balance ... shift`), never
-    /// thinner than the ghost layer; `off` keeps the start's planes. At least 1.0.
-    /// summary.json's `decomposition` gives the shifts and the imbalance the start's
-    /// planes would give.
-    #[arg(long, value_name = "THRESH|off", default_value_t)]
-    balance: BalanceSpec,
+    /// thinner than the ghost layer; `off` keeps the start's planes. At least 1.0;
+    /// default 1.1, or with --resume the one the run started with. summary.json's
+    /// `decomposition` gives the shifts and the imbalance the start's planes would give.
+    #[arg(long, value_name = "THRESH|off")]
+    balance: Option<BalanceSpec>,
     /// With `--sweep rpm=` or `screw_ratio=`: a run directory whose summary.json holds
     /// the same scene (digest) is not run again, so a sweep can be resumed or extended.
     #[arg(long)]
@@ -154,7 +154,7 @@ fn planned(args: RunArgs) -> Result<RunPlan, ExitCode> {
         force_dt: args.force_dt,
         keep_going: args.keep_going,
         grid: args.grid.map(|g| g.to_string()),
-        balance: args.grid.map(|_| args.balance.to_string()),
+        balance: args.balance.map(|b| b.to_string()),
     };
     let (invocation, resumed) =
         RunInvocation::resolve(given, args.case.is_some(), args.resume.as_deref()).map_err(

@@ -297,34 +297,42 @@ impl RunInvocation {
         Ok((stored, Some(Arc::new(loaded))))
     }
 
-    /// The grid and balance the run steps on: `grid` and `balance` as given, or, when no
-    /// grid is given, the ones this (resumed) command line stored; with the command line
-    /// naming them, so that the restart files the run writes from now on name the grid it
-    /// runs on. The error names the stored value that does not parse.
+    /// The grid and balance the run steps on: each as given, or, when not given, as this
+    /// (resumed) command line stored it (the balance applies to the scene's own grid too, so
+    /// a run resumed without `--balance` goes on as it started), else the scene's grid and
+    /// the default balance; with the command line naming them, so that the restart files
+    /// the run writes from now on name what it runs on. The error names the stored value
+    /// that does not parse.
     pub fn with_grid(
         self,
         grid: Option<GridSpec>,
-        balance: BalanceSpec,
+        balance: Option<BalanceSpec>,
     ) -> Result<(RunInvocation, Option<GridSpec>, BalanceSpec), String> {
-        let (grid, balance) = match (grid, &self.grid) {
-            (None, Some(stored)) => {
-                let balance: Result<BalanceSpec, String> = self
-                    .balance
-                    .as_deref()
-                    .map_or(Ok(BalanceSpec::default()), str::parse);
-                stored
-                    .parse::<GridSpec>()
-                    .and_then(|g| Ok((Some(g), balance?)))
-                    .map_err(|e| format!("the stored --grid/--balance: {e}"))?
-            }
-            _ => (grid, balance),
+        let stored = |e: String| format!("the stored --grid/--balance: {e}");
+        let grid = match grid {
+            Some(g) => Some(g),
+            None => self
+                .grid
+                .as_deref()
+                .map(str::parse)
+                .transpose()
+                .map_err(stored)?,
+        };
+        let balance = match balance {
+            Some(b) => Some(b),
+            None => self
+                .balance
+                .as_deref()
+                .map(str::parse)
+                .transpose()
+                .map_err(stored)?,
         };
         let invocation = RunInvocation {
             grid: grid.map(|g| g.to_string()),
-            balance: grid.map(|_| balance.to_string()),
+            balance: balance.map(|b| b.to_string()),
             ..self
         };
-        Ok((invocation, grid, balance))
+        Ok((invocation, grid, balance.unwrap_or_default()))
     }
 }
 
@@ -433,36 +441,51 @@ mod tests {
     #[test]
     fn a_resumed_run_keeps_its_stored_grid_unless_given_another() {
         let stored = invocation(Some("2x1x1"), Some("1.2"));
-        let (kept, grid, balance) = stored
-            .clone()
-            .with_grid(None, BalanceSpec::default())
-            .unwrap();
+        let (kept, grid, balance) = stored.clone().with_grid(None, None).unwrap();
         assert_eq!(grid, Some("2x1x1".parse().unwrap()));
         assert_eq!(balance, "1.2".parse().unwrap());
         assert_eq!(kept, stored);
         // Another grid: the stored one is replaced, in the command line too.
         let other: GridSpec = "1x2x1".parse().unwrap();
-        let (moved, grid, balance) = stored
-            .with_grid(Some(other), BalanceSpec::default())
-            .unwrap();
+        let (moved, grid, balance) = stored.clone().with_grid(Some(other), None).unwrap();
         assert_eq!(grid, Some(other));
-        assert_eq!(balance, BalanceSpec::default());
+        assert_eq!(balance, "1.2".parse().unwrap());
         assert_eq!(moved.grid.as_deref(), Some("1x2x1"));
+        // Another balance: the stored one is replaced.
+        let (_, _, balance) = stored.with_grid(None, Some(BalanceSpec::Off)).unwrap();
+        assert_eq!(balance, BalanceSpec::Off);
         // No grid given or stored: none, and none recorded.
-        let (plain, grid, _) = invocation(None, None)
-            .with_grid(None, BalanceSpec::default())
-            .unwrap();
+        let (plain, grid, balance) = invocation(None, None).with_grid(None, None).unwrap();
         assert_eq!((grid, plain.grid, plain.balance), (None, None, None));
+        assert_eq!(balance, BalanceSpec::default());
+    }
+
+    #[test]
+    fn a_balance_given_without_a_grid_is_stored_and_resumed() {
+        // `cgdem run case.toml --balance off`: the scene's own grid, planes never moved.
+        let (given, grid, balance) = invocation(None, None)
+            .with_grid(None, Some(BalanceSpec::Off))
+            .unwrap();
+        assert_eq!((grid, balance), (None, BalanceSpec::Off));
+        assert_eq!(given.balance.as_deref(), Some("off"));
+        // `cgdem run --resume DIR` with no --balance: the stored one, not the default.
+        let (resumed, _, balance) = given.clone().with_grid(None, None).unwrap();
+        assert_eq!(balance, BalanceSpec::Off);
+        assert_eq!(resumed, given);
     }
 
     #[test]
     fn a_stored_grid_that_does_not_parse_is_named() {
         let err = invocation(Some("2y1"), None)
-            .with_grid(None, BalanceSpec::default())
+            .with_grid(None, None)
             .unwrap_err();
         assert!(err.starts_with("the stored --grid/--balance:"), "{err}");
         let err = invocation(Some("2x1x1"), Some("0.5"))
-            .with_grid(None, BalanceSpec::default())
+            .with_grid(None, None)
+            .unwrap_err();
+        assert!(err.starts_with("the stored --grid/--balance:"), "{err}");
+        let err = invocation(None, Some("0.5"))
+            .with_grid(None, None)
             .unwrap_err();
         assert!(err.starts_with("the stored --grid/--balance:"), "{err}");
     }
