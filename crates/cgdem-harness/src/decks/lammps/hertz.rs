@@ -625,6 +625,53 @@ mod tests {
         assert!(!d.contains("pad_2"));
     }
 
+    /// The planar walls' fixes, with one material and with material tables (their names,
+    /// groups and `Xplane lo hi`), as written before the two writers shared the bounds: a
+    /// wall facing +x or +z bounds from below (`lo NULL`), one facing -x from above.
+    #[test]
+    fn planar_wall_fixes_keep_their_planes_with_one_material_and_with_tables() {
+        crate::at_repo_root();
+        let planes = |d: &str| -> Vec<String> {
+            d.lines()
+                .filter(|l| l.starts_with("fix ") && l.contains(" wall/gran granular "))
+                .map(|l| {
+                    let w: Vec<&str> = l.split_whitespace().collect();
+                    [&w[1..3], &w[w.len() - 3..]].concat().join(" ")
+                })
+                .collect()
+        };
+        let (scene, particles) = collapse_scene_and_particle();
+        let uniform = write_hertz_deck(&scene, &particles, 5e-5).unwrap();
+        let scene = Scene::load(std::path::Path::new(
+            "tests/data/tiny_two_material_collapse.toml",
+        ))
+        .unwrap();
+        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let tables = write_hertz_deck(&scene, &particles, 1e-5).unwrap();
+        assert_eq!(
+            planes(&uniform.input),
+            [
+                "w_floor all zplane 0.00000000000000000e0 NULL",
+                "w_back all xplane 0.00000000000000000e0 NULL",
+                "w_gate all xplane NULL 1.00000000000000006e-1",
+                "w_end all xplane NULL 5.00000000000000000e-1",
+            ]
+        );
+        assert_eq!(
+            planes(&tables.input),
+            [
+                "w_floor_1 grains_1 zplane 0.00000000000000000e0 NULL",
+                "w_floor_2 grains_2 zplane 0.00000000000000000e0 NULL",
+                "w_back_1 grains_1 xplane 0.00000000000000000e0 NULL",
+                "w_back_2 grains_2 xplane 0.00000000000000000e0 NULL",
+                "w_gate_1 grains_1 xplane NULL 4.00000000000000008e-2",
+                "w_gate_2 grains_2 xplane NULL 4.00000000000000008e-2",
+                "w_end_1 grains_1 xplane NULL 1.49999999999999994e-1",
+                "w_end_2 grains_2 xplane NULL 1.49999999999999994e-1",
+            ]
+        );
+    }
+
     #[test]
     fn tsuji_q_matches_the_mapping_table() {
         // reference/MAPPING.md, from hertz_mapping.py.
