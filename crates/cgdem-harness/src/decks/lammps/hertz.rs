@@ -24,8 +24,8 @@ use std::fmt::Write as _;
 use super::bodies::body_lines;
 use super::coefficients::{rolling_stiffness, tangential_damping_ratio, tsuji_q_of};
 use super::tables::{table_pair_lines, wall_fixes, WallGroup};
-use super::{removal_pads, DIALECT};
-use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use super::{plane_args, removal_pads, DIALECT};
+use crate::decks::hertz::{hertz_settings, material, wall_material, HERTZ_COLUMNS};
 use crate::decks::lines::{
     block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
@@ -261,18 +261,11 @@ fn wall_model(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, D
 fn wall_fix_lines(scene: &Scene, wall_model: &str) -> Result<String, DeckError> {
     let mut lines = String::new();
     for wall in &scene.walls {
-        let (axis, up) = wall_axis(scene, wall)?;
-        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
-        let (lo, hi) = if up {
-            (at, "NULL".to_string())
-        } else {
-            ("NULL".to_string(), at)
-        };
         let _ = writeln!(
             lines,
-            "fix             w_{} all wall/gran granular {wall_model} {}plane {lo} {hi}",
+            "fix             w_{} all wall/gran granular {wall_model} {}",
             wall.name,
-            ["x", "y", "z"][axis]
+            plane_args(scene, wall)?
         );
     }
     Ok(lines)
