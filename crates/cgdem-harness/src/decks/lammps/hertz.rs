@@ -24,8 +24,8 @@ use std::fmt::Write as _;
 use super::bodies::body_lines;
 use super::coefficients::{rolling_stiffness, tangential_damping_ratio, tsuji_q_of};
 use super::tables::{table_pair_lines, wall_fixes, WallGroup};
-use super::{removal_pads, DIALECT};
-use crate::decks::hertz::{hertz_settings, material, wall_axis, wall_material, HERTZ_COLUMNS};
+use super::{plane_args, removal_pads, DIALECT};
+use crate::decks::hertz::{hertz_settings, material, wall_material, HERTZ_COLUMNS};
 use crate::decks::lines::{
     block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
@@ -261,18 +261,11 @@ fn wall_model(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, D
 fn wall_fix_lines(scene: &Scene, wall_model: &str) -> Result<String, DeckError> {
     let mut lines = String::new();
     for wall in &scene.walls {
-        let (axis, up) = wall_axis(scene, wall)?;
-        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
-        let (lo, hi) = if up {
-            (at, "NULL".to_string())
-        } else {
-            ("NULL".to_string(), at)
-        };
         let _ = writeln!(
             lines,
-            "fix             w_{} all wall/gran granular {wall_model} {}plane {lo} {hi}",
+            "fix             w_{} all wall/gran granular {wall_model} {}",
             wall.name,
-            ["x", "y", "z"][axis]
+            plane_args(scene, wall)?
         );
     }
     Ok(lines)
@@ -623,6 +616,53 @@ mod tests {
         at(d, "unfix           w_gate_1\nunfix           w_gate_2\n");
         at(d, "fix             pad_1 all addforce 0.0 0.0 0.0");
         assert!(!d.contains("pad_2"));
+    }
+
+    /// The planar walls' fixes, with one material and with material tables (their names,
+    /// groups and `Xplane lo hi`), as written before the two writers shared the bounds: a
+    /// wall facing +x or +z bounds from below (`lo NULL`), one facing -x from above.
+    #[test]
+    fn planar_wall_fixes_keep_their_planes_with_one_material_and_with_tables() {
+        crate::at_repo_root();
+        let planes = |d: &str| -> Vec<String> {
+            d.lines()
+                .filter(|l| l.starts_with("fix ") && l.contains(" wall/gran granular "))
+                .map(|l| {
+                    let w: Vec<&str> = l.split_whitespace().collect();
+                    [&w[1..3], &w[w.len() - 3..]].concat().join(" ")
+                })
+                .collect()
+        };
+        let (scene, particles) = collapse_scene_and_particle();
+        let uniform = write_hertz_deck(&scene, &particles, 5e-5).unwrap();
+        let scene = Scene::load(std::path::Path::new(
+            "tests/data/tiny_two_material_collapse.toml",
+        ))
+        .unwrap();
+        let particles = cgdem_core::run::initial_particles_clear_of_bodies(&scene).unwrap();
+        let tables = write_hertz_deck(&scene, &particles, 1e-5).unwrap();
+        assert_eq!(
+            planes(&uniform.input),
+            [
+                "w_floor all zplane 0.00000000000000000e0 NULL",
+                "w_back all xplane 0.00000000000000000e0 NULL",
+                "w_gate all xplane NULL 1.00000000000000006e-1",
+                "w_end all xplane NULL 5.00000000000000000e-1",
+            ]
+        );
+        assert_eq!(
+            planes(&tables.input),
+            [
+                "w_floor_1 grains_1 zplane 0.00000000000000000e0 NULL",
+                "w_floor_2 grains_2 zplane 0.00000000000000000e0 NULL",
+                "w_back_1 grains_1 xplane 0.00000000000000000e0 NULL",
+                "w_back_2 grains_2 xplane 0.00000000000000000e0 NULL",
+                "w_gate_1 grains_1 xplane NULL 4.00000000000000008e-2",
+                "w_gate_2 grains_2 xplane NULL 4.00000000000000008e-2",
+                "w_end_1 grains_1 xplane NULL 1.49999999999999994e-1",
+                "w_end_2 grains_2 xplane NULL 1.49999999999999994e-1",
+            ]
+        );
     }
 
     #[test]

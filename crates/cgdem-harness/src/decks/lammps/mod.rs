@@ -15,11 +15,13 @@ pub use wca::write_wca_deck;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::hertz::wall_axis;
+use super::lines::g;
 use super::{Deck, DeckError, Dialect, RunStatus, RunnerOptions};
 use crate::code::Code;
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
-use cgdem_core::scene::{ContactSettings, Scene};
+use cgdem_core::scene::{ContactSettings, Scene, WallSettings};
 
 /// LAMMPS's words: `atom_style sphere`, `comm_modify vel yes`, the neighbour list checked
 /// every step; `lmp`, `log.lammps`.
@@ -68,4 +70,18 @@ pub(crate) fn removal_pads(scene: &Scene, fixes_per_wall: usize) -> String {
         let _ = writeln!(d, "fix             pad_{k} all addforce 0.0 0.0 0.0");
     }
     d
+}
+
+/// The `Xplane lo hi` that ends a planar wall's `fix wall/gran`: the particles are on the
+/// side the normal points to, so a wall facing +axis bounds them from below (`lo NULL`),
+/// one facing -axis from above (`NULL hi`).
+fn plane_args(scene: &Scene, wall: &WallSettings) -> Result<String, DeckError> {
+    let (axis, up) = wall_axis(scene, wall)?;
+    let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
+    let (lo, hi) = if up {
+        (at.as_str(), "NULL")
+    } else {
+        ("NULL", at.as_str())
+    };
+    Ok(format!("{}plane {lo} {hi}", ["x", "y", "z"][axis]))
 }

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::coefficients::{rolling_args, tangential_damping_ratio, tsuji_q_of};
-use crate::decks::hertz::wall_axis;
+use super::plane_args;
 use crate::decks::lines::g;
 use crate::decks::DeckError;
 use cgdem_core::math::Real;
@@ -129,13 +129,7 @@ fn table_wall_fix_lines(
         let _ = writeln!(lines, "group           {} type {}", w.group, a + 1);
     }
     for wall in &scene.walls {
-        let (axis, up) = wall_axis(scene, wall)?;
-        let at = g([wall.point.x, wall.point.y, wall.point.z][axis]);
-        let (lo, hi) = if up {
-            (at, "NULL".to_string())
-        } else {
-            ("NULL".to_string(), at)
-        };
+        let plane = plane_args(scene, wall)?;
         for w in groups {
             let a = w.species.expect("a table wall group names its species");
             let k = wall.material;
@@ -144,7 +138,7 @@ fn table_wall_fix_lines(
             let p = t.wall_pair(a, k);
             let _ = writeln!(
                 lines,
-                "fix             w_{}{} {} wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {}plane {lo} {hi}",
+                "fix             w_{}{} {} wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {plane}",
                 wall.name,
                 w.suffix,
                 w.group,
@@ -154,8 +148,7 @@ fn table_wall_fix_lines(
                 g(8.0 * g_eff),
                 g(tangential_damping_ratio(y, g_eff)),
                 g(p.friction),
-                rolling_args(h, p, y, g_eff, s.radius(), s.mass()),
-                ["x", "y", "z"][axis]
+                rolling_args(h, p, y, g_eff, s.radius(), s.mass())
             );
         }
     }
