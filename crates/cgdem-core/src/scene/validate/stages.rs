@@ -4,7 +4,8 @@ use super::super::raw::*;
 use super::super::*;
 use super::{names, Checker};
 
-/// `[[stage]]`: at least one; each ends after a duration or once the bed has settled.
+/// `[[stage]]`: at least one, names unique; each ends after a duration or once the bed has
+/// settled.
 pub(super) fn stages(
     c: &Checker,
     raw: &[RawStage],
@@ -15,6 +16,14 @@ pub(super) fn stages(
     }
     let mut stages = Vec::new();
     for (k, s) in raw.iter().enumerate() {
+        // Measurements and outputs name a stage: two of one name would be measured twice.
+        if stages.iter().any(|x: &Stage| x.name == s.name) {
+            return Err(c.invalid(
+                format!("stage[{k}].name"),
+                &s.name,
+                "a name not used by another stage",
+            ));
+        }
         for name in &s.remove_walls {
             c.one_of(
                 format!("stage[{k}].remove_walls"),
