@@ -16,7 +16,7 @@ pub(super) struct AdviseArgs {
     /// report (e.g. aor_hertz-fidelity).
     case: String,
     /// repose_angle (deg), profile, mass_flow, mass_flow_eq7, t_half, front_history,
-    /// pore_size (relative) or porosity (absolute).
+    /// pore_size, discharge_rate (relative) or porosity (absolute).
     #[arg(long)]
     quantity: String,
     /// The largest error allowed, in the quantity's unit (e.g. 2 for 2 deg, 0.05 for 5%).

@@ -280,7 +280,7 @@ fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError
         keep_going: c.keep_going,
         discharge: c
             .discharge
-            .map(|d| crate::silo::parse_discharge(d, k, path))
+            .map(|d| crate::silo::parse_discharge(d, &format!("case[{k}]"), path))
             .transpose()?,
     })
 }

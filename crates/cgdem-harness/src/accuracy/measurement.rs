@@ -76,6 +76,25 @@ pub struct AccuracyPoint {
     /// and the reference run's (same seed) have covered ([`front_history_gap`]).
     #[serde(default)]
     pub front_error: Option<f64>,
+    /// A silo's discharge rate, kg/s (mass: a parcel counts lambda^3 grains), over the
+    /// sweep's window, with its block standard error (`crate::silo::discharge_rate`).
+    #[serde(default)]
+    pub discharge_rate_kg_s: Option<f64>,
+    #[serde(default)]
+    pub discharge_rate_std_error_kg_s: Option<f64>,
+    /// |Q / Q of the reference run with the same seed - 1|.
+    #[serde(default)]
+    pub discharge_rate_error: Option<f64>,
+    /// The fill's bulk density when the gate opened, kg/m3 (Beverloo's rho_b).
+    #[serde(default)]
+    pub bulk_density_kg_m3: Option<f64>,
+    /// The run's particle (parcel) diameter, m.
+    #[serde(default)]
+    pub particle_diameter_m: Option<f64>,
+    /// When the discharge stopped (s after the gate opened): no grain left over the last
+    /// two blocks of the window, an arch over the orifice (a clog).
+    #[serde(default)]
+    pub flow_stopped_at_s: Option<f64>,
 }
 
 impl AccuracyPoint {
@@ -90,6 +109,7 @@ impl AccuracyPoint {
             porosity_error: None,
             pore_size_error: None,
             front_error: None,
+            discharge_rate_error: None,
             ..self.clone()
         }
     }
@@ -134,10 +154,11 @@ pub enum Measure {
     Front,
     Porosity,
     PoreSize,
+    DischargeRate,
 }
 
 impl Measure {
-    pub const ALL: [Measure; 8] = [
+    pub const ALL: [Measure; 9] = [
         Measure::Angle,
         Measure::Profile,
         Measure::MassFlow,
@@ -146,6 +167,7 @@ impl Measure {
         Measure::Front,
         Measure::Porosity,
         Measure::PoreSize,
+        Measure::DischargeRate,
     ];
 
     /// The run's error under this measure.
@@ -159,6 +181,7 @@ impl Measure {
             Measure::Front => p.front_error,
             Measure::Porosity => p.porosity_error,
             Measure::PoreSize => p.pore_size_error,
+            Measure::DischargeRate => p.discharge_rate_error,
         }
     }
 
@@ -173,6 +196,7 @@ impl Measure {
             Measure::Front => "front_history",
             Measure::Porosity => "porosity",
             Measure::PoreSize => "pore_size",
+            Measure::DischargeRate => "discharge_rate",
         }
     }
 
@@ -190,6 +214,7 @@ impl Measure {
             Measure::Front => "front history vs reference",
             Measure::Porosity => "porosity vs reference",
             Measure::PoreSize => "pore size (in diameters) vs reference",
+            Measure::DischargeRate => "discharge rate vs reference",
         }
     }
 
@@ -203,6 +228,7 @@ impl Measure {
             Measure::Front => "front_error",
             Measure::Porosity => "porosity_error",
             Measure::PoreSize => "pore_size_error",
+            Measure::DischargeRate => "discharge_rate_error",
         }
     }
 
@@ -216,6 +242,7 @@ impl Measure {
             Measure::Front => "largest gap in run-out covered [-]",
             Measure::Porosity => "|porosity - reference| [-]",
             Measure::PoreSize => "|pore diameter / d over the reference's - 1| [-]",
+            Measure::DischargeRate => "|W / W_reference - 1| (discharge rate) [-]",
         }
     }
 
@@ -228,6 +255,7 @@ impl Measure {
             Measure::Front => t.front,
             Measure::Porosity => t.porosity,
             Measure::PoreSize => t.pore_size,
+            Measure::DischargeRate => t.discharge_rate,
         }
     }
 
@@ -346,6 +374,7 @@ pub(crate) fn measure(points: &mut [AccuracyPoint]) {
         p.front_error = difference(Measure::Front, p, r);
         p.porosity_error = difference(Measure::Porosity, p, r);
         p.pore_size_error = difference(Measure::PoreSize, p, r);
+        p.discharge_rate_error = difference(Measure::DischargeRate, p, r);
     }
 }
 
@@ -388,6 +417,9 @@ fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
         }
         Measure::Porosity => finite((p.porosity? - r.porosity?).abs()),
         Measure::PoreSize => finite((p.pore_diameter_d? / r.pore_diameter_d? - 1.0).abs()),
+        Measure::DischargeRate => {
+            finite((p.discharge_rate_kg_s? / r.discharge_rate_kg_s? - 1.0).abs())
+        }
     }
 }
 

@@ -16,8 +16,13 @@
 //!
 //! Its phases, one file each: `suite` (the `[[accuracy]]` entry), `runs` (every setting
 //! with every seed and code), `measurement` (errors, means over seeds, the cheapest setting)
-//! and `report` (the subsection, its figures, `points.csv` and the coarse-graining matrix).
+//! and `report` (the subsection, its figures, `points.csv` and the coarse-graining matrix);
+//! `discharge` measures and reports a silo's discharge rate (a sweep with a `discharge`
+//! table).
 
+mod discharge;
+#[cfg(test)]
+mod discharge_tests;
 mod measurement;
 mod report;
 mod runs;

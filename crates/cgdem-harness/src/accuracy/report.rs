@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::discharge::write_discharge_table;
 use super::measurement::candidates;
 use super::{
     cheapest_setting, measure_named, pareto_front, settings, AccuracyPoint, AccuracySweep,
@@ -47,6 +48,9 @@ pub(crate) fn write_sweep_section(
     sub.table(cheapest_table(&cheapest));
     if sweep.series.iter().any(|s| s.knob == Knob::Lambda) {
         write_matrix(sub, case, &measures, &sweep.targets, points, dir)?;
+    }
+    if let Some(discharge) = &sweep.discharge {
+        write_discharge_table(sub, discharge, points, dir)?;
     }
     sub.table(table);
     Ok(cheapest)
@@ -116,7 +120,11 @@ fn points_table(points: &[AccuracyPoint], measures: &[Measure]) -> Table {
             (Some(a), _, _) => format!("{a:.2} deg"),
             (_, Some(q), _) => format!("{q:.3} kg/s"),
             (_, _, Some(e)) => format!("porosity {e:.4}"),
-            _ => "-".into(),
+            _ => match (p.discharge_rate_kg_s, p.flow_stopped_at_s) {
+                (Some(w), None) => format!("discharge {w:.4} kg/s"),
+                (Some(w), Some(t)) => format!("discharge {w:.4} kg/s, stopped at {t:.2} s"),
+                _ => "-".into(),
+            },
         };
         table.row(
             [
@@ -171,6 +179,12 @@ fn points_csv(points: &[AccuracyPoint]) -> CsvBuffer {
         "pore_diameter_d",
         "pore_size_error",
         "front_error",
+        "discharge_rate_kg_s",
+        "discharge_rate_std_error_kg_s",
+        "discharge_rate_error",
+        "bulk_density_kg_m3",
+        "particle_diameter_m",
+        "flow_stopped_at_s",
     ]);
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
@@ -203,6 +217,12 @@ fn points_csv(points: &[AccuracyPoint]) -> CsvBuffer {
             o(p.pore_diameter_d),
             o(p.pore_size_error),
             o(p.front_error),
+            o(p.discharge_rate_kg_s),
+            o(p.discharge_rate_std_error_kg_s),
+            o(p.discharge_rate_error),
+            o(p.bulk_density_kg_m3),
+            o(p.particle_diameter_m),
+            o(p.flow_stopped_at_s),
         ]);
     }
     csv

@@ -4,10 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
+use super::discharge::measure_discharge;
 use super::{AccuracyPoint, AccuracySweep, Knob, KnobSeries};
 use crate::code::Code;
 use crate::dynamics::FlowSeries;
 use crate::runs::{run_concurrently, run_one, Outcome, ValidateError, ValidateOptions};
+use crate::silo::DischargeSettings;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::Scene;
 
@@ -173,7 +175,11 @@ pub(crate) fn run_sweep(
     }
     let points = run_concurrently(&runs, options.jobs, |run| {
         let point = run_point(
-            &run.scene, run.code, run.lambda, run.rule, run.seed, &run.dir, options,
+            &run.scene,
+            (run.code, run.lambda, run.rule, run.seed),
+            &run.dir,
+            sweep.discharge.as_ref(),
+            options,
         );
         let p = AccuracyPoint {
             case: case.clone(),
@@ -200,14 +206,13 @@ pub(crate) fn run_sweep(
     Ok(points)
 }
 
-/// Runs one point (or reuses it) and reads what it measured.
+/// Runs one point (or reuses it) and reads what it measured; with `discharge`, the run is
+/// measured as a silo's discharge.
 fn run_point(
     scene: &Scene,
-    code: Code,
-    lambda: u32,
-    rule: CoarseGrainRule,
-    seed: u64,
+    (code, lambda, rule, seed): (Code, u32, CoarseGrainRule, u64),
     dir: &Path,
+    discharge: Option<&DischargeSettings>,
     options: &ValidateOptions,
 ) -> AccuracyPoint {
     let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
@@ -222,6 +227,7 @@ fn run_point(
     // A run that lost particles (LIGGGHTS and LAMMPS drop atoms that leave the box) may end
     // without a heap or a flow to measure.
     if record.status == Outcome::Ok
+        && discharge.is_none()
         && record.repose_angle_deg.is_none()
         && summary["conveying"]["mass_flow_kg_s"].as_f64().is_none()
         && summary["packing"]["porosity"].as_f64().is_none()
@@ -241,7 +247,8 @@ fn run_point(
     let particle_steps = summary["particle_steps"]
         .as_f64()
         .or_else(|| Some(record.n_particles? as f64 * record.steps? as f64));
-    AccuracyPoint {
+    let measured = record.clone();
+    let mut point = AccuracyPoint {
         case: record.case,
         code,
         series: String::new(),
@@ -286,5 +293,18 @@ fn run_point(
             .map(|pore| pore / (scene.max_diameter() * lambda as f64))
             .filter(|v| ok && v.is_finite() && *v > 0.0),
         pore_size_error: None,
+        discharge_rate_kg_s: None,
+        discharge_rate_std_error_kg_s: None,
+        discharge_rate_error: None,
+        bulk_density_kg_m3: None,
+        particle_diameter_m: None,
+        flow_stopped_at_s: None,
+    };
+    if let Some(d) = discharge.filter(|_| ok) {
+        if let Err(problem) = measure_discharge(scene, d, &measured, &mut point) {
+            point.status = Outcome::Failed;
+            point.reason = Some(format!("measured no discharge: {problem}"));
+        }
     }
+    point
 }

@@ -83,6 +83,8 @@ pub struct Targets {
     pub porosity: f64,
     /// Relative difference of the mean pore diameter in particle diameters.
     pub pore_size: f64,
+    /// Relative discharge-rate error (a silo's, against the reference run).
+    pub discharge_rate: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -99,6 +101,9 @@ pub struct AccuracySweep {
     pub reference: BTreeMap<Knob, f64>,
     pub series: Vec<KnobSeries>,
     pub targets: Targets,
+    /// How each run is measured as a discharge (`discharge`, as a suite case's): the silo's
+    /// rate, as mass, against the reference's.
+    pub discharge: Option<crate::silo::DischargeSettings>,
 }
 
 #[derive(Deserialize)]
@@ -119,6 +124,8 @@ pub(crate) struct RawSweep {
     front_target: Option<f64>,
     porosity_target: Option<f64>,
     pore_size_target: Option<f64>,
+    discharge_rate_target: Option<f64>,
+    discharge: Option<crate::silo::RawDischarge>,
 }
 
 #[derive(Deserialize)]
@@ -162,6 +169,7 @@ fn parse_targets(raw: &RawSweep, k: usize, path: &Path) -> Result<Targets, Suite
         front: target("front_target", raw.front_target, 0.1)?,
         porosity: target("porosity_target", raw.porosity_target, 0.02)?,
         pore_size: target("pore_size_target", raw.pore_size_target, 0.1)?,
+        discharge_rate: target("discharge_rate_target", raw.discharge_rate_target, 0.05)?,
     })
 }
 
@@ -264,6 +272,10 @@ impl AccuracySweep {
             ));
         }
         let targets = parse_targets(&raw, k, path)?;
+        let discharge = raw
+            .discharge
+            .map(|d| crate::silo::parse_discharge(d, &format!("accuracy[{k}]"), path))
+            .transpose()?;
         Ok(AccuracySweep {
             file: raw.file,
             overrides,
@@ -273,6 +285,7 @@ impl AccuracySweep {
             reference,
             series,
             targets,
+            discharge,
         })
     }
 

@@ -78,6 +78,12 @@ pub(crate) fn run(
         pore_size_error: None,
         flow_stage: None,
         front_error: None,
+        discharge_rate_kg_s: None,
+        discharge_rate_std_error_kg_s: None,
+        discharge_rate_error: None,
+        bulk_density_kg_m3: None,
+        particle_diameter_m: None,
+        flow_stopped_at_s: None,
     }
 }
 
@@ -137,6 +143,7 @@ fn errors_pair_runs_by_seed_and_settings_average_over_seeds() {
         front: 0.1,
         porosity: 0.02,
         pore_size: 0.1,
+        discharge_rate: 0.05,
     };
     let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &targets, &points);
     assert_eq!(c.setting, None);

@@ -89,6 +89,18 @@ pub fn discharge_series(
     Ok(series)
 }
 
+/// When the flow stopped: the time of the last change of the discharged mass, when nothing
+/// left over at least `quiet_s` before the series' end (an arch over the orifice that held:
+/// a clog, a measured result); None while grains still leave.
+pub fn flow_stopped_at(series: &DischargeSeries, quiet_s: f64) -> Option<f64> {
+    let end = *series.time_s.last()?;
+    let last_mass = *series.mass_kg.last()?;
+    let k = series.mass_kg.iter().rposition(|&m| m != last_mass);
+    // The mass holds from the sample after the last change (the stage start if none).
+    let since = k.map_or(0.0, |k| series.time_s[k + 1]);
+    (end - since >= quiet_s - 1e-9).then_some(since)
+}
+
 /// Least-squares slope and intercept of `y` against `x` (at least two distinct x).
 fn line_fit(x: &[f64], y: &[f64]) -> Option<(f64, f64)> {
     let n = x.len() as f64;

@@ -11,9 +11,10 @@ mod tests;
 
 pub use measurement::{
     beverloo_c, beverloo_rate, bulk_density, combined_c, data_bulk_density, discharge_rate,
-    discharge_series, dump_bulk_density, fit_c_and_k, DischargeRate, DischargeSeries, PUBLISHED_C,
-    PUBLISHED_K, STANDARD_GRAVITY,
+    discharge_series, dump_bulk_density, fit_c_and_k, flow_stopped_at, DischargeRate,
+    DischargeSeries, PUBLISHED_C, PUBLISHED_K, STANDARD_GRAVITY,
 };
+pub(crate) use report::measure_one;
 pub use report::{measure_runs, write_silo_overview, write_silo_section, SiloRun};
 
 use std::path::Path;
@@ -49,15 +50,15 @@ pub(crate) struct RawDischarge {
     bulk_hi: [f64; 3],
 }
 
-/// `[case.discharge]` of `[[case]]` number `k`, checked.
+/// The `discharge` table of the suite entry `entry` (`case[0]`, `accuracy[2]`), checked.
 pub(crate) fn parse_discharge(
     raw: RawDischarge,
-    k: usize,
+    entry: &str,
     path: &Path,
 ) -> Result<DischargeSettings, SuiteError> {
     let invalid = |field: &str, value: String, allowed: &str| SuiteError::Invalid {
         file: path.to_path_buf(),
-        field: format!("case[{k}].discharge.{field}"),
+        field: format!("{entry}.discharge.{field}"),
         value,
         allowed: allowed.into(),
     };

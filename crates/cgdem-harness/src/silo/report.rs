@@ -40,8 +40,10 @@ pub struct SiloRun {
     pub problem: Option<String>,
 }
 
-/// Reads a run's summary and measures it; `Err` says why it cannot be.
-fn measure_one(
+/// Reads a run's summary and measures it (the mass of the run's own particles: a parcel at
+/// lambda carries lambda^3 grains' mass); `Err` says why it cannot be. Also returns the
+/// step at which the gate opened.
+pub(crate) fn measure_one(
     scene: &Scene,
     settings: &DischargeSettings,
     r: &RunRecord,
