@@ -126,12 +126,13 @@ struct RawKnownDifference {
 }
 
 /// The criteria a comparison is judged by (`verdict::Criterion::name`).
-pub const CRITERIA: [&str; 5] = [
+pub const CRITERIA: [&str; 6] = [
     "repose angle",
     "t_half ratio",
     "front gap",
     "wall height gap",
     "kinetic energy gap",
+    crate::silo::CRITERION,
 ];
 
 impl Suite {
@@ -299,7 +300,7 @@ fn parse_known_difference(
         return Err(invalid(
             field("criterion"),
             format!("\"{}\"", kd.criterion),
-            "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\"",
+            "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\", \"discharge rate\" (a silo case)",
         ));
     }
     if !(kd.band[0].is_finite() && kd.band[1].is_finite() && kd.band[0] <= kd.band[1]) {

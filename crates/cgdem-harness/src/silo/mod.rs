@@ -8,6 +8,7 @@ mod measurement;
 mod report;
 #[cfg(test)]
 mod tests;
+mod verdict;
 
 pub use measurement::{
     beverloo_c, beverloo_rate, bulk_density, combined_c, data_bulk_density, discharge_rate,
@@ -16,6 +17,7 @@ pub use measurement::{
 };
 pub(crate) use report::measure_one;
 pub use report::{measure_runs, write_silo_overview, write_silo_section, SiloRun};
+pub use verdict::{cgdem_verdict, rate_comparison, RateVerdict, COMPARISON, CRITERION};
 
 use std::path::Path;
 

@@ -15,6 +15,8 @@ use super::DischargeSettings;
 use crate::code::Code;
 use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
 use crate::runs::{output_error, Outcome, RunRecord, ValidateError};
+use crate::validation::Comparison;
+use crate::verdict::Verdict;
 use cgdem_core::coarse_graining::coarse_grain_by;
 use cgdem_core::io::write_atomic;
 use cgdem_core::output_format::RunSummary;
@@ -200,59 +202,6 @@ pub fn measure_runs(
     out
 }
 
-/// cgdem's verdict on one case: its rate within the reference codes' spread widened by two
-/// standard errors on each side, or within two combined standard errors of the one
-/// reference code that ran. None without a cgdem or a reference rate.
-pub fn cgdem_verdict(runs: &[SiloRun]) -> Option<(bool, String)> {
-    let rates = |code: Code| -> Vec<&DischargeRate> {
-        runs.iter()
-            .filter(|s| s.code == code)
-            .filter_map(|s| s.rate.as_ref())
-            .collect()
-    };
-    let mean = |r: &[&DischargeRate]| -> Option<(f64, f64)> {
-        (!r.is_empty()).then(|| {
-            let n = r.len() as f64;
-            let m = r.iter().map(|x| x.rate_kg_s).sum::<f64>() / n;
-            let se = r
-                .iter()
-                .map(|x| x.std_error_kg_s.powi(2))
-                .sum::<f64>()
-                .sqrt()
-                / n;
-            (m, se)
-        })
-    };
-    let (cg, cg_se) = mean(&rates(Code::Cgdem))?;
-    let refs: Vec<(Code, f64, f64)> = [Code::Liggghts, Code::Lammps]
-        .iter()
-        .filter_map(|&c| mean(&rates(c)).map(|(m, se)| (c, m, se)))
-        .collect();
-    if refs.is_empty() {
-        return None;
-    }
-    let lo = refs
-        .iter()
-        .map(|r| r.1 - 2.0 * r.2)
-        .fold(f64::INFINITY, f64::min);
-    let hi = refs
-        .iter()
-        .map(|r| r.1 + 2.0 * r.2)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let ok = cg + 2.0 * cg_se >= lo && cg - 2.0 * cg_se <= hi;
-    let mut text = format!("cgdem {cg:.4} +- {cg_se:.4} kg/s");
-    for (c, m, se) in &refs {
-        let z = (cg - m) / (cg_se * cg_se + se * se).sqrt();
-        let _ = write!(text, "; {} {m:.4} +- {se:.4} kg/s ({z:+.1} SE)", c.name());
-    }
-    let _ = write!(
-        text,
-        "; reference spread with 2 SE {lo:.4} .. {hi:.4} kg/s: cgdem {}",
-        if ok { "within" } else { "outside" }
-    );
-    Some((ok, text))
-}
-
 fn num(v: Option<f64>, digits: usize) -> Cell {
     Cell::num(v.map_or("-".into(), |x| format!("{x:.digits$}")))
 }
@@ -264,6 +213,7 @@ pub fn write_silo_section(
     (file, seeds): (&Path, &[u64]),
     settings: &DischargeSettings,
     runs: &[SiloRun],
+    verdict: Option<&Comparison>,
     out: &Path,
 ) -> Result<(), ValidateError> {
     let dir = out.join("figures").join(&scene.name);
@@ -281,15 +231,13 @@ pub fn write_silo_section(
         settings.bulk_lo,
         settings.bulk_hi,
     ));
-    if let Some((ok, text)) = cgdem_verdict(runs) {
-        section.banner(
-            if ok {
-                crate::report::Status::Pass
-            } else {
-                crate::report::Status::Fail
-            },
-            format!("Discharge rate: {text}."),
-        );
+    if let Some(c) = verdict {
+        let status = match c.verdict {
+            Verdict::Pass => crate::report::Status::Pass,
+            Verdict::KnownDifference => crate::report::Status::Known,
+            Verdict::Fail => crate::report::Status::Fail,
+        };
+        section.banner(status, format!("Discharge rate: {}.", c.detail));
     }
     let mut figure = Figure::new(
         format!("{}: mass discharged against time", scene.name),

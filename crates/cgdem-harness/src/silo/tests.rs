@@ -201,3 +201,65 @@ fn cgdems_bulk_density_comes_from_the_data_file_it_writes_at_the_fills_end() {
     assert!(e.unwrap_err().contains("none.data"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A measured run of `code` with `rate` +- `se` kg/s.
+fn measured(code: crate::code::Code, rate: f64, se: f64) -> SiloRun {
+    SiloRun {
+        code,
+        lambda: 1,
+        seed: 1,
+        dir: std::path::PathBuf::new(),
+        grain_diameter_m: 0.004,
+        series: None,
+        rate: Some(DischargeRate {
+            rate_kg_s: rate,
+            std_error_kg_s: se,
+            window_s: [0.1, 0.6],
+            block_rates_kg_s: vec![rate; 5],
+            drift_kg_s: 0.0,
+            drifts: false,
+        }),
+        bulk_density: None,
+        c_fixed_k: None,
+        problem: None,
+    }
+}
+
+#[test]
+fn cgdem_outside_the_reference_codes_spread_is_a_failed_comparison_unless_declared() {
+    use crate::code::Code::{Cgdem, Lammps, Liggghts};
+    use crate::verdict::{KnownDifference, Verdict};
+    // The reduced suite's 60 mm rates (reports/silo/NOTE.md): within.
+    let within = [
+        measured(Cgdem, 2.0116, 0.0122),
+        measured(Liggghts, 2.0110, 0.0197),
+        measured(Lammps, 1.9951, 0.0142),
+    ];
+    let c = rate_comparison("silo_reduced-d60", &within, &[]).unwrap();
+    assert_eq!((c.verdict, c.difference), (Verdict::Pass, 0.0), "{c:?}");
+    // Its 40 mm rates: cgdem 0.6773 - 2 x 0.0022 = 0.6729 above the spread's top, LAMMPS's
+    // 0.6597 + 2 x 0.0044 = 0.6685, by 0.0044 kg/s of the reference codes' mean 0.65325.
+    let outside = [
+        measured(Cgdem, 0.6773, 0.0022),
+        measured(Liggghts, 0.6468, 0.0058),
+        measured(Lammps, 0.6597, 0.0044),
+    ];
+    let c = rate_comparison("silo_reduced", &outside, &[]).unwrap();
+    assert_eq!(c.verdict, Verdict::Fail);
+    assert!((c.difference - 0.0044 / 0.65325).abs() < 1e-9, "{c:?}");
+    assert!(c.detail.contains("outside"), "{}", c.detail);
+    // A declared difference holds it in its band (amber); one whose band it leaves does not.
+    let declared = |band: [f64; 2]| KnownDifference {
+        comparison: COMPARISON.into(),
+        criterion: CRITERION.into(),
+        reason: "test".into(),
+        evidence: "reports/silo/NOTE.md".into(),
+        band,
+    };
+    let c = rate_comparison("silo_reduced", &outside, &[declared([0.0, 0.01])]).unwrap();
+    assert_eq!(c.verdict, Verdict::KnownDifference);
+    let c = rate_comparison("silo_reduced", &outside, &[declared([0.0, 0.005])]).unwrap();
+    assert_eq!(c.verdict, Verdict::Fail);
+    // No reference rate: nothing to compare.
+    assert!(rate_comparison("silo_reduced", &outside[..1], &[]).is_none());
+}

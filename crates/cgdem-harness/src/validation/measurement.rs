@@ -41,7 +41,7 @@ pub struct Comparison {
 
 impl Comparison {
     /// A comparison judged by `criteria`.
-    fn judged(
+    pub(crate) fn judged(
         case: &str,
         kind: &str,
         part: &str,

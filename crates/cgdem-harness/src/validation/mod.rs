@@ -146,15 +146,19 @@ fn run_cases(
         if let Some(settings) = &case.discharge {
             let measured = silos.iter().find(|(n, _)| *n == scene.name).map(|(_, m)| m);
             let measured = measured.map_or(&[][..], |m| m.as_slice());
+            let verdict =
+                super::silo::rate_comparison(&scene.name, measured, &case.known_differences);
             super::silo::write_silo_section(
                 report,
                 &scene,
                 (&case.file, &case.seeds),
                 settings,
                 measured,
+                verdict.as_ref(),
                 &options.out,
             )?;
             runs.extend(case_runs);
+            comparisons.extend(verdict);
             continue;
         }
         if scene.conveying.is_some() {
