@@ -293,7 +293,7 @@ fn short_screw(file: &str) -> Scene {
         "body[2].cell_size=0.01",
         "insert[0].refill.interval=0.02",
         "conveying.discard=0.01",
-        "conveying.blocks=1",
+        "conveying.blocks=2",
         "output.vtk_interval=0.0",
     ];
     if !file.contains("particles") {
