@@ -17,7 +17,7 @@ pub use measurement::{
 };
 pub(crate) use report::measure_one;
 pub use report::{measure_runs, write_silo_overview, write_silo_section, SiloRun};
-pub use verdict::{cgdem_verdict, rate_comparison, RateVerdict, COMPARISON, CRITERION};
+pub use verdict::{cgdem_verdict, rate_criterion, RateVerdict, COMPARISON, CRITERION};
 
 use std::path::Path;
 

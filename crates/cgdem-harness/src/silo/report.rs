@@ -15,7 +15,6 @@ use super::DischargeSettings;
 use crate::code::Code;
 use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
 use crate::runs::{output_error, Outcome, RunRecord, ValidateError};
-use crate::validation::Comparison;
 use crate::verdict::Verdict;
 use cgdem_core::coarse_graining::coarse_grain_by;
 use cgdem_core::io::write_atomic;
@@ -213,7 +212,7 @@ pub fn write_silo_section(
     (file, seeds): (&Path, &[u64]),
     settings: &DischargeSettings,
     runs: &[SiloRun],
-    verdict: Option<&Comparison>,
+    verdict: Option<(Verdict, &str)>,
     out: &Path,
 ) -> Result<(), ValidateError> {
     let dir = out.join("figures").join(&scene.name);
@@ -231,13 +230,13 @@ pub fn write_silo_section(
         settings.bulk_lo,
         settings.bulk_hi,
     ));
-    if let Some(c) = verdict {
-        let status = match c.verdict {
+    if let Some((verdict, text)) = verdict {
+        let status = match verdict {
             Verdict::Pass => crate::report::Status::Pass,
             Verdict::KnownDifference => crate::report::Status::Known,
             Verdict::Fail => crate::report::Status::Fail,
         };
-        section.banner(status, format!("Discharge rate: {}.", c.detail));
+        section.banner(status, format!("Discharge rate: {text}."));
     }
     let mut figure = Figure::new(
         format!("{}: mass discharged against time", scene.name),

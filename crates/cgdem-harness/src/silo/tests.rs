@@ -226,7 +226,7 @@ fn measured(code: crate::code::Code, rate: f64, se: f64) -> SiloRun {
 }
 
 #[test]
-fn cgdem_outside_the_reference_codes_spread_is_a_failed_comparison_unless_declared() {
+fn cgdem_outside_the_reference_codes_spread_fails_its_criterion_unless_declared() {
     use crate::code::Code::{Cgdem, Lammps, Liggghts};
     use crate::verdict::{KnownDifference, Verdict};
     // The reduced suite's 60 mm rates (reports/silo/NOTE.md): within.
@@ -235,8 +235,8 @@ fn cgdem_outside_the_reference_codes_spread_is_a_failed_comparison_unless_declar
         measured(Liggghts, 2.0110, 0.0197),
         measured(Lammps, 1.9951, 0.0142),
     ];
-    let c = rate_comparison("silo_reduced-d60", &within, &[]).unwrap();
-    assert_eq!((c.verdict, c.difference), (Verdict::Pass, 0.0), "{c:?}");
+    let (c, _) = rate_criterion(&within, &[]).unwrap();
+    assert_eq!((c.verdict, c.value), (Verdict::Pass, 0.0), "{c:?}");
     // Its 40 mm rates: cgdem 0.6773 - 2 x 0.0022 = 0.6729 above the spread's top, LAMMPS's
     // 0.6597 + 2 x 0.0044 = 0.6685, by 0.0044 kg/s of the reference codes' mean 0.65325.
     let outside = [
@@ -244,10 +244,10 @@ fn cgdem_outside_the_reference_codes_spread_is_a_failed_comparison_unless_declar
         measured(Liggghts, 0.6468, 0.0058),
         measured(Lammps, 0.6597, 0.0044),
     ];
-    let c = rate_comparison("silo_reduced", &outside, &[]).unwrap();
+    let (c, text) = rate_criterion(&outside, &[]).unwrap();
     assert_eq!(c.verdict, Verdict::Fail);
-    assert!((c.difference - 0.0044 / 0.65325).abs() < 1e-9, "{c:?}");
-    assert!(c.detail.contains("outside"), "{}", c.detail);
+    assert!((c.value - 0.0044 / 0.65325).abs() < 1e-9, "{c:?}");
+    assert!(text.contains("outside"), "{text}");
     // A declared difference holds it in its band (amber); one whose band it leaves does not.
     let declared = |band: [f64; 2]| KnownDifference {
         comparison: COMPARISON.into(),
@@ -256,10 +256,10 @@ fn cgdem_outside_the_reference_codes_spread_is_a_failed_comparison_unless_declar
         evidence: "reports/silo/NOTE.md".into(),
         band,
     };
-    let c = rate_comparison("silo_reduced", &outside, &[declared([0.0, 0.01])]).unwrap();
+    let (c, _) = rate_criterion(&outside, &[declared([0.0, 0.01])]).unwrap();
     assert_eq!(c.verdict, Verdict::KnownDifference);
-    let c = rate_comparison("silo_reduced", &outside, &[declared([0.0, 0.005])]).unwrap();
+    let (c, _) = rate_criterion(&outside, &[declared([0.0, 0.005])]).unwrap();
     assert_eq!(c.verdict, Verdict::Fail);
     // No reference rate: nothing to compare.
-    assert!(rate_comparison("silo_reduced", &outside[..1], &[]).is_none());
+    assert!(rate_criterion(&outside[..1], &[]).is_none());
 }

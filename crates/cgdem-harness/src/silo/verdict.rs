@@ -8,7 +8,6 @@ use std::fmt::Write as _;
 use super::measurement::DischargeRate;
 use super::report::SiloRun;
 use crate::code::Code;
-use crate::validation::Comparison;
 use crate::verdict::{Criterion, KnownDifference};
 
 /// The comparison's and the criterion's names, as a `[[case.known_difference]]` gives them.
@@ -97,13 +96,10 @@ pub fn cgdem_verdict(runs: &[SiloRun]) -> Option<RateVerdict> {
     })
 }
 
-/// The case's comparison: passes within the spread, amber where a known difference of
-/// [`COMPARISON`] and [`CRITERION`] holds the gap in its band, red otherwise.
-pub fn rate_comparison(
-    case: &str,
-    runs: &[SiloRun],
-    known: &[KnownDifference],
-) -> Option<Comparison> {
+/// The case's criterion, with the rates in words: passes within the spread, amber where a
+/// known difference of [`COMPARISON`] and [`CRITERION`] holds the gap in its band, red
+/// otherwise (`crate::validation` makes it one of the suite's comparisons).
+pub fn rate_criterion(runs: &[SiloRun], known: &[KnownDifference]) -> Option<(Criterion, String)> {
     let v = cgdem_verdict(runs)?;
     let known = known.iter().find(|k| k.applies_to(COMPARISON, CRITERION));
     // The noise is already in the gap (each rate widened by two standard errors).
@@ -116,12 +112,5 @@ pub fn rate_comparison(
         0.0,
         known,
     );
-    Some(Comparison::judged(
-        case,
-        "codes",
-        "final state",
-        COMPARISON,
-        v.text,
-        vec![criterion],
-    ))
+    Some((criterion, v.text))
 }

@@ -146,15 +146,25 @@ fn run_cases(
         if let Some(settings) = &case.discharge {
             let measured = silos.iter().find(|(n, _)| *n == scene.name).map(|(_, m)| m);
             let measured = measured.map_or(&[][..], |m| m.as_slice());
-            let verdict =
-                super::silo::rate_comparison(&scene.name, measured, &case.known_differences);
+            let verdict = super::silo::rate_criterion(measured, &case.known_differences).map(
+                |(criterion, text)| {
+                    Comparison::judged(
+                        &scene.name,
+                        "codes",
+                        "final state",
+                        super::silo::COMPARISON,
+                        text,
+                        vec![criterion],
+                    )
+                },
+            );
             super::silo::write_silo_section(
                 report,
                 &scene,
                 (&case.file, &case.seeds),
                 settings,
                 measured,
-                verdict.as_ref(),
+                verdict.as_ref().map(|c| (c.verdict, c.detail.as_str())),
                 &options.out,
             )?;
             runs.extend(case_runs);
