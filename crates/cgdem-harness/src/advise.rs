@@ -29,6 +29,12 @@ pub enum AdviseError {
         case: String,
         known: String,
     },
+    #[error("{file}: `{case}` names several cases, one per variant: {variants}; name one of them")]
+    Ambiguous {
+        file: PathBuf,
+        case: String,
+        variants: String,
+    },
     #[error("{file}: case `{case}` has no successful fine reference run to compare with")]
     NoReference { file: PathBuf, case: String },
     #[error("{suite}: `{case}` is not one of its accuracy sweeps' cases, nor the one of them with a variant (its sweeps' cases: {known})")]
@@ -163,10 +169,11 @@ pub fn matrix_paths(matrix: &Path) -> (PathBuf, PathBuf) {
 }
 
 /// Which of `cases` the user's `case` names: itself, or the one case that is `case` with a
-/// variant (`aor_hertz` for `aor_hertz-fidelity`); None when none or several are.
-pub fn resolve_case<'a>(cases: &[&'a str], case: &str) -> Option<&'a str> {
+/// variant (`aor_hertz` for `aor_hertz-fidelity`). Otherwise the cases with a variant it
+/// names (several: ambiguous; none: unknown).
+pub fn resolve_case<'a>(cases: &[&'a str], case: &str) -> Result<&'a str, Vec<&'a str>> {
     if let Some(exact) = cases.iter().find(|&&c| c == case) {
-        return Some(exact);
+        return Ok(exact);
     }
     let mut variants: Vec<&str> = cases
         .iter()
@@ -175,7 +182,35 @@ pub fn resolve_case<'a>(cases: &[&'a str], case: &str) -> Option<&'a str> {
         .collect();
     variants.sort();
     variants.dedup();
-    (variants.len() == 1).then(|| variants[0])
+    match variants[..] {
+        [one] => Ok(one),
+        _ => Err(variants),
+    }
+}
+
+/// The error for a `case` that names none of `known` (`NotFound`'s) or several (`Ambiguous`).
+fn unresolved(
+    source: &Path,
+    case: &str,
+    variants: Vec<&str>,
+    known: &[&str],
+    not_found: impl FnOnce(String) -> AdviseError,
+) -> AdviseError {
+    if variants.len() > 1 {
+        return AdviseError::Ambiguous {
+            file: source.to_path_buf(),
+            case: case.to_string(),
+            variants: variants.join(", "),
+        };
+    }
+    let mut known = known.to_vec();
+    known.sort();
+    known.dedup();
+    not_found(if known.is_empty() {
+        "none".into()
+    } else {
+        known.join(", ")
+    })
 }
 
 /// `cgdem advise --run`: makes the accuracy sweeps of `case` in `suite` as `cgdem validate
@@ -201,19 +236,17 @@ pub fn run_case(
         names.push(name);
     }
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    let Some(name) = resolve_case(&refs, case).map(str::to_string) else {
-        let mut known = names.clone();
-        known.sort();
-        known.dedup();
-        return Err(AdviseError::NoSweep {
-            suite: suite.source.clone(),
-            case: case.to_string(),
-            known: if known.is_empty() {
-                "none".into()
-            } else {
-                known.join(", ")
-            },
-        });
+    let name = match resolve_case(&refs, case) {
+        Ok(name) => name.to_string(),
+        Err(variants) => {
+            return Err(unresolved(&suite.source, case, variants, &refs, |known| {
+                AdviseError::NoSweep {
+                    suite: suite.source.clone(),
+                    case: case.to_string(),
+                    known,
+                }
+            }))
+        }
     };
     let mine = Suite {
         cases: Vec::new(),
@@ -252,12 +285,17 @@ pub fn advise(
     let mut cases: Vec<&str> = points.iter().map(|p| p.case.as_str()).collect();
     cases.sort();
     cases.dedup();
-    let Some(name) = resolve_case(&cases, case) else {
-        return Err(AdviseError::NoCase {
-            file: file.to_path_buf(),
-            case: case.to_string(),
-            known: cases.join(", "),
-        });
+    let name = match resolve_case(&cases, case) {
+        Ok(name) => name,
+        Err(variants) => {
+            return Err(unresolved(file, case, variants, &cases, |known| {
+                AdviseError::NoCase {
+                    file: file.to_path_buf(),
+                    case: case.to_string(),
+                    known,
+                }
+            }))
+        }
     };
     let mine: Vec<AccuracyPoint> = points
         .iter()
@@ -483,6 +521,40 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("porosity") && e.contains("repose_angle"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_name_with_several_variants_asks_for_one_of_them_by_name() {
+        let mut points = matrix();
+        let more: Vec<AccuracyPoint> = points
+            .iter()
+            .map(|p| AccuracyPoint {
+                case: "aor-wide".into(),
+                ..p.clone()
+            })
+            .collect();
+        points.extend(more);
+        let e = advise(Path::new("m.json"), &points, "aor", Measure::Angle, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.json")
+                && e.contains("several")
+                && e.contains("aor-fidelity, aor-wide")
+                && !e.contains("no coarse-graining points"),
+            "{e}"
+        );
+        // Named in full, each is answered.
+        assert!(advise(
+            Path::new("m.json"),
+            &points,
+            "aor-wide",
+            Measure::Angle,
+            1.0
+        )
+        .is_ok());
+        assert_eq!(resolve_case(&["a-x", "b-y"], "a"), Ok("a-x"));
+        assert_eq!(resolve_case(&["a-x", "b-y"], "c"), Err(vec![]));
     }
 
     #[test]
