@@ -34,7 +34,8 @@ pub(super) struct BenchArgs {
     /// Skip the untimed runs to the scene's end that compare the heaps.
     #[arg(long)]
     no_outcome: bool,
-    /// Time limit of one reference-code run, seconds.
+    /// Time limit of one reference-code run: seconds of CPU time per rank (a loaded or paused
+    /// machine does not use it up), and 4 times that of wall clock (a hang).
     #[arg(long, default_value_t = 1800)]
     reference_timeout: u64,
     /// Also time cgdem on this grid (`2x1x1`, as `run --grid`), as a case CASE-gridG in

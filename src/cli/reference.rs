@@ -33,7 +33,8 @@ pub(super) struct ReferenceArgs {
     /// MPI ranks (runs `mpirun --allow-run-as-root -np N lmp|liggghts`); default: serial.
     #[arg(long)]
     np: Option<u32>,
-    /// Kill the code after this many seconds.
+    /// Kill the code after this many seconds of CPU time per rank (a loaded or paused machine
+    /// does not use it up), or 4 times that of wall clock (a hang).
     #[arg(long, default_value_t = 7200)]
     timeout: u64,
     /// Write the deck even if the time step exceeds the stable limit.
@@ -148,13 +149,17 @@ fn report(code: Code, run: ReferenceRun, out: &std::path::Path) -> Result<ExitCo
             "{name} failed (exit code {exit_code:?}) in {}; log tail:\n{log_tail}",
             out.display()
         )),
-        RunStatus::TimedOut { after_s, log_tail } => {
+        RunStatus::TimedOut {
+            after_s,
+            cpu_s,
+            log_tail,
+        } => {
             // The partial outputs are kept, with a summary that says so when it could be made.
             let partial = run.partial_error.map_or(String::new(), |e| {
                 format!(" (post-processing the partial run failed: {e})")
             });
             Err(format!(
-                "{name} killed after {after_s:.0} s (--timeout) in {}{partial}; log tail:\n{log_tail}",
+                "{name} killed after {cpu_s:.0} s of CPU per rank, {after_s:.0} s of wall clock (--timeout) in {}{partial}; log tail:\n{log_tail}",
                 out.display()
             ))
         }

@@ -23,7 +23,8 @@ pub(super) struct ValidateArgs {
     /// Worker threads for cgdem (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// Time limit of one reference-code run, seconds.
+    /// Time limit of one reference-code run: seconds of CPU time per rank (a loaded or paused
+    /// machine does not use it up), and 4 times that of wall clock (a hang).
     #[arg(long, default_value_t = 3600)]
     reference_timeout: u64,
     /// No per-run progress lines.

@@ -482,8 +482,12 @@ fn run_reference_code(
         } => Err(RunOutcome::Failed(format!(
             "{name} exit code {exit_code:?}; log tail: {log_tail}"
         ))),
-        RunStatus::TimedOut { after_s, log_tail } => Err(RunOutcome::Failed(format!(
-            "{name} timed out after {after_s:.0} s (partial outputs kept); log tail: {log_tail}"
+        RunStatus::TimedOut {
+            after_s,
+            cpu_s,
+            log_tail,
+        } => Err(RunOutcome::Failed(format!(
+            "{name} timed out after {cpu_s:.0} s of CPU per rank ({after_s:.0} s of wall clock; --reference-timeout) (partial outputs kept); log tail: {log_tail}"
         ))),
     }
 }

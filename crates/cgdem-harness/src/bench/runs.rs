@@ -184,10 +184,14 @@ fn not_completed(status: RunStatus) -> RunResult {
         } => {
             result = RunResult::failed(format!("exit code {exit_code:?}; log tail:\n{log_tail}"));
         }
-        RunStatus::TimedOut { after_s, log_tail } => {
+        RunStatus::TimedOut {
+            after_s,
+            cpu_s,
+            log_tail,
+        } => {
             result.status = "timed out".into();
             result.reason = Some(format!(
-                "killed after {after_s:.0} s; log tail:\n{log_tail}"
+                "killed after {cpu_s:.0} s of CPU per rank ({after_s:.0} s of wall clock); log tail:\n{log_tail}"
             ));
         }
     }

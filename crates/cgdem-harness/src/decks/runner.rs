@@ -23,6 +23,9 @@ pub const INSTALL_HINT: &str = "bash scripts/install-references.sh";
 pub struct RunnerOptions {
     /// MPI ranks: `Some(n)` runs `mpirun --allow-run-as-root -np n lmp ...`.
     pub np: Option<u32>,
+    /// The run is stopped when its processes have used this much CPU time per rank, or
+    /// [`WALL_BACKSTOP`] times this of wall clock (a hang that sleeps). CPU time, because a
+    /// run that shares a loaded machine, or is paused, still progresses at its CPU's pace.
     pub timeout: Duration,
     /// Raised by the command on SIGINT/SIGTERM: the run is ended (its whole tree) and reported
     /// as failed with [`INTERRUPTED`]; no run starts while it is raised.
@@ -38,6 +41,9 @@ impl Default for RunnerOptions {
         }
     }
 }
+
+/// A run is stopped at this many times its CPU-time limit of wall clock.
+pub const WALL_BACKSTOP: u32 = 4;
 
 /// How an interrupted run's failure begins (`RunStatus::Failed::log_tail`).
 pub const INTERRUPTED: &str = "interrupted (SIGINT/SIGTERM)";
@@ -66,8 +72,10 @@ pub enum RunStatus {
         exit_code: Option<i32>,
         log_tail: String,
     },
+    /// Stopped at its limit: `after_s` of wall clock, `cpu_s` of CPU time per rank.
     TimedOut {
         after_s: f64,
+        cpu_s: f64,
         log_tail: String,
     },
 }
@@ -198,7 +206,15 @@ pub fn run_command(
         Ok(child) => child,
         Err(e) => return failed(format!("cannot start `{}`: {e}", argv.join(" "))),
     };
+    let ranks = options.np.unwrap_or(1).max(1) as f64;
+    let wall_limit = options.timeout.saturating_mul(WALL_BACKSTOP);
+    // The tree's CPU time is read about once a second (a walk of /proc).
+    let (mut cpu_s, mut cpu_read) = (0.0, started);
     loop {
+        if cpu_read.elapsed() >= Duration::from_secs(1) {
+            cpu_s = tree_cpu_seconds(child.id()) / ranks;
+            cpu_read = Instant::now();
+        }
         match child.try_wait() {
             Ok(Some(status)) => {
                 let wall_s = started.elapsed().as_secs_f64();
@@ -211,10 +227,13 @@ pub fn run_command(
                     }
                 };
             }
-            Ok(None) if started.elapsed() >= options.timeout => {
+            Ok(None)
+                if cpu_s >= options.timeout.as_secs_f64() || started.elapsed() >= wall_limit =>
+            {
                 end_run_tree(&mut child);
                 return RunStatus::TimedOut {
                     after_s: started.elapsed().as_secs_f64(),
+                    cpu_s,
                     log_tail: log_tail_of(dir, log_file, 20),
                 };
             }
@@ -284,6 +303,37 @@ fn proc_stat(pid: u32) -> Option<(u32, u64, char)> {
     let ppid = fields.get(1)?.parse().ok()?;
     let start = fields.get(19)?.parse().ok()?;
     Some((ppid, start, state))
+}
+
+/// CPU time (user and system) in seconds of `root` and every living process below it; 0
+/// where /proc cannot be read. A rank that has exited no longer counts: the limit is for
+/// runs that go on.
+fn tree_cpu_seconds(root: u32) -> f64 {
+    #[cfg(unix)]
+    {
+        // SAFETY: sysconf has no preconditions.
+        let ticks = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
+        let ticks = if ticks > 0 { ticks as f64 } else { 100.0 };
+        let of = |pid: u32| -> u64 {
+            let Ok(text) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+                return 0;
+            };
+            let Some(close) = text.rfind(')') else {
+                return 0;
+            };
+            // After the name: state, ppid, ... utime and stime are the 12th and 13th.
+            let fields: Vec<&str> = text[close + 1..].split_whitespace().collect();
+            let field = |i: usize| fields.get(i).and_then(|f| f.parse::<u64>().ok());
+            field(11).unwrap_or(0) + field(12).unwrap_or(0)
+        };
+        let total = of(root) + descendants(root).iter().map(|p| of(p.pid)).sum::<u64>();
+        total as f64 / ticks
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = root;
+        0.0
+    }
 }
 
 /// Every living process below `root` (not `root` itself), by walking /proc's parent links.
@@ -401,6 +451,55 @@ mod tests {
         assert!(
             matches!(&again, RunStatus::Failed { log_tail, .. } if log_tail.ends_with("not started")),
             "{again:?}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A script standing in for a reference code (it ignores its arguments).
+    fn fake_code(dir: &Path, body: &str) -> PathBuf {
+        let program = dir.join("fake_code.sh");
+        std::fs::write(&program, format!("#!/bin/sh\n{body}\n")).unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&program, std::fs::Permissions::from_mode(0o755)).unwrap();
+        program
+    }
+
+    #[test]
+    fn the_limit_is_cpu_time_of_the_whole_tree_with_wall_clock_only_as_a_backstop() {
+        let dir = std::env::temp_dir().join(format!("cgdem_runner_cpu_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let options = RunnerOptions {
+            np: None,
+            timeout: Duration::from_secs(1),
+            stop: None,
+        };
+        // The CPU is used by a child of the script, as by mpirun's ranks.
+        let busy = fake_code(&dir, "sh -c 'while :; do :; done' & wait");
+        let status = run_program(&busy, &dir, "deck.in", "log.txt", &options);
+        let RunStatus::TimedOut { after_s, cpu_s, .. } = status else {
+            panic!("{status:?}");
+        };
+        assert!(
+            cpu_s >= 1.0 && after_s < 30.0,
+            "{cpu_s} s CPU, {after_s} s wall"
+        );
+        // Asleep (as a run paused or starved on a loaded machine) it is not stopped after a
+        // second of wall clock: it ends by itself, within the wall-clock backstop.
+        let asleep = fake_code(&dir, "sleep 2 & wait");
+        let status = run_program(&asleep, &dir, "deck.in", "log.txt", &options);
+        assert!(
+            matches!(status, RunStatus::Completed { wall_s } if wall_s >= 2.0),
+            "{status:?}"
+        );
+        // A hang that sleeps is stopped at the backstop.
+        let hang = fake_code(&dir, "sleep 30 & wait");
+        let status = run_program(&hang, &dir, "deck.in", "log.txt", &options);
+        let RunStatus::TimedOut { after_s, cpu_s, .. } = status else {
+            panic!("{status:?}");
+        };
+        assert!(
+            after_s >= WALL_BACKSTOP as f64 && after_s < 20.0 && cpu_s < 1.0,
+            "{cpu_s} s CPU, {after_s} s wall"
         );
         let _ = std::fs::remove_dir_all(&dir);
     }
