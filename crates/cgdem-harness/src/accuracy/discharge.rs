@@ -55,12 +55,10 @@ struct Level {
     stopped: Vec<(u64, f64)>,
 }
 
+/// Mean and standard error of the mean (None for one value).
 fn mean_se(v: &[f64]) -> (f64, Option<f64>) {
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let se = (v.len() > 1)
-        .then(|| (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt());
-    (mean, se)
+    let (mean, sd, n) = crate::verdict::mean_sd(v).unwrap_or((f64::NAN, 0.0, 0));
+    (mean, (n > 1).then(|| sd / (n as f64).sqrt()))
 }
 
 fn levels(points: &[AccuracyPoint]) -> Vec<Level> {
