@@ -478,12 +478,21 @@ fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
     let out = ask(case).arg("--matrix").arg(&report).output().unwrap();
     assert_eq!(String::from_utf8_lossy(&out.stdout), second);
 
-    // A case the suite has no sweep of, or a scene name two of its variants share, is an
-    // error naming the cases it has; nothing runs.
-    for asked in ["no_such_case", "tiny_hertz_collapse"] {
+    // A case the suite has no sweep of is an error naming the cases it has; a scene name
+    // two of its variants share is one naming those variants; nothing runs.
+    for (asked, says) in [
+        (
+            "no_such_case",
+            "`no_such_case` is not one of its accuracy sweeps",
+        ),
+        (
+            "tiny_hertz_collapse",
+            "`tiny_hertz_collapse` names several cases",
+        ),
+    ] {
         let (ok, _, stderr) = advise(asked);
         assert!(
-            !ok && stderr.contains(&format!("`{asked}` is not one of its accuracy sweeps"))
+            !ok && stderr.contains(says)
                 && stderr.contains("tiny_hertz_collapse-fidelity, tiny_hertz_collapse-short"),
             "{stderr}"
         );
