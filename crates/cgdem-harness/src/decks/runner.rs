@@ -289,20 +289,32 @@ struct ProcessId {
 
 impl ProcessId {
     fn alive(&self) -> bool {
-        proc_stat(self.pid).is_some_and(|(_, start, state)| start == self.start && state != 'Z')
+        proc_stat(self.pid).is_some_and(|s| s.start == self.start && s.state != 'Z')
     }
 }
 
-/// (parent pid, start time, state) from /proc/PID/stat.
-fn proc_stat(pid: u32) -> Option<(u32, u64, char)> {
+/// What /proc/PID/stat says of a process.
+struct ProcStat {
+    ppid: u32,
+    /// Start time, in clock ticks since boot (with the pid, it names the process).
+    start: u64,
+    state: char,
+    /// User plus system CPU time, in clock ticks.
+    cpu_ticks: u64,
+}
+
+fn proc_stat(pid: u32) -> Option<ProcStat> {
     let text = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
     // The command name may hold spaces and parentheses: fields follow the last ')'.
     let rest = &text[text.rfind(')')? + 2..];
     let fields: Vec<&str> = rest.split_whitespace().collect();
-    let state = fields.first()?.chars().next()?;
-    let ppid = fields.get(1)?.parse().ok()?;
-    let start = fields.get(19)?.parse().ok()?;
-    Some((ppid, start, state))
+    let number = |i: usize| fields.get(i)?.parse::<u64>().ok();
+    Some(ProcStat {
+        ppid: fields.get(1)?.parse().ok()?,
+        start: number(19)?,
+        state: fields.first()?.chars().next()?,
+        cpu_ticks: number(11)? + number(12)?,
+    })
 }
 
 /// CPU time (user and system) in seconds of `root` and every living process below it; 0
@@ -314,18 +326,7 @@ fn tree_cpu_seconds(root: u32) -> f64 {
         // SAFETY: sysconf has no preconditions.
         let ticks = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
         let ticks = if ticks > 0 { ticks as f64 } else { 100.0 };
-        let of = |pid: u32| -> u64 {
-            let Ok(text) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
-                return 0;
-            };
-            let Some(close) = text.rfind(')') else {
-                return 0;
-            };
-            // After the name: state, ppid, ... utime and stime are the 12th and 13th.
-            let fields: Vec<&str> = text[close + 1..].split_whitespace().collect();
-            let field = |i: usize| fields.get(i).and_then(|f| f.parse::<u64>().ok());
-            field(11).unwrap_or(0) + field(12).unwrap_or(0)
-        };
+        let of = |pid: u32| proc_stat(pid).map_or(0, |s| s.cpu_ticks);
         let total = of(root) + descendants(root).iter().map(|p| of(p.pid)).sum::<u64>();
         total as f64 / ticks
     }
@@ -344,8 +345,8 @@ fn descendants(root: u32) -> Vec<ProcessId> {
             let Some(pid) = entry.file_name().to_str().and_then(|n| n.parse().ok()) else {
                 continue;
             };
-            if let Some((ppid, start, _)) = proc_stat(pid) {
-                all.push((pid, ppid, start));
+            if let Some(s) = proc_stat(pid) {
+                all.push((pid, s.ppid, s.start));
             }
         }
     }
@@ -367,7 +368,7 @@ mod tests {
     use super::*;
 
     fn alive(pid: u32) -> bool {
-        proc_stat(pid).is_some_and(|(_, _, state)| state != 'Z')
+        proc_stat(pid).is_some_and(|s| s.state != 'Z')
     }
 
     /// A throwaway tree: a shell in its own group starts sleeps, one of them in a group of its
