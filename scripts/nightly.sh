@@ -26,8 +26,9 @@ mkdir -p "$night"
 
 # The speed guard, on the quiet machine before the suite: this build against the previous
 # night's (kept in target/nightly-previous), alternating pairs on the heap bench and the
-# shortened main job. A median ratio below 0.95 is a flag on the history's first screen and
-# in the night's report (history.rs reads speed_guard.json).
+# shortened main job. A median ratio below 0.95, still below after as many pairs more (the
+# guard's second look), is a flag on the history's first screen and in the night's report
+# (history.rs reads speed_guard.json).
 previous=target/nightly-previous
 if [ -x "$previous/cgdem" ]; then
     started=$(date +%s)

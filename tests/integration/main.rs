@@ -17,4 +17,5 @@ mod reference_stages;
 mod restart;
 mod scene_reference;
 mod scenes;
+mod scripts;
 mod stability;
