@@ -38,7 +38,11 @@ pub struct SiloRun {
     pub bulk_density: Option<(f64, Code)>,
     /// Beverloo's C with k = 1.5 and its standard error.
     pub c_fixed_k: Option<(f64, f64)>,
+    /// Why there is no measurement.
     pub problem: Option<String>,
+    /// Why a measured run has no bulk density of its own (a reference run's trajectory was
+    /// deleted, as the nightly does after its report): the rate stands without it.
+    pub bulk_density_problem: Option<String>,
 }
 
 /// Reads a run's summary and measures it (the mass of the run's own particles: a parcel at
@@ -89,18 +93,18 @@ pub(crate) fn measure_one(
     let series = discharge_series(&r.dir, &settings.stage, stage.start_s, species.mass())?;
     let rate = discharge_rate(&series, settings.discard_s, settings.blocks)?;
     let gate_step = (stage.start_s / summary.dt_s).round() as u64;
-    let bulk_density = match r.code {
-        Code::Cgdem => cgdem_bulk_density(&coarse, settings, &r.dir)?,
-        _ => Some((
-            dump_bulk_density(
-                &r.dir,
-                &coarse,
-                gate_step,
-                settings.bulk_lo,
-                settings.bulk_hi,
-            )?,
-            r.code,
-        )),
+    let (bulk_density, bulk_density_problem) = match r.code {
+        Code::Cgdem => (cgdem_bulk_density(&coarse, settings, &r.dir)?, None),
+        _ => match dump_bulk_density(
+            &r.dir,
+            &coarse,
+            gate_step,
+            settings.bulk_lo,
+            settings.bulk_hi,
+        ) {
+            Ok(rho) => (Some((rho, r.code)), None),
+            Err(e) => (None, Some(format!("no bulk density: {e}"))),
+        },
     };
     Ok((
         SiloRun {
@@ -114,6 +118,7 @@ pub(crate) fn measure_one(
             bulk_density,
             c_fixed_k: None,
             problem: None,
+            bulk_density_problem,
         },
         Some(gate_step),
     ))
@@ -164,6 +169,7 @@ pub fn measure_runs(
                 bulk_density: None,
                 c_fixed_k: None,
                 problem: Some(problem),
+                bulk_density_problem: None,
             };
             if r.status != Outcome::Ok {
                 return failed(r.reason.clone().unwrap_or_else(|| "not run".into()));
@@ -313,7 +319,12 @@ fn runs_table(settings: &DischargeSettings, runs: &[SiloRun]) -> (Table, String)
                 .collect::<Vec<_>>()
                 .join(" ")
         });
-        let rho_text = s.bulk_density.map_or("-".into(), |(r, c)| {
+        let none = if s.bulk_density_problem.is_some() {
+            "- (see the CSV's problem)"
+        } else {
+            "-"
+        };
+        let rho_text = s.bulk_density.map_or(none.into(), |(r, c)| {
             if c == s.code {
                 format!("{r:.0}")
             } else {
@@ -388,7 +399,11 @@ fn runs_table(settings: &DischargeSettings, runs: &[SiloRun]) -> (Table, String)
             f(s.c_fixed_k.map(|c| c.0)),
             f(s.c_fixed_k.map(|c| c.1)),
             f(published),
-            s.problem.as_deref().unwrap_or("").replace('"', "'"),
+            s.problem
+                .as_deref()
+                .or(s.bulk_density_problem.as_deref())
+                .unwrap_or("")
+                .replace('"', "'"),
         );
     }
     (table, csv)

@@ -1,3 +1,4 @@
+use std::fmt::Write as _;
 use std::path::Path;
 
 use super::*;
@@ -222,6 +223,7 @@ fn measured(code: crate::code::Code, rate: f64, se: f64) -> SiloRun {
         bulk_density: None,
         c_fixed_k: None,
         problem: None,
+        bulk_density_problem: None,
     }
 }
 
@@ -262,4 +264,66 @@ fn cgdem_outside_the_reference_codes_spread_fails_its_criterion_unless_declared(
     assert_eq!(c.verdict, Verdict::Fail);
     // No reference rate: nothing to compare.
     assert!(rate_criterion(&outside[..1], &[]).is_none());
+}
+
+#[test]
+fn a_reference_run_whose_trajectory_is_gone_keeps_its_rate_and_says_why_it_has_no_density() {
+    // The nightly deletes the dumps after its report; a report rebuilt from the night
+    // (`--reuse`) must still judge the rates, which come from timeseries.csv alone.
+    crate::at_repo_root();
+    let dir = std::env::temp_dir().join(format!("cgdem-silo-no-dump-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A LIGGGHTS run's summary as the silo suite wrote it (the gate opened at 0.25 s).
+    std::fs::copy(
+        "reports/silo/suite/runs/silo_reduced/liggghts-lambda1-seed1/summary.json",
+        dir.join("summary.json"),
+    )
+    .unwrap();
+    // 100 grains leave every 0.01 s from the gate's opening.
+    let mut csv = String::from("time_s,stage,n_particles\n0.24,fill,24000\n0.25,fill,24000\n");
+    for k in 1..=60 {
+        let _ = writeln!(
+            csv,
+            "{},discharge,{}",
+            0.25 + 0.01 * k as f64,
+            24000 - 100 * k
+        );
+    }
+    std::fs::write(dir.join("timeseries.csv"), csv).unwrap();
+    let suite = crate::suite::Suite::parse(
+        "name = \"s\"\ndescription = \"d\"\n[[case]]\nfile = \"validation/cases/silo_reduced.toml\"\ncodes = [\"liggghts\"]\nlambdas = [1]\nseeds = [1]\ndischarge = { stage = \"discharge\", orifice_diameter = 0.04, discard = 0.1, blocks = 5, bulk_lo = [-0.028, -0.028, 0.03], bulk_hi = [0.028, 0.028, 0.07] }\n",
+        Path::new("s.toml"),
+    )
+    .unwrap();
+    let settings = suite.cases[0].discharge.as_ref().unwrap();
+    let scene =
+        cgdem_core::scene::Scene::load(Path::new("validation/cases/silo_reduced.toml")).unwrap();
+    let record = crate::runs::RunRecord::ok(
+        "silo_reduced".into(),
+        crate::code::Code::Liggghts,
+        1,
+        cgdem_core::scene::CoarseGrainRule::Seed,
+        1,
+        dir.clone(),
+    );
+    let runs = measure_runs(&scene, settings, &[record]);
+    let run = &runs[0];
+    let grain = 2500.0 * std::f64::consts::PI / 6.0 * 0.004f64.powi(3);
+    let rate = run.rate.as_ref().expect("the rate stands without the dump");
+    assert!(
+        (rate.rate_kg_s - 100.0 * grain / 0.01).abs() < 1e-9,
+        "{rate:?}"
+    );
+    assert!(run.problem.is_none() && run.bulk_density.is_none() && run.c_fixed_k.is_none());
+    let why = run.bulk_density_problem.as_deref().unwrap();
+    assert!(
+        why.starts_with("no bulk density") && why.contains("dump"),
+        "{why}"
+    );
+    let verdict = cgdem_verdict(&[
+        measured(crate::code::Code::Cgdem, rate.rate_kg_s, 0.001),
+        run.clone(),
+    ]);
+    assert_eq!(verdict.map(|v| v.gap), Some(0.0));
+    std::fs::remove_dir_all(&dir).unwrap();
 }
