@@ -102,9 +102,9 @@ pub fn run_reference(
         }
         Err(e) => return Err(e.to_string()),
     };
-    if let RunStatus::TimedOut { after_s, .. } = &run.status {
+    if let RunStatus::TimedOut { after_s, cpu_s, .. } = &run.status {
         summary.warnings.push(format!(
-            "{} killed after {after_s:.0} s (time limit): partial run",
+            "{} killed after {cpu_s:.0} s of CPU per rank ({after_s:.0} s of wall clock; the time limit): partial run",
             options.code.label()
         ));
     }

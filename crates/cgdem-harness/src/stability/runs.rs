@@ -261,9 +261,12 @@ fn stop_or_crash(
                 )),
             ),
         },
-        RunStatus::TimedOut { after_s, .. } => (
+        RunStatus::TimedOut { after_s, cpu_s, .. } => (
             None,
-            Some(format!("{} timed out after {after_s:.0} s", code.name())),
+            Some(format!(
+                "{} timed out after {cpu_s:.0} s of CPU per rank ({after_s:.0} s of wall clock)",
+                code.name()
+            )),
         ),
         _ => (log.error.clone(), None),
     }
