@@ -45,6 +45,24 @@ pub struct SiloRun {
     pub bulk_density_problem: Option<String>,
 }
 
+impl SiloRun {
+    /// The bulk density as the runs table shows it: kg/m3, and whose fill when not its own.
+    fn bulk_density_text(&self) -> String {
+        match self.bulk_density {
+            Some((rho, code)) if code == self.code => format!("{rho:.0}"),
+            Some((rho, code)) => format!("{rho:.0} ({}'s fill)", code.name()),
+            None if self.bulk_density_problem.is_some() => "- (see the CSV's problem)".into(),
+            None => "-".into(),
+        }
+    }
+
+    /// Why the run has no measurement, or no bulk density, for the CSV's quoted column.
+    fn csv_problem(&self) -> String {
+        let problem = self.problem.as_ref().or(self.bulk_density_problem.as_ref());
+        problem.map_or(String::new(), |p| p.replace('"', "'"))
+    }
+}
+
 /// Reads a run's summary and measures it (the mass of the run's own particles: a parcel at
 /// lambda carries lambda^3 grains' mass); `Err` says why it cannot be. Also returns the
 /// step at which the gate opened.
@@ -319,18 +337,7 @@ fn runs_table(settings: &DischargeSettings, runs: &[SiloRun]) -> (Table, String)
                 .collect::<Vec<_>>()
                 .join(" ")
         });
-        let none = if s.bulk_density_problem.is_some() {
-            "- (see the CSV's problem)"
-        } else {
-            "-"
-        };
-        let rho_text = s.bulk_density.map_or(none.into(), |(r, c)| {
-            if c == s.code {
-                format!("{r:.0}")
-            } else {
-                format!("{r:.0} ({}'s fill)", c.name())
-            }
-        });
+        let rho_text = s.bulk_density_text();
         let drift = s.rate.as_ref().map_or(Cell::num("-"), |r| {
             let text = format!("{:+.4}", r.drift_kg_s);
             if r.drifts {
@@ -399,11 +406,7 @@ fn runs_table(settings: &DischargeSettings, runs: &[SiloRun]) -> (Table, String)
             f(s.c_fixed_k.map(|c| c.0)),
             f(s.c_fixed_k.map(|c| c.1)),
             f(published),
-            s.problem
-                .as_deref()
-                .or(s.bulk_density_problem.as_deref())
-                .unwrap_or("")
-                .replace('"', "'"),
+            s.csv_problem(),
         );
     }
     (table, csv)
