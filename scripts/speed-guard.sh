@@ -121,28 +121,11 @@ run_pairs() {
     done
 }
 
-# below ROWS THRESHOLD: exit 0 when a median ratio over the rows so far is below the threshold.
-below() {
-    python3 - "$1" "$2" <<'PY'
-import csv, statistics, sys
-rows = list(csv.DictReader(open(sys.argv[1])))
-heap = statistics.median(float(r["heap_new"]) / float(r["heap_base"]) for r in rows)
-main = statistics.median(float(r["mainjob_base_s"]) / float(r["mainjob_new_s"]) for r in rows)
-sys.exit(0 if min(heap, main) < float(sys.argv[2]) else 1)
-PY
-}
-
-run_pairs 1 "$pairs"
-confirmed=0
-if [ "$confirm" -gt 0 ] && below "$rows" "$threshold"; then
-    echo "speed-guard: a median is below $threshold after $pairs pairs; $confirm pairs more before the verdict" >&2
-    run_pairs $((pairs + 1)) $((pairs + confirm))
-    confirmed=$confirm
-fi
-
-python3 - "$rows" "$threshold" "$json" "$base_label" "$new_label" "$base" "$new" "$confirmed" <<'PY'
+# The verdict over the pairs so far: exit 1 when a median ratio is below the threshold;
+# `report` also prints the figures and writes the JSON, `quiet` only decides.
+verdict=$(cat <<'PY'
 import csv, json, statistics, sys
-rows_path, threshold, json_path, base_spec, new_spec, base_bin, new_bin, confirmed = sys.argv[1:]
+rows_path, threshold, json_path, base_spec, new_spec, base_bin, new_bin, confirmed, mode = sys.argv[1:]
 threshold = float(threshold)
 rows = list(csv.DictReader(open(rows_path)))
 heap = [float(r["heap_new"]) / float(r["heap_base"]) for r in rows]
@@ -154,6 +137,8 @@ result = {
     "mainjob_ratio_median": statistics.median(main), "mainjob_ratios": main,
 }
 result["flagged"] = min(result["heap_ratio_median"], result["mainjob_ratio_median"]) < threshold
+if mode == "quiet":
+    sys.exit(1 if result["flagged"] else 0)
 for name, r in (("heap bench", heap), ("main job", main)):
     print(f"{name}: new / base = {statistics.median(r):.3f} (median of {len(r)}; "
           + " ".join(f"{x:.3f}" for x in r) + ")")
@@ -166,3 +151,14 @@ if json_path:
         json.dump(result, f, indent=2)
 sys.exit(1 if result["flagged"] else 0)
 PY
+)
+
+run_pairs 1 "$pairs"
+confirmed=0
+if [ "$confirm" -gt 0 ] && ! python3 -c "$verdict" "$rows" "$threshold" "" "$base_label" "$new_label" "$base" "$new" 0 quiet; then
+    echo "speed-guard: a median is below $threshold after $pairs pairs; $confirm pairs more before the verdict" >&2
+    run_pairs $((pairs + 1)) $((pairs + confirm))
+    confirmed=$confirm
+fi
+
+python3 -c "$verdict" "$rows" "$threshold" "$json" "$base_label" "$new_label" "$base" "$new" "$confirmed" report

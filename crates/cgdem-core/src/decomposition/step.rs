@@ -45,7 +45,8 @@ pub struct Drive<'a> {
     /// Posed at the step's end: they move their particles (`kinematic`) after the drift.
     pub bodies: &'a [Body],
     pub kinematic: &'a [KinematicParticles],
-    /// A particle entering one of these calls for a rebuild, which deletes it.
+    /// The delete regions checked this step (every `DELETE_EVERY`-th; none on the others): a
+    /// particle in one calls for a rebuild, which deletes it.
     pub delete_regions: &'a [Aabb],
     /// Whether spins are integrated (the world's laws need them).
     pub rotates: bool,
