@@ -1,12 +1,18 @@
-//! The worker threads of one process: each steps the same block of subdomains every phase,
-//! and waits for the next phase spinning, so that a phase starts in about a microsecond.
+//! The worker threads of one process: each starts every phase on the same block of
+//! subdomains, waits for the next phase spinning (so that a phase starts in about a
+//! microsecond), and a phase ends when its work is done, not when every thread has come.
 //!
 //! A decomposed step has two parallel phases separated by a little serial work (the
 //! forward's routing, a reduction). Rayon's fork-join put its workers to sleep in that gap
 //! and woke them through the kernel for the next phase: 8% of a 2-thread heap run went to
 //! the scheduler, and two threads reached 1.7x one where two MPI ranks (each busy-polling
 //! in MPI) reached 1.9x. The team spins for `SPIN` before it sleeps, as OpenMP's runtimes
-//! do, and always gives subdomain `s` to the same thread, whose cache then holds it.
+//! do, and gives subdomain `s` first to the same thread, whose cache then holds it.
+//!
+//! The threads of a VM are not always running: the host takes a vCPU away for milliseconds
+//! at a time. A phase that waited for every thread stalled for as long, a hundred steps'
+//! worth; here a thread that finishes early takes over the subdomains another has not
+//! started, and a thread that arrives after the phase is over skips it.
 
 use std::any::Any;
 use std::cell::UnsafeCell;
@@ -21,7 +27,9 @@ use std::time::{Duration, Instant};
 /// run on fewer subdomains than threads) frees its core at once.
 const SPIN: Duration = Duration::from_micros(200);
 
-/// A phase's task: called once per thread with the thread's index (0 is the caller).
+/// A phase's task, called with the thread's index (0 is the caller) by the caller and by
+/// each worker that joins before the phase closes: the caller's call must do whatever no
+/// worker has taken.
 type Job<'a> = dyn Fn(usize) + Sync + 'a;
 
 /// The caller plus `threads - 1` workers.
@@ -32,14 +40,30 @@ pub struct Team {
     running: Mutex<()>,
 }
 
+/// The phase word: the phase's number in the high 32 bits, whether workers may still join
+/// in bit 31, and how many are inside its task in the low bits. One word, so that joining
+/// (while open) and closing (by the caller) cannot cross.
+struct Phase;
+
+impl Phase {
+    const OPEN: u64 = 1 << 31;
+    const INSIDE: u64 = Phase::OPEN - 1;
+
+    fn number(word: u64) -> u64 {
+        word >> 32
+    }
+
+    fn opened(number: u64) -> u64 {
+        (number << 32) | Phase::OPEN
+    }
+}
+
 struct Shared {
-    /// Counts the phases; a worker runs `job` when it changes.
-    epoch: AtomicU64,
+    /// See [`Phase`]; a worker joins a phase when its number changes.
+    phase: AtomicU64,
     /// The phase's task with its lifetime erased: written by `run` only while no worker
-    /// reads it (before the epoch moves, after every worker has finished).
+    /// can read it (before the phase opens, after it closed with no worker inside).
     job: UnsafeCell<Option<*const Job<'static>>>,
-    /// Workers still running this phase.
-    pending: AtomicUsize,
     sleepers: AtomicUsize,
     lock: Mutex<()>,
     wake: Condvar,
@@ -57,9 +81,8 @@ impl Team {
     /// A team of `threads` threads: the caller and `threads - 1` new ones.
     pub fn new(threads: usize) -> Team {
         let shared = Arc::new(Shared {
-            epoch: AtomicU64::new(0),
+            phase: AtomicU64::new(0),
             job: UnsafeCell::new(None),
-            pending: AtomicUsize::new(0),
             sleepers: AtomicUsize::new(0),
             lock: Mutex::new(()),
             wake: Condvar::new(),
@@ -86,39 +109,42 @@ impl Team {
         self.workers.len() + 1
     }
 
-    /// Runs `job(t)` on every thread `t` of the team (the caller is 0) and returns when all
-    /// have finished; a panic in any is raised here.
-    pub fn run(&self, job: &Job<'_>) {
+    /// Runs `job(0)` here and `job(t)` on each worker `t` that joins before `job(0)` has
+    /// returned, and returns when every call has; a panic in any is raised here.
+    fn run(&self, job: &Job<'_>) {
         if self.workers.is_empty() {
             job(0);
             return;
         }
         // Busy with another phase (a task that starts a phase itself, or a clone of the
-        // decomposition stepped on another thread): this one runs every part here.
+        // decomposition stepped on another thread): this one runs on its caller alone.
         let _one_phase = match self.running.try_lock() {
             Ok(guard) => guard,
             Err(std::sync::TryLockError::Poisoned(e)) => e.into_inner(),
             Err(std::sync::TryLockError::WouldBlock) => {
-                (0..self.threads()).for_each(job);
+                job(0);
                 return;
             }
         };
         let s = &*self.shared;
-        // SAFETY: the workers read the pointer only during this phase, and this function
-        // returns (or unwinds) only after every worker has finished with it.
+        // SAFETY: a worker reads the pointer only after joining the phase, and this
+        // function returns (or unwinds) only after the phase has closed with no worker
+        // inside.
         let erased: *const Job<'static> =
             unsafe { std::mem::transmute::<&Job<'_>, &'static Job<'static>>(job) };
         unsafe { *s.job.get() = Some(erased) };
-        s.pending.store(self.workers.len(), Ordering::Relaxed);
-        s.epoch.fetch_add(1, Ordering::SeqCst);
+        let number = Phase::number(s.phase.load(Ordering::Relaxed)) + 1;
+        s.phase.store(Phase::opened(number), Ordering::SeqCst);
         if s.sleepers.load(Ordering::SeqCst) > 0 {
             let _guard = s.lock.lock().unwrap_or_else(PoisonError::into_inner);
             s.wake.notify_all();
         }
         let mine = catch_unwind(AssertUnwindSafe(|| job(0)));
+        // Closed, no worker joins any more; wait for those inside.
+        s.phase.fetch_and(!Phase::OPEN, Ordering::AcqRel);
         let started = Instant::now();
         let mut spins = 0u32;
-        while s.pending.load(Ordering::Acquire) != 0 {
+        while s.phase.load(Ordering::Acquire) & Phase::INSIDE != 0 {
             spins = spins.wrapping_add(1);
             // On a machine with more threads than cores, spinning starves the worker waited
             // for: yield once the wait is long.
@@ -147,7 +173,8 @@ impl Drop for Team {
     fn drop(&mut self) {
         let s = &*self.shared;
         s.stop.store(true, Ordering::SeqCst);
-        s.epoch.fetch_add(1, Ordering::SeqCst);
+        // A new number, closed: the workers wake, see `stop` and return.
+        s.phase.fetch_add(1 << 32, Ordering::SeqCst);
         {
             let _guard = s.lock.lock().unwrap_or_else(PoisonError::into_inner);
             s.wake.notify_all();
@@ -164,31 +191,52 @@ impl std::fmt::Debug for Team {
     }
 }
 
-/// A worker's life: wait for a phase, run its part, say so; until the team is dropped.
+/// A worker's life: wait for a phase, join it if still open, run its part, leave; until
+/// the team is dropped.
 fn work(s: &Shared, index: usize) {
     let mut seen = 0;
     loop {
-        seen = next_epoch(s, seen);
+        let word = next_phase(s, seen);
         if s.stop.load(Ordering::SeqCst) {
             return;
         }
-        // SAFETY: published before the epoch moved, and kept alive until `pending` is 0.
+        seen = Phase::number(word);
+        if !join(s, word) {
+            continue;
+        }
+        // SAFETY: published before the phase opened, and kept until this worker has left.
         let job = unsafe { (*s.job.get()).expect("a phase publishes its task") };
         if let Err(payload) = catch_unwind(AssertUnwindSafe(|| unsafe { (*job)(index) })) {
             let mut first = s.panic.lock().unwrap_or_else(PoisonError::into_inner);
             first.get_or_insert(payload);
         }
-        s.pending.fetch_sub(1, Ordering::Release);
+        s.phase.fetch_sub(1, Ordering::Release);
     }
 }
 
-/// Waits until the epoch differs from `seen`: spinning for `SPIN`, then asleep.
-fn next_epoch(s: &Shared, seen: u64) -> u64 {
+/// Counts this worker inside the phase `word` names if it is still open.
+fn join(s: &Shared, mut word: u64) -> bool {
+    let number = Phase::number(word);
+    while Phase::number(word) == number && word & Phase::OPEN != 0 {
+        match s
+            .phase
+            .compare_exchange_weak(word, word + 1, Ordering::AcqRel, Ordering::Acquire)
+        {
+            Ok(_) => return true,
+            Err(now) => word = now,
+        }
+    }
+    false
+}
+
+/// Waits until the phase's number differs from `seen`: spinning for `SPIN`, then asleep.
+/// Returns the phase word.
+fn next_phase(s: &Shared, seen: u64) -> u64 {
     let started = Instant::now();
     let mut spins = 0u32;
     loop {
-        let now = s.epoch.load(Ordering::Acquire);
-        if now != seen {
+        let now = s.phase.load(Ordering::Acquire);
+        if Phase::number(now) != seen {
             return now;
         }
         spins = spins.wrapping_add(1);
@@ -197,15 +245,15 @@ fn next_epoch(s: &Shared, seen: u64) -> u64 {
         }
         std::hint::spin_loop();
     }
-    // `run` moves the epoch and then reads `sleepers`; this thread counts itself in
-    // `sleepers` and then reads the epoch (all SeqCst): one of the two sees the other, and
+    // `run` opens the phase and then reads `sleepers`; this thread counts itself in
+    // `sleepers` and then reads the phase (all SeqCst): one of the two sees the other, and
     // the notify, taken under the lock, cannot fall between the check and the wait.
     let mut guard = s.lock.lock().unwrap_or_else(PoisonError::into_inner);
     s.sleepers.fetch_add(1, Ordering::SeqCst);
-    let mut now = s.epoch.load(Ordering::SeqCst);
-    while now == seen {
+    let mut now = s.phase.load(Ordering::SeqCst);
+    while Phase::number(now) == seen {
         guard = s.wake.wait(guard).unwrap_or_else(PoisonError::into_inner);
-        now = s.epoch.load(Ordering::SeqCst);
+        now = s.phase.load(Ordering::SeqCst);
     }
     s.sleepers.fetch_sub(1, Ordering::SeqCst);
     drop(guard);
@@ -227,9 +275,10 @@ impl<T> Disjoint<T> {
 }
 
 impl Team {
-    /// `task(&mut items[s])` for each `s` of `chosen` (distinct, increasing), the
-    /// threads taking contiguous blocks of `chosen` (the same blocks every phase); the
-    /// results by index of `items`, `None` where not chosen.
+    /// `task(&mut items[s])` for each `s` of `chosen` (distinct, increasing), each thread
+    /// starting on its own contiguous block of `chosen` (the same block every phase) and
+    /// then taking, from the back, what is left of the others'; the results by index of
+    /// `items`, `None` where not chosen. Which thread runs a task changes nothing in it.
     pub fn each_of<T: Send, R: Send>(
         &self,
         items: &mut [T],
@@ -251,14 +300,26 @@ impl Team {
         }
         let (inputs, outputs) = (Disjoint(items.as_mut_ptr()), Disjoint(results.as_mut_ptr()));
         let m = chosen.len();
+        let claimed: Vec<AtomicBool> = (0..m).map(|_| AtomicBool::new(false)).collect();
+        let block = |t: usize| t * m / threads..(t + 1) * m / threads;
+        let take = |k: usize| {
+            if !claimed[k].swap(true, Ordering::AcqRel) {
+                let s = chosen[k];
+                // SAFETY: `claimed[k]` goes to one thread only, and the indices of
+                // `chosen` are distinct and in bounds (asserted above).
+                unsafe { *outputs.at(s) = Some(task(&mut *inputs.at(s))) };
+            }
+        };
         self.run(&|t: usize| {
             if t >= threads {
                 return;
             }
-            for &s in &chosen[t * m / threads..(t + 1) * m / threads] {
-                // SAFETY: the blocks of `chosen` do not overlap and its indices are
-                // distinct and in bounds (asserted above).
-                unsafe { *outputs.at(s) = Some(task(&mut *inputs.at(s))) };
+            // Its own block from the front, then what is left of the others' from their
+            // backs: a thread that finishes early takes over the items a slower one has
+            // not reached, and in a balanced phase each keeps its own (and its cache).
+            block(t).for_each(take);
+            for other in (t + 1..threads).chain(0..t) {
+                block(other).rev().for_each(take);
             }
         });
         results
@@ -316,20 +377,69 @@ mod tests {
         assert_eq!(items, vec![3, 3]);
     }
 
+    fn on_a_worker() -> bool {
+        std::thread::current()
+            .name()
+            .is_some_and(|n| n.starts_with("cgdem-worker"))
+    }
+
+    /// Waits (up to 10 s) until `flag` is set: the caller holds its first item until a
+    /// worker has taken one, so that the worker surely works in the phase.
+    fn wait_for(flag: &AtomicBool) {
+        let started = Instant::now();
+        while !flag.load(Ordering::Acquire) && started.elapsed() < Duration::from_secs(10) {
+            std::thread::yield_now();
+        }
+    }
+
     #[test]
     fn a_panic_on_a_worker_reaches_the_caller_and_the_team_goes_on() {
         let team = Team::new(2);
         let mut items = vec![0u32; 2];
+        let worker_started = AtomicBool::new(false);
         let caught = catch_unwind(AssertUnwindSafe(|| {
             team.each_of(&mut items, &[0, 1], |x| {
-                if *x == 0 && std::thread::current().name() == Some("cgdem-worker-1") {
+                if on_a_worker() {
+                    worker_started.store(true, Ordering::Release);
                     panic!("planted");
                 }
+                wait_for(&worker_started);
                 *x += 1;
             })
         }));
+        assert!(
+            worker_started.load(Ordering::Acquire),
+            "the worker never joined"
+        );
         assert!(caught.is_err());
         team.each_of(&mut items, &[0, 1], |x| *x += 10);
         assert_eq!(items[0], 11);
+    }
+
+    #[test]
+    fn the_caller_takes_over_what_a_late_or_slow_worker_has_not_started() {
+        let team = Team::new(2);
+        let mut items: Vec<Option<bool>> = vec![None; 8];
+        let chosen: Vec<usize> = (0..8).collect();
+        // The worker's first item takes 200 ms; the caller's items are quick.
+        team.each_of(&mut items, &chosen, |ran_on_worker| {
+            let worker = on_a_worker();
+            if worker {
+                std::thread::sleep(Duration::from_millis(200));
+            }
+            *ran_on_worker = Some(worker);
+        });
+        assert!(
+            items.iter().all(Option::is_some),
+            "every item ran: {items:?}"
+        );
+        let on_worker = items.iter().filter(|r| **r == Some(true)).count();
+        assert!(
+            on_worker <= 1,
+            "the worker's block is 4 items, but it held 1 when the caller was done: {items:?}"
+        );
+        // The worker finished its one item before the phase returned.
+        team.each_of(&mut items, &chosen, |r| *r = None);
+        assert!(items.iter().all(Option::is_none));
     }
 }
