@@ -417,29 +417,52 @@ mod tests {
     }
 
     #[test]
-    fn the_caller_takes_over_what_a_late_or_slow_worker_has_not_started() {
+    fn the_caller_takes_over_what_a_slow_worker_has_not_started() {
         let team = Team::new(2);
         let mut items: Vec<Option<bool>> = vec![None; 8];
         let chosen: Vec<usize> = (0..8).collect();
-        // The worker's first item takes 200 ms; the caller's items are quick.
+        // The worker's first item (item 4, the front of its block) takes 500 ms; the
+        // caller's first waits until the worker is in it, the others are quick.
+        let worker_started = AtomicBool::new(false);
+        let started = Instant::now();
         team.each_of(&mut items, &chosen, |ran_on_worker| {
             let worker = on_a_worker();
             if worker {
-                std::thread::sleep(Duration::from_millis(200));
+                worker_started.store(true, Ordering::Release);
+                std::thread::sleep(Duration::from_millis(500));
+            } else {
+                wait_for(&worker_started);
             }
             *ran_on_worker = Some(worker);
         });
         assert!(
+            worker_started.load(Ordering::Acquire),
+            "the worker never joined"
+        );
+        assert!(
             items.iter().all(Option::is_some),
             "every item ran: {items:?}"
         );
-        let on_worker = items.iter().filter(|r| **r == Some(true)).count();
-        assert!(
-            on_worker <= 1,
-            "the worker's block is 4 items, but it held 1 when the caller was done: {items:?}"
+        let on_worker: Vec<usize> = (0..8).filter(|&k| items[k] == Some(true)).collect();
+        assert_eq!(
+            on_worker,
+            vec![4],
+            "the worker's block is items 4-7; the caller takes 5-7 while it sleeps in 4"
         );
-        // The worker finished its one item before the phase returned.
-        team.each_of(&mut items, &chosen, |r| *r = None);
-        assert!(items.iter().all(Option::is_none));
+        // The phase returned only once the worker had left its item.
+        assert!(started.elapsed() >= Duration::from_millis(500));
+    }
+
+    #[test]
+    fn every_item_runs_once_whether_or_not_a_sleeping_worker_joins() {
+        let team = Team::new(2);
+        for _ in 0..20 {
+            let mut items = vec![0u32; 8];
+            let chosen: Vec<usize> = (0..8).collect();
+            team.each_of(&mut items, &chosen, |x| *x += 1);
+            assert_eq!(items, vec![1; 8]);
+            // The worker falls asleep between the phases.
+            std::thread::sleep(SPIN * 5);
+        }
     }
 }
