@@ -18,7 +18,8 @@
 //! of lower id first, so both sides compute the same numbers and keep the same history.
 //! Each phase packs what travels into buffers and unpacks them on the other side: threads in
 //! one process read them in place, MPI ranks send the same buffers ([`transport`]). The
-//! threads of a process form a [`team`] that keeps each subdomain on one thread.
+//! threads of a process form a [`team`] that gives each subdomain to the same thread, unless
+//! another is free first.
 
 pub mod balance;
 pub mod borders;

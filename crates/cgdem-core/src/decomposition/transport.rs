@@ -107,8 +107,8 @@ impl Comm {
     }
 
     /// `task` on each subdomain this rank owns (`items[s]` stands for subdomain `s`), each
-    /// on the thread of this process that always steps it; results by subdomain, `None`
-    /// where owned elsewhere.
+    /// on the thread of this process whose block it is unless another thread is free first
+    /// ([`Team::each_of`]); results by subdomain, `None` where owned elsewhere.
     pub fn each_owned<T: Send, R: Send>(
         &self,
         items: &mut [T],
