@@ -182,8 +182,7 @@ pub(crate) fn stage_lines(
                 max_duration,
             } => {
                 let chunk_s = dump_every as Real * dt;
-                let min_chunks = (min_duration / chunk_s - 1e-9).ceil().max(0.0) as u64;
-                let max_chunks = ((max_duration / chunk_s).round() as u64).max(1);
+                let (min_chunks, max_chunks) = settle_chunks(min_duration, max_duration, chunk_s);
                 let (var, label) = (format!("chunk{k}"), format!("stage{k}"));
                 let _ = writeln!(d, "variable        {var} loop {max_chunks}");
                 let _ = writeln!(d, "label           loop_{label}");
@@ -215,4 +214,36 @@ pub(crate) fn stage_lines(
         }
     }
     repose_dumps
+}
+
+/// A settled stage's bounds in whole output intervals of `chunk_s` (the decks test the
+/// kinetic energy once per interval): at least `ceil(min)`, at most `max` rounded to the
+/// nearest interval, but never fewer than the minimum (with `min = max = 1.5` intervals,
+/// 0.015 / 0.01 is 1.4999..., which rounded to 1, and the stage ended before its minimum).
+fn settle_chunks(min_duration: Real, max_duration: Real, chunk_s: Real) -> (u64, u64) {
+    let min_chunks = (min_duration / chunk_s - 1e-9).ceil().max(0.0) as u64;
+    let max_chunks = ((max_duration / chunk_s).round() as u64)
+        .max(min_chunks)
+        .max(1);
+    (min_chunks, max_chunks)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::settle_chunks;
+
+    #[test]
+    fn a_settled_stage_never_ends_before_its_minimum_in_whole_intervals() {
+        // The case found: min = max = 0.015 s with outputs every 0.01 s.
+        assert_eq!(settle_chunks(0.015, 0.015, 0.01), (2, 2));
+        assert_eq!(settle_chunks(0.045, 0.1, 0.01), (5, 10));
+        assert_eq!(settle_chunks(0.0, 0.004, 0.01), (0, 1));
+        for (min, max, chunk) in [(0.3, 0.3, 0.02), (0.11, 0.12, 0.05), (0.7, 0.71, 0.1)] {
+            let (lo, hi) = settle_chunks(min, max, chunk);
+            assert!(
+                lo <= hi && lo as f64 * chunk >= min - 1e-9,
+                "{min} {max} {chunk}"
+            );
+        }
+    }
 }
