@@ -10,8 +10,8 @@
 //! do, and gives subdomain `s` first to the same thread, whose cache then holds it.
 //!
 //! The threads of a VM are not always running: the host takes a vCPU away for milliseconds
-//! at a time. A phase that waited for every thread stalled for as long, a hundred steps'
-//! worth; here a thread that finishes early takes over the subdomains another has not
+//! at a time. A phase that waited for every thread stalled for as long, several steps'
+//! worth (a heap step takes about half a millisecond); here a thread that finishes early takes over the subdomains another has not
 //! started, and a thread that arrives after the phase is over skips it.
 
 use std::any::Any;
