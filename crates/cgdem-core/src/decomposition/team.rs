@@ -11,8 +11,9 @@
 //!
 //! The threads of a VM are not always running: the host takes a vCPU away for milliseconds
 //! at a time. A phase that waited for every thread stalled for as long, several steps'
-//! worth (a heap step takes about half a millisecond); here a thread that finishes early takes over the subdomains another has not
-//! started, and a thread that arrives after the phase is over skips it.
+//! worth (a heap step takes about half a millisecond); here a thread that finishes early
+//! takes over the subdomains another has not started, and a thread that arrives after the
+//! phase is over skips it.
 
 use std::any::Any;
 use std::cell::UnsafeCell;
