@@ -409,6 +409,8 @@ def item_stability(a):
     text = re.sub(r"^codes\s*=.*$\n?", "", text, flags=re.M)
     text = text.replace("[[stability]]\n", '[[stability]]\ncodes = ["cgdem"]\n')
     text = text.replace('name = "stability"', 'name = "stability-cgdem"', 1)
+    # Its scenes are named relative to the suite file; this copy lives elsewhere.
+    text = text.replace('file = "../', f'file = "{ROOT}/validation/')
     suite = runs / "stability-cgdem.toml"
     suite.write_text(text)
     verdicts = {}

@@ -14,9 +14,12 @@ fn stability_suite_classifies_a_stable_and_a_detected_case() {
     let suite = dir.join("suite.toml");
     std::fs::write(
         &suite,
-        "name = \"stability-test\"\n\
-         [[stability]]\nfile = \"validation/stability/impact_50ms_wca.toml\"\ncodes = [\"cgdem\"]\n\
-         [[stability]]\nfile = \"validation/stability/dt_5x.toml\"\ncodes = [\"cgdem\"]\nforce_dt = true\n",
+        format!(
+            "name = \"stability-test\"\n\
+             [[stability]]\nfile = \"{root}/validation/stability/impact_50ms_wca.toml\"\ncodes = [\"cgdem\"]\n\
+             [[stability]]\nfile = \"{root}/validation/stability/dt_5x.toml\"\ncodes = [\"cgdem\"]\nforce_dt = true\n",
+            root = env!("CARGO_MANIFEST_DIR")
+        ),
     )
     .unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_cgdem"))
@@ -73,9 +76,12 @@ fn validate_grid_decomposes_cgdem_runs_and_reuse_tells_them_apart() {
     let suite = dir.join("suite.toml");
     std::fs::write(
         &suite,
-        "name = \"grid-test\"\n\
-         [[case]]\nfile = \"tests/data/tiny_drop.toml\"\ncodes = [\"cgdem\"]\nlambdas = [1]\nseeds = [1]\n\
-         [[stability]]\nfile = \"validation/stability/impact_50ms_wca.toml\"\ncodes = [\"cgdem\"]\n",
+        format!(
+            "name = \"grid-test\"\n\
+             [[case]]\nfile = \"{root}/tests/data/tiny_drop.toml\"\ncodes = [\"cgdem\"]\nlambdas = [1]\nseeds = [1]\n\
+             [[stability]]\nfile = \"{root}/validation/stability/impact_50ms_wca.toml\"\ncodes = [\"cgdem\"]\n",
+            root = env!("CARGO_MANIFEST_DIR")
+        ),
     )
     .unwrap();
     let report = dir.join("report");

@@ -12,11 +12,13 @@ use cgdem_core::scene::{Override, Scene, SceneError};
 
 pub use crate::code::Code;
 pub use crate::suite_entry::SuiteError;
-pub(crate) use crate::suite_entry::{load_variant, parse_codes, parse_variant, rule_names};
+pub(crate) use crate::suite_entry::{
+    beside_suite, load_variant, parse_codes, parse_variant, rule_names,
+};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SuiteCase {
-    /// The scene file, relative to the repository root (the working directory).
+    /// The scene file; the suite names it relative to the suite file ([`beside_suite`]).
     pub file: PathBuf,
     pub codes: Vec<Code>,
     pub lambdas: Vec<u32>,
@@ -182,6 +184,74 @@ impl Suite {
     }
 }
 
+impl Suite {
+    /// The suite `cgdem validate CASE.toml` runs for a scene file of one's own: one case
+    /// with the default tolerances, run by `codes` at `lambdas` under paper A's rule with
+    /// `seeds`, measured as its scene's observers say (`[repose]`, `[conveying]`,
+    /// `[discharge]`, `[packing]`). `name` is the scene's.
+    pub fn for_scene(
+        file: &Path,
+        name: &str,
+        codes: &[Code],
+        lambdas: &[u32],
+        seeds: &[u64],
+    ) -> Result<Suite, SuiteError> {
+        // Named absolutely, the case's file resolves to itself beside any suite path; the
+        // messages then name the scene file, which is what the user gave.
+        let absolute = std::path::absolute(file).unwrap_or_else(|_| file.to_path_buf());
+        let raw = RawCase {
+            file: absolute,
+            codes: codes.iter().map(|c| c.name().to_string()).collect(),
+            lambdas: lambdas.to_vec(),
+            cg_rules: Vec::new(),
+            seeds: seeds.to_vec(),
+            angle_tolerance_deg: None,
+            time_ratio_tolerance: None,
+            front_tolerance: None,
+            wall_height_tolerance: None,
+            kinetic_energy_tolerance: None,
+            known_difference: Vec::new(),
+            set: Vec::new(),
+            variant: None,
+            rpms: Vec::new(),
+            keep_going: false,
+            discharge: None,
+        };
+        let case = parse_case(raw, 0, file)?;
+        Ok(Suite {
+            name: name.to_string(),
+            description: format!(
+                "The scene {} in {}, {} seeds per code and level.",
+                file.display(),
+                codes
+                    .iter()
+                    .map(|c| c.label())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                seeds.len()
+            ),
+            source: file.to_path_buf(),
+            cases: vec![case],
+            accuracy: Vec::new(),
+            stability: Vec::new(),
+        })
+    }
+
+    /// Every code some entry of the suite runs, each once.
+    pub fn codes(&self) -> Vec<Code> {
+        let mut codes: Vec<Code> = self
+            .cases
+            .iter()
+            .flat_map(|c| c.codes.clone())
+            .chain(self.accuracy.iter().flat_map(|a| a.codes()))
+            .chain(self.stability.iter().flat_map(|s| s.codes.clone()))
+            .collect();
+        codes.sort();
+        codes.dedup();
+        codes
+    }
+}
+
 /// `[[case]]` number `k` of the suite at `path`, checked.
 fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError> {
     let invalid =
@@ -264,7 +334,7 @@ fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError
         ));
     }
     Ok(SuiteCase {
-        file: c.file,
+        file: beside_suite(path, &c.file),
         codes,
         lambdas: c.lambdas,
         cg_rules,
@@ -317,12 +387,13 @@ fn parse_known_difference(
             "why the codes or levels differ, in words",
         ));
     }
-    // The evidence is a file of the repository (paths from its root, as `file`).
-    if !Path::new(&kd.evidence).is_file() {
+    // The evidence is a file, named relative to the suite file as `file` is.
+    let evidence = beside_suite(path, Path::new(&kd.evidence));
+    if !evidence.is_file() {
         return Err(invalid(
             field("evidence"),
-            format!("\"{}\"", kd.evidence),
-            "an existing file, relative to the repository root, that documents the difference",
+            format!("\"{}\" ({})", kd.evidence, evidence.display()),
+            "an existing file, relative to the suite file, that documents the difference",
         ));
     }
     if kd.comparison.trim().is_empty() {
@@ -336,7 +407,7 @@ fn parse_known_difference(
         comparison: kd.comparison,
         criterion: kd.criterion,
         reason: kd.reason,
-        evidence: kd.evidence,
+        evidence: evidence.display().to_string(),
         band: kd.band,
     })
 }

@@ -23,6 +23,28 @@ pub(crate) fn load_variant(
     Ok(scene)
 }
 
+/// A path a suite file names (a case's scene, a known difference's evidence), taken relative
+/// to the suite file's own directory, as LAMMPS users expect of files named in an input, so a
+/// suite runs from any working directory. `.` and `..` are folded away without touching the
+/// disk, so the repository's suites name their scenes as `validation/cases/...` in reports.
+pub(crate) fn beside_suite(suite: &Path, named: &Path) -> PathBuf {
+    use std::path::Component;
+    let joined = suite.parent().unwrap_or(Path::new("")).join(named);
+    let mut out = PathBuf::new();
+    for part in joined.components() {
+        match part {
+            Component::CurDir => {}
+            Component::ParentDir
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) =>
+            {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
 /// A suite entry's `set` overrides, checked with its `variant` name: a name of letters,
 /// digits, `-` and `_`, required when `set` changes the scene. `entry` names the entry in
 /// messages (`case[2]`).

@@ -277,7 +277,7 @@ impl AccuracySweep {
             .map(|d| crate::silo::parse_discharge(d, &format!("accuracy[{k}]"), path))
             .transpose()?;
         Ok(AccuracySweep {
-            file: raw.file,
+            file: crate::suite_entry::beside_suite(path, &raw.file),
             overrides,
             variant: raw.variant,
             seeds,

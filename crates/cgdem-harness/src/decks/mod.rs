@@ -24,6 +24,7 @@ pub mod postprocess;
 pub mod run;
 pub mod runner;
 mod stages;
+pub mod version;
 
 pub use dump::{parse_dump, read_dump, DumpError, Frame};
 pub use postprocess::{postprocess, write_summary, PostprocessError};

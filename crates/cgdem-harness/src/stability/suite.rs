@@ -106,7 +106,7 @@ pub(crate) fn parse_cases(
             path,
         )?;
         out.push(StabilityCase {
-            file: c.file,
+            file: crate::suite_entry::beside_suite(path, &c.file),
             codes,
             lambda,
             force_dt: c.force_dt,

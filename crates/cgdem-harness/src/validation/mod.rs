@@ -13,12 +13,14 @@
 mod measurement;
 mod report;
 mod runs;
+mod status;
 #[cfg(test)]
 mod tests;
 
 pub use crate::runs::{Outcome, RunRecord, ValidateError, ValidateOptions};
 pub use measurement::Comparison;
 pub(crate) use report::machine_provenance;
+pub use status::{Status, StatusCounts};
 
 use std::collections::BTreeMap;
 
@@ -37,6 +39,8 @@ use runs::run_case;
 #[derive(Clone, Debug, Serialize)]
 pub struct ValidationSummary {
     pub suite: String,
+    /// The overall status (`Status::of`), set once every part is in.
+    pub status: Status,
     pub provenance: BTreeMap<String, String>,
     pub runs: Vec<RunRecord>,
     pub comparisons: Vec<Comparison>,
@@ -62,7 +66,8 @@ pub fn validate_suite(
 ) -> Result<ValidationSummary, ValidateError> {
     std::fs::create_dir_all(&options.out).map_err(|e| output_error(&options.out, e))?;
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
-    let provenance = provenance(suite, options);
+    let mut provenance = provenance(suite, options);
+    let warnings = reference_versions(suite, &mut provenance, options.quiet);
     let (runs, comparisons) = run_cases(suite, options, &mut report)?;
     let accuracy =
         super::accuracy::run_sweeps(&suite.accuracy, &suite.source, options, &mut report)?;
@@ -71,15 +76,17 @@ pub fn validate_suite(
             file: suite.source.clone(),
             message,
         })?;
-    let summary = ValidationSummary {
+    let mut summary = ValidationSummary {
         suite: suite.name.clone(),
+        status: Status::Green,
         provenance,
         runs,
         comparisons,
         accuracy,
         stability,
     };
-    write_intro(&mut report, &summary, suite, options);
+    summary.status = Status::of(&summary);
+    write_intro(&mut report, &summary, suite, options, &warnings);
     let json_path = options.out.join("summary.json");
     let json = serde_json::to_string_pretty(&summary).map_err(|e| output_error(&json_path, e))?;
     write_atomic(&json_path, json.as_bytes()).map_err(|e| output_error(&json_path, e))?;
@@ -88,6 +95,38 @@ pub fn validate_suite(
         .write(&html_path)
         .map_err(|e| output_error(&html_path, e))?;
     Ok(summary)
+}
+
+/// Each reference code the suite runs, as found: its release (or that it is missing) in the
+/// provenance; a release the decks were not verified against is warned about on the console
+/// and returned for the report's first screen.
+fn reference_versions(
+    suite: &Suite,
+    provenance: &mut BTreeMap<String, String>,
+    quiet: bool,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for code in suite.codes() {
+        let Some(dialect) = crate::decks::dialect(code) else {
+            continue;
+        };
+        let key = format!("{} version", code.label());
+        match crate::decks::version::find_version(dialect) {
+            Ok(version) => {
+                provenance.insert(key, version.describe());
+                if let Some(w) = version.warning() {
+                    if !quiet {
+                        eprintln!("warning: {w}");
+                    }
+                    warnings.push(w);
+                }
+            }
+            Err(reason) => {
+                provenance.insert(key, format!("not available: {reason}"));
+            }
+        }
+    }
+    warnings
 }
 
 /// Runs and judges the suite's cases, each scene's in one section of `report`; returns every
@@ -116,7 +155,14 @@ fn run_cases(
                     .known_differences
                     .extend(case.known_differences.iter().cloned());
             }
-            None => scenes.push((scene, case.clone(), case_runs)),
+            None => {
+                // A scene's own `[discharge]` measures it when the suite gives none.
+                let mut case = case.clone();
+                if case.discharge.is_none() {
+                    case.discharge = scene.discharge.as_ref().map(Into::into);
+                }
+                scenes.push((scene, case, case_runs))
+            }
         }
     }
     let screws: Vec<(&Scene, &[RunRecord])> = scenes

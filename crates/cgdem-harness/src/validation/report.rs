@@ -110,43 +110,39 @@ fn write_status(
     options: &ValidateOptions,
 ) {
     use crate::report::Status;
-    let count = |v: Verdict| {
-        summary
-            .comparisons
-            .iter()
-            .filter(|c| c.verdict == v)
-            .count()
+    let counts = super::StatusCounts::of(summary);
+    let status = match summary.status {
+        super::Status::Green => Status::Pass,
+        super::Status::Amber => Status::Known,
+        super::Status::Incomplete => Status::Skipped,
+        super::Status::Red => Status::Fail,
     };
-    let (red, amber, green) = (
-        count(Verdict::Fail),
-        count(Verdict::KnownDifference),
-        count(Verdict::Pass),
-    );
     let failed_runs: Vec<&RunRecord> = summary
         .runs
         .iter()
         .filter(|r| r.status == Outcome::Failed)
         .collect();
-    let stability_failed = summary
-        .stability
-        .iter()
-        .filter(|r| r.code == Code::Cgdem && r.verdict == crate::stability::Verdict::Failed)
-        .count();
-    let (status, word) = if red > 0 || !failed_runs.is_empty() || stability_failed > 0 {
-        (Status::Fail, "red")
-    } else if amber > 0 {
-        (Status::Known, "amber")
-    } else {
-        (Status::Pass, "green")
-    };
     let mut line = format!(
-        "Status: {word}. {red} comparisons fail, {amber} are known differences inside their \
-         bands, {green} pass; {} of {} runs failed",
-        failed_runs.len(),
+        "Status: {}. {} comparisons fail, {} are known differences inside their bands, {} \
+         pass; {} of {} runs failed",
+        summary.status.word(),
+        counts.failed_comparisons,
+        counts.known_differences,
+        counts.passed_comparisons,
+        counts.failed_runs,
         summary.runs.len()
     );
     if !summary.stability.is_empty() {
-        line += &format!("; {stability_failed} cgdem stability verdicts failed");
+        line += &format!(
+            "; {} cgdem stability verdicts failed",
+            counts.failed_stability
+        );
+    }
+    if counts.skipped_runs + counts.skipped_stability > 0 {
+        line += &format!(
+            "; {} runs not made, so their comparisons are missing (listed below)",
+            counts.skipped_runs + counts.skipped_stability
+        );
     }
     line.push('.');
     intro.banner(status, line);
@@ -194,6 +190,11 @@ fn write_status(
         intro.paragraph("Red and amber rows:");
         intro.list(flagged);
     }
+    let not_made = not_made(summary);
+    if !not_made.is_empty() {
+        intro.paragraph("Runs not made (their comparisons are missing; the status is incomplete):");
+        intro.list(not_made);
+    }
     match &options.history {
         None => {
             intro.paragraph(
@@ -210,6 +211,47 @@ fn write_status(
             }
         }
     }
+}
+
+/// The runs that were not made, grouped by case, code and reason (a missing code skips
+/// every run of it alike: one line says so).
+fn not_made(summary: &ValidationSummary) -> Vec<Cell> {
+    let mut lines: Vec<(String, usize)> = Vec::new();
+    let mut add = |line: String| match lines.iter_mut().find(|(l, _)| *l == line) {
+        Some((_, n)) => *n += 1,
+        None => lines.push((line, 1)),
+    };
+    for r in summary.runs.iter().filter(|r| r.status == Outcome::Skipped) {
+        add(format!(
+            "{} in {}: {}",
+            r.case,
+            r.code.label(),
+            r.reason.as_deref().unwrap_or("not run")
+        ));
+    }
+    let points = summary.accuracy.as_ref().map_or(&[][..], |a| &a.points[..]);
+    for p in points.iter().filter(|p| p.status == Outcome::Skipped) {
+        add(format!(
+            "{} (accuracy sweep) in {}: {}",
+            p.case,
+            p.code.label(),
+            p.reason.as_deref().unwrap_or("not run")
+        ));
+    }
+    for r in &summary.stability {
+        if r.verdict == crate::stability::Verdict::Skipped {
+            add(format!(
+                "{} (stability) in {}: {}",
+                r.case,
+                r.code.label(),
+                r.message
+            ));
+        }
+    }
+    lines
+        .into_iter()
+        .map(|(line, n)| Cell::text(format!("{line} ({n} runs)")))
+        .collect()
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -681,9 +723,13 @@ pub(super) fn write_intro(
     summary: &ValidationSummary,
     suite: &Suite,
     options: &ValidateOptions,
+    warnings: &[String],
 ) {
     let intro = report.intro();
     write_status(intro, summary, options);
+    for w in warnings {
+        intro.banner(crate::report::Status::Known, format!("Warning: {w}"));
+    }
     let runs_at = match &options.runs_dir {
         None => "runs/".to_string(),
         Some(dir) => dir.display().to_string(),
