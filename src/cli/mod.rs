@@ -44,8 +44,12 @@ pub struct Cli {
 enum Command {
     /// Run a scene (a TOML case file) and write its outputs.
     Run(run::RunArgs),
-    /// Run a validation suite (validation/suites/*.toml) with cgdem and the reference codes,
-    /// compare the runs and write DIR/index.html, DIR/summary.json, figures and their CSV.
+    /// Run a validation suite (validation/suites/*.toml), or a scene file of your own, with
+    /// cgdem and the reference codes, compare the runs and write DIR/index.html,
+    /// DIR/summary.json, figures and their CSV. Exit status: 0 green or amber (only declared
+    /// known differences), 1 red, 2 could not run (bad arguments or files), 3 incomplete
+    /// (comparisons not made: a reference code missing or unable to express the case),
+    /// 130/143 interrupted.
     Validate(validate::ValidateArgs),
     /// Throughput of cgdem, LIGGGHTS and LAMMPS on the same case, side by side: every code
     /// starts from one state that cgdem prepares, runs the same steps, alternating (A B C,
@@ -218,12 +222,22 @@ fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, ExitCode> {
         })
 }
 
-/// The suite file a suite argument names: a path, or a name in validation/suites.
+/// The suite file a suite argument names: a path, or the name of a shipped suite, looked
+/// for in the working directory's validation/suites, then in the repository this cgdem was
+/// built from (so `--suite smoke` works from any directory on the machine that built it).
 fn suite_path(suite: &str) -> PathBuf {
     if suite.ends_with(".toml") || suite.contains('/') {
-        PathBuf::from(suite)
+        return PathBuf::from(suite);
+    }
+    let file = format!("{suite}.toml");
+    let here = PathBuf::from("validation/suites").join(&file);
+    let built_from = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("validation/suites")
+        .join(&file);
+    if !here.is_file() && built_from.is_file() {
+        built_from
     } else {
-        PathBuf::from("validation/suites").join(format!("{suite}.toml"))
+        here
     }
 }
 

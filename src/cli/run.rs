@@ -282,6 +282,9 @@ impl RunPlan {
         let inv = &self.invocation;
         let scene = load_scene(&inv.case, &inv.set, inv.variant.as_deref(), inv.seed)?;
         let (lambda, cg_rule) = (inv.lambda, inv.cg_rule);
+        for w in scene.implausible_parameters() {
+            eprintln!("warning: {w}");
+        }
         let checks = coarse_grain_checks(&scene, lambda, cg_rule);
         let refused: Vec<String> = checks
             .iter()
@@ -369,6 +372,8 @@ fn print_summary(summary: &RunSummary, figures: &[PathBuf], out_dir: &std::path:
         if let Some(rule) = &summary.repose_rule {
             println!("  rule: {rule}");
         }
+    } else if let Some(reason) = &summary.repose_not_measured {
+        println!("repose angle not measured: {reason}");
     }
     if let Some(p) = &summary.packing {
         println!(

@@ -9,17 +9,44 @@ use super::{checked_checkpoint_every, install_interrupt, interrupted, suite_path
 use cgdem_core::decomposition::{BalanceSpec, GridSpec};
 use cgdem_harness::code::Code;
 use cgdem_harness::runs::CgdemDecomposition;
-use cgdem_harness::validation::{validate, Outcome, ValidateOptions, ValidationSummary};
+use cgdem_harness::suite::Suite;
+use cgdem_harness::validation::{validate_suite, Outcome, ValidateOptions, ValidationSummary};
 use cgdem_harness::verdict::Verdict;
 
 #[derive(Args)]
 pub(super) struct ValidateArgs {
-    /// The suite: a name in validation/suites (smoke, nightly, full) or a path.
-    #[arg(long, default_value = "smoke")]
-    suite: String,
-    /// Output directory.
-    #[arg(long, default_value = "reports/latest")]
-    out: PathBuf,
+    /// A scene file of your own, validated without a suite file: run in cgdem, LIGGGHTS and
+    /// LAMMPS (--codes), 3 seeds (--seeds), and measured as its observers say ([repose],
+    /// [conveying], [discharge], [packing]), judged by the default tolerances.
+    #[arg(value_name = "CASE.toml", conflicts_with = "suite")]
+    case: Option<PathBuf>,
+    /// The suite: a shipped one (smoke, nightly, full, ...: validation/suites) or a suite
+    /// file's path; files it names are relative to it. Default: smoke.
+    #[arg(long)]
+    suite: Option<String>,
+    /// With CASE.toml: the codes that run it (cgdem,liggghts,lammps).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "case",
+        default_value = "cgdem,liggghts,lammps"
+    )]
+    codes: Vec<String>,
+    /// With CASE.toml: the coarse-graining levels (powers of two; 1 is the scene as written).
+    #[arg(long, value_delimiter = ',', requires = "case", default_value = "1")]
+    lambdas: Vec<u32>,
+    /// With CASE.toml: the insertion seeds, one run per code, level and seed.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "case",
+        default_value = "1,2,3"
+    )]
+    seeds: Vec<u64>,
+    /// Output directory (default: cgdem-reports/NAME in the working directory, NAME the
+    /// suite's or the case's name).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Worker threads for cgdem (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -98,11 +125,21 @@ pub(super) fn execute(args: ValidateArgs) -> ExitCode {
         Ok(pool) => pool,
         Err(code) => return code,
     };
+    let suite = match load_suite(&args) {
+        Ok(suite) => suite,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("cgdem-reports").join(&suite.name));
     let interrupt = install_interrupt();
-    let out = args.out.clone();
     let options = ValidateOptions {
-        suite: suite_path(&args.suite),
-        out: args.out,
+        suite: suite.source.clone(),
+        out: out.clone(),
         quiet: args.quiet,
         progress: crate::progress_bar::progress(args.quiet),
         reference_timeout_s: args.reference_timeout,
@@ -120,20 +157,51 @@ pub(super) fn execute(args: ValidateArgs) -> ExitCode {
         checkpoint_every,
         runs_dir: None,
     };
-    let result = pool.install(|| validate(&options));
+    let result = pool.install(|| validate_suite(&suite, &options));
     if let Some(code) = interrupted(&interrupt, &out) {
         if let Err(e) = &result {
             eprintln!("error: {e}");
         }
         return code;
     }
-    super::exit_with(result.map(|summary| {
-        println!(
-            "{}; report in {}",
-            counts(&summary),
-            out.join("index.html").display()
-        );
-    }))
+    match result {
+        Ok(summary) => {
+            println!(
+                "{}; status {}; report in {}",
+                counts(&summary),
+                summary.status.word(),
+                out.join("index.html").display()
+            );
+            ExitCode::from(summary.status.exit_code())
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// The suite to run: the one named by --suite (default smoke), or one made for CASE.toml.
+fn load_suite(args: &ValidateArgs) -> Result<Suite, String> {
+    let Some(case) = &args.case else {
+        let path = suite_path(args.suite.as_deref().unwrap_or("smoke"));
+        return Suite::load(&path).map_err(|e| e.to_string());
+    };
+    let scene = cgdem_core::scene::Scene::load(case).map_err(|e| e.to_string())?;
+    for w in scene.implausible_parameters() {
+        eprintln!("warning: {w}");
+    }
+    let codes = args
+        .codes
+        .iter()
+        .map(|name| {
+            Code::from_name(name).ok_or_else(|| {
+                format!("--codes {name:?}: not a code; allowed: cgdem, liggghts, lammps")
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Suite::for_scene(case, &scene.name, &codes, &args.lambdas, &args.seeds)
+        .map_err(|e| e.to_string())
 }
 
 /// The suite's runs, comparisons, accuracy points and stability runs, counted with their

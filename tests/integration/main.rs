@@ -19,3 +19,4 @@ mod scene_reference;
 mod scenes;
 mod scripts;
 mod stability;
+mod validate_status;

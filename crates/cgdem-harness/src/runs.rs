@@ -61,6 +61,9 @@ pub struct RunRecord {
     pub particle_steps_per_s: Option<f64>,
     pub repose_angle_deg: Option<f64>,
     pub repose_fit_r2: Option<f64>,
+    /// Why the repose angle was not measured, when the scene asks for one and it was not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repose_not_measured: Option<String>,
     pub runout_m: Option<f64>,
     /// The Hertz scene's tangential law (`history`, `coulomb`, `yang`); None for WCA.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -114,6 +117,7 @@ impl RunRecord {
             particle_steps_per_s: None,
             repose_angle_deg: None,
             repose_fit_r2: None,
+            repose_not_measured: None,
             runout_m: None,
             tangential: None,
             reused: false,
@@ -512,6 +516,7 @@ fn fill_from_summary(record: &mut RunRecord) {
     record.particle_steps_per_s = f("particle_steps_per_s");
     record.repose_angle_deg = f("repose_angle_deg");
     record.repose_fit_r2 = f("repose_fit_r2");
+    record.repose_not_measured = value["repose_not_measured"].as_str().map(str::to_string);
     record.runout_m = f("runout_m");
     let conveying = |key: &str| value["conveying"][key].as_f64();
     record.mass_flow_kg_s = conveying("mass_flow_kg_s");

@@ -77,13 +77,14 @@ pub struct ReposeFit {
     pub bins_used: usize,
 }
 
-/// Repose angle by the rule in the module doc; None if fewer than 3 bins fall in the window.
+/// Repose angle by the rule in the module doc; why it cannot be measured otherwise (fewer
+/// than 3 bins in the window, no slope to fit, or a fit that is not a finite number).
 pub fn repose_angle(
     profile: &HeapProfile,
     min_depth: Real,
     exclude_wall: Real,
     exclude_toe: Real,
-) -> Option<ReposeFit> {
+) -> Result<ReposeFit, String> {
     let front = profile.front(min_depth);
     let runout = front - profile.wall_x;
     let from = profile.wall_x + exclude_wall * runout;
@@ -92,8 +93,20 @@ pub fn repose_angle(
         .map(|k| (profile.bin_centre(k), profile.heights[k]))
         .filter(|&(x, _)| x >= from && x <= to)
         .collect();
-    let (slope, r_squared) = least_squares(&points)?;
-    Some(ReposeFit {
+    if points.len() < 3 {
+        return Err(format!(
+            "no heap to fit: {} profile bins between the wall and the front after the exclusions (at least 3 needed)",
+            points.len()
+        ));
+    }
+    let (slope, r_squared) =
+        least_squares(&points).ok_or("the profile's bins share one x: no slope to fit")?;
+    if !(slope.is_finite() && r_squared.is_finite() && runout.is_finite()) {
+        return Err(format!(
+            "the fit is not a finite number (slope {slope}, R^2 {r_squared}, run-out {runout} m): the heap's heights or the box overflow"
+        ));
+    }
+    Ok(ReposeFit {
         angle_deg: (-slope).atan().to_degrees(),
         r_squared,
         runout,

@@ -33,6 +33,9 @@ pub struct ReposeSample {
     pub trigger: SampleTrigger,
     pub repose_angle_deg: Option<Real>,
     pub repose_fit_r2: Option<Real>,
+    /// Why the angle could not be measured, when it could not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_measured: Option<String>,
     pub runout_m: Real,
     pub wall_height_m: Real,
 }
@@ -55,8 +58,9 @@ impl ReposeSample {
         ReposeSample {
             time_after_start_s,
             trigger,
-            repose_angle_deg: fit.as_ref().map(|f| f.angle_deg),
-            repose_fit_r2: fit.as_ref().map(|f| f.r_squared),
+            repose_angle_deg: fit.as_ref().ok().map(|f| f.angle_deg),
+            repose_fit_r2: fit.as_ref().ok().map(|f| f.r_squared),
+            not_measured: fit.as_ref().err().cloned(),
             runout_m: profile.front(2.0 * max_diameter) - profile.wall_x,
             wall_height_m: profile.wall_height(),
         }

@@ -91,6 +91,9 @@ pub struct RunSummary {
     pub repose_angle_deg: Option<Real>,
     pub repose_fit_r2: Option<Real>,
     pub repose_rule: Option<String>,
+    /// Why the headline repose angle could not be measured, when the scene asks for one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repose_not_measured: Option<String>,
     pub runout_m: Option<Real>,
     pub repose_samples: Vec<ReposeSample>,
     pub stages: Vec<StageRecord>,

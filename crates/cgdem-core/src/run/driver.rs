@@ -247,6 +247,7 @@ fn base_summary<L: PairLaw, W: WallLaw>(
         repose_angle_deg: None,
         repose_fit_r2: None,
         repose_rule: describe_repose_rule(scene),
+        repose_not_measured: None,
         runout_m: None,
         repose_samples: Vec::new(),
         stages: std::mem::take(&mut driver.stages),

@@ -4,6 +4,7 @@ mod cg_rule;
 mod error;
 mod materials;
 mod overrides;
+mod plausibility;
 mod raw;
 mod validate;
 
@@ -530,6 +531,24 @@ pub struct PackingSettings {
     pub bin_width_diameters: Real,
 }
 
+/// A discharge through an orifice (a silo, a hopper): the mass deleted in the scene's
+/// `[[delete]]` boxes against time gives the discharge rate, its slope over the stage after
+/// `discard` (measured by the validation harness from `timeseries.csv`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DischargeSettings {
+    /// The stage that opens the orifice; times count from its start.
+    pub stage: String,
+    /// The orifice's diameter, m (Beverloo's law; the smallest opening grains pass).
+    pub orifice_diameter: Real,
+    /// Start-up left out after the stage starts, s.
+    pub discard: Real,
+    /// Blocks of the steady window for the rate's standard error.
+    pub blocks: u32,
+    /// The box whose grains give the fill's bulk density when the stage starts, m.
+    pub bulk_lo: [Real; 3],
+    pub bulk_hi: [Real; 3],
+}
+
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum StageEnd {
     /// Run for this long.
@@ -634,6 +653,7 @@ pub struct Scene {
     pub deletions: Vec<(Vec3, Vec3)>,
     pub conveying: Option<ConveyingSettings>,
     pub packing: Option<PackingSettings>,
+    pub discharge: Option<DischargeSettings>,
 }
 
 /// What [`Scene::to_json`] writes.

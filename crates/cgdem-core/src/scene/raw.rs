@@ -42,6 +42,8 @@ pub struct RawScene {
     pub conveying: Option<RawConveying>,
     #[serde(default)]
     pub packing: Option<RawPacking>,
+    #[serde(default)]
+    pub discharge: Option<RawDischarge>,
     /// The built-in silo's dimensions, for `mesh = "silo:wall"` / `"silo:fill"`.
     #[serde(default)]
     pub silo: Option<RawSilo>,
@@ -322,4 +324,16 @@ pub struct RawRepose {
     pub bin_width_diameters: Option<f64>,
     pub exclude_wall_fraction: Option<f64>,
     pub exclude_toe_fraction: Option<f64>,
+}
+
+/// `[discharge]`: a hopper or silo emptied through an orifice into `[[delete]]` boxes.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDischarge {
+    pub stage: String,
+    pub orifice_diameter: f64,
+    pub discard: f64,
+    pub blocks: Option<u32>,
+    pub bulk_lo: [f64; 3],
+    pub bulk_hi: [f64; 3],
 }

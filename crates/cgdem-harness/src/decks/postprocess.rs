@@ -291,6 +291,10 @@ pub fn postprocess(
         threads: ranks,
         repose_angle_deg: headline.and_then(|s| s.repose_angle_deg),
         repose_fit_r2: headline.and_then(|s| s.repose_fit_r2),
+        repose_not_measured: scene.repose.as_ref().and_then(|_| match headline {
+            Some(s) => s.not_measured.clone(),
+            None => Some("the run left no heap profile at the repose times".into()),
+        }),
         repose_rule: scene.repose.as_ref().map(|r| format!("as cgdem's (analysis::heap), on the {} write_dump at {:?} s after stage `{}` began", plan.code, r.at_times, r.stage)),
         runout_m: headline.map(|s| s.runout_m),
         repose_samples: samples,

@@ -82,7 +82,7 @@ fn heap_figure(
         rule.exclude_wall_fraction,
         rule.exclude_toe_fraction,
     );
-    if let Some(fit) = fit {
+    if let Ok(fit) = fit {
         let window: Vec<(f64, f64)> = points
             .iter()
             .copied()

@@ -41,6 +41,20 @@ pub struct DischargeSettings {
     pub bulk_hi: [f64; 3],
 }
 
+impl From<&cgdem_core::scene::DischargeSettings> for DischargeSettings {
+    /// A scene's own `[discharge]` table, checked when the scene was read.
+    fn from(d: &cgdem_core::scene::DischargeSettings) -> Self {
+        DischargeSettings {
+            stage: d.stage.clone(),
+            orifice_diameter_m: d.orifice_diameter,
+            discard_s: d.discard,
+            blocks: d.blocks as usize,
+            bulk_lo: d.bulk_lo,
+            bulk_hi: d.bulk_hi,
+        }
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawDischarge {

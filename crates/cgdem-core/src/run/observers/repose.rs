@@ -150,6 +150,10 @@ impl<L: PairLaw, W: WallLaw> Observer<L, W> for ReposeMeter<'_> {
         let headline = headline_sample(&self.samples);
         summary.repose_angle_deg = headline.and_then(|s| s.repose_angle_deg);
         summary.repose_fit_r2 = headline.and_then(|s| s.repose_fit_r2);
+        summary.repose_not_measured = match headline {
+            Some(s) => s.not_measured.clone(),
+            None => Some("the run ended before the repose stage's first measurement".into()),
+        };
         summary.runout_m = headline.map(|s| s.runout_m);
         summary.repose_samples = std::mem::take(&mut self.samples);
         Ok(())

@@ -119,8 +119,14 @@ pub fn scene(raw: RawScene, file: &Path) -> Result<Scene, SceneError> {
         .as_ref()
         .map(|pk| packing::packing(&c, pk, &stages, &domain, &species))
         .transpose()?;
+    let discharge = raw
+        .discharge
+        .as_ref()
+        .map(|d| stages::discharge(&c, d, &stages, &deletions))
+        .transpose()?;
 
     Ok(Scene {
+        discharge,
         packing,
         bodies,
         deletions,

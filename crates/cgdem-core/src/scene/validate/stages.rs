@@ -1,4 +1,4 @@
-//! `[[stage]]`, `[output]` and `[repose]`.
+//! `[[stage]]`, `[output]`, `[repose]` and `[discharge]`.
 
 use super::super::raw::*;
 use super::super::*;
@@ -160,5 +160,68 @@ pub(super) fn repose(
             r.exclude_toe_fraction,
             0.15,
         )?,
+    })
+}
+
+/// `[discharge]`: its stage, orifice, window and bulk-density box; the discharged mass is
+/// what the `[[delete]]` boxes remove, so there must be one.
+pub(super) fn discharge(
+    c: &Checker,
+    d: &RawDischarge,
+    stages: &[Stage],
+    deletions: &[(Vec3, Vec3)],
+) -> Result<DischargeSettings, SceneError> {
+    c.one_of(
+        "discharge.stage",
+        &d.stage,
+        "stages",
+        stages.iter().map(|s| &s.name),
+    )?;
+    if deletions.is_empty() {
+        return Err(c.invalid(
+            "delete",
+            "(none)",
+            "at least one [[delete]] box with [discharge]: the discharged mass is what they remove",
+        ));
+    }
+    if !(d.orifice_diameter.is_finite() && d.orifice_diameter > 0.0) {
+        return Err(c.invalid(
+            "discharge.orifice_diameter",
+            d.orifice_diameter,
+            "a diameter in m, > 0",
+        ));
+    }
+    let stage = stages.iter().find(|s| s.name == d.stage).expect("checked");
+    let longest = match stage.end {
+        StageEnd::Duration(t) => t,
+        StageEnd::Settled { max_duration, .. } => max_duration,
+    };
+    if !(d.discard.is_finite() && d.discard >= 0.0 && d.discard < longest) {
+        return Err(c.invalid(
+            "discharge.discard",
+            d.discard,
+            format!("seconds >= 0 and shorter than the stage ({longest} s)"),
+        ));
+    }
+    let blocks = d.blocks.unwrap_or(5);
+    if blocks < 2 {
+        return Err(c.invalid("discharge.blocks", blocks, "an integer, at least 2"));
+    }
+    if (0..3).any(|i| {
+        !(d.bulk_lo[i].is_finite() && d.bulk_hi[i].is_finite() && d.bulk_hi[i] > d.bulk_lo[i])
+    }) {
+        return Err(c.invalid(
+            "discharge.bulk_hi",
+            format!("{:?} (bulk_lo {:?})", d.bulk_hi, d.bulk_lo),
+            "a box corner above bulk_lo along x, y and z, in m",
+        ));
+    }
+    Ok(DischargeSettings {
+        stage: d.stage.clone(),
+        orifice_diameter: d.orifice_diameter,
+        discard: d.discard,
+        blocks,
+        bulk_lo: d.bulk_lo,
+        bulk_hi: d.bulk_hi,
     })
 }
