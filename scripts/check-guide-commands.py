@@ -14,7 +14,7 @@ A page is read top to bottom:
                                            (default: a fresh scratch directory)
     <!-- guide-check: replace "A" -> "B" --> in CI, the blocks after it use B for A (a
                                            smaller case than the page's, to fit CI's time)
-    <!-- guide-check: exit N -->           the next block's commands exit with N
+    <!-- guide-check: exit N[,M] -->       the next block's commands exit with N (or M)
     <!-- guide-check: skip -->             the next block is not run (it installs or
                                            recurses, e.g. the test command itself)
 Exit status: 0 when every block ran as expected, 1 otherwise.
@@ -63,14 +63,14 @@ def check(page):
     env["PATH"] = f"{ROOT / 'target' / 'release'}:{env.get('PATH', '')}"
     failures = 0
     for directives, lang, body in blocks(text):
-        expected, skip = 0, False
+        expected, skip = {0}, False
         for d in directives:
             if d == "cwd repository":
                 cwd = ROOT
             elif d == "skip":
                 skip = True
             elif d.startswith("exit "):
-                expected = int(d.split()[1])
+                expected = {int(x) for x in d.split()[1].split(",")}
             elif m := REPLACE.fullmatch(d):
                 replacements.append((m.group(1), m.group(2)))
             else:
@@ -95,9 +95,9 @@ def check(page):
             started = time.time()
             p = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True)
             took = time.time() - started
-            status = "ok" if p.returncode == expected else "FAILED"
-            print(f"{page.name}: {status} ({took:.0f} s, exit {p.returncode}, expected {expected}): {command}")
-            if p.returncode != expected:
+            status = "ok" if p.returncode in expected else "FAILED"
+            print(f"{page.name}: {status} ({took:.0f} s, exit {p.returncode}, expected {sorted(expected)}): {command}")
+            if p.returncode not in expected:
                 failures += 1
                 print(p.stdout[-3000:])
                 print(p.stderr[-3000:], file=sys.stderr)
