@@ -557,7 +557,9 @@ mod tests {
         assert!(walls < settle && settle < turn && turn < top_up && top_up < convey);
         assert!(!d.contains("move_casing"));
         at(d, "dump            traj all custom");
-        assert!(deck.plan.notes.iter().any(|n| n.contains("fix evaporate")));
+        // The outlet's [[delete]] box is emptied every 100 steps, not left out with a note.
+        assert!(d[convey..].contains("every 100 \"delete_atoms region delete_0 compress no\""));
+        assert!(deck.plan.notes.iter().all(|n| !n.contains("evaporate")));
     }
 
     /// tests/data/tiny_two_material_collapse.toml: species bead (type 1) and grit (2), the
