@@ -96,7 +96,7 @@ fn reference_run(command: ReferenceCommand) -> Result<ExitCode, String> {
         }
         return Ok(code);
     }
-    let run = run?;
+    let run = run.map_err(|e| e.to_string())?;
     if let Some(w) = &run.dt_warning {
         eprintln!("warning: {w}");
     }

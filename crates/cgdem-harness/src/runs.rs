@@ -17,15 +17,19 @@ use cgdem_core::math::Real;
 use cgdem_core::run::{restart, CheckpointOptions, Progress, RunOptions, StageEnding};
 use cgdem_core::scene::{ContactSettings, Scene};
 
-/// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`.
+/// How a run ended; `summary.json` and the history files spell it `ok`, `failed`, `skipped`,
+/// `unsupported`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Outcome {
     /// It ran and its summary was read (it may still have stopped early: `partial`).
     Ok,
     Failed,
-    /// Not run: the code cannot run this scene, or it is not installed.
+    /// Not run: the code is not installed (or cgdem was interrupted before it).
     Skipped,
+    /// Not run: the code cannot express the scene (a feature it lacks, named in the reason),
+    /// so this code's comparison is not made.
+    Unsupported,
 }
 
 impl Outcome {
@@ -34,6 +38,7 @@ impl Outcome {
             Outcome::Ok => "ok",
             Outcome::Failed => "failed",
             Outcome::Skipped => "skipped",
+            Outcome::Unsupported => "unsupported",
         }
     }
 }
@@ -90,6 +95,10 @@ pub struct RunRecord {
     pub eq7_mass_flow_kg_s: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ratio_to_eq7: Option<f64>,
+    /// The run's own `summary.json` warnings: a reference deck's approximations of the scene
+    /// (reference/MAPPING.md) and the post-processing's caveats, shown with the case.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 impl RunRecord {
@@ -129,8 +138,52 @@ impl RunRecord {
             bulk_density_kg_m3: None,
             eq7_mass_flow_kg_s: None,
             ratio_to_eq7: None,
+            notes: Vec::new(),
         }
     }
+}
+
+/// What one code's runs of a case say beside their figures: why runs were not made
+/// (`Outcome::Unsupported`: what the code cannot express) and the runs' notes, each distinct
+/// text once.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CodeNotes {
+    pub code: Code,
+    pub unsupported: Vec<String>,
+    pub notes: Vec<String>,
+}
+
+/// Per code, in the order the runs name them, the reasons and notes of its runs; codes with
+/// neither are left out.
+pub fn notes_by_code(runs: &[RunRecord]) -> Vec<CodeNotes> {
+    let mut out: Vec<CodeNotes> = Vec::new();
+    let push = |v: &mut Vec<String>, text: &str| {
+        if !v.iter().any(|t| t == text) {
+            v.push(text.to_string());
+        }
+    };
+    for r in runs {
+        let at = match out.iter().position(|c| c.code == r.code) {
+            Some(at) => at,
+            None => {
+                out.push(CodeNotes {
+                    code: r.code,
+                    unsupported: Vec::new(),
+                    notes: Vec::new(),
+                });
+                out.len() - 1
+            }
+        };
+        let c = &mut out[at];
+        if let (Outcome::Unsupported, Some(reason)) = (r.status, &r.reason) {
+            push(&mut c.unsupported, reason);
+        }
+        for note in &r.notes {
+            push(&mut c.notes, note);
+        }
+    }
+    out.retain(|c| !c.unsupported.is_empty() || !c.notes.is_empty());
+    out
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -340,6 +393,10 @@ pub(super) fn run_one(
             record.status = Outcome::Skipped;
             record.reason = Some(reason);
         }
+        Err(RunOutcome::Unsupported(reason)) => {
+            record.status = Outcome::Unsupported;
+            record.reason = Some(reason);
+        }
         Err(RunOutcome::Failed(reason)) => {
             record.status = Outcome::Failed;
             record.reason = Some(reason);
@@ -350,6 +407,7 @@ pub(super) fn run_one(
 
 enum RunOutcome {
     Skipped(String),
+    Unsupported(String),
     Failed(String),
 }
 
@@ -421,7 +479,8 @@ fn finished_digest(dir: &Path) -> Option<String> {
 }
 
 /// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
-/// reused. LIGGGHTS cannot express the seed's WCA model: its runs of such a case are skipped.
+/// reused. A scene the code cannot express (LIGGGHTS and the seed's WCA model, or a feature
+/// a deck writer refuses) is `Unsupported`, with the reason.
 fn run_reference_code(
     code: Code,
     scene: &Scene,
@@ -431,7 +490,9 @@ fn run_reference_code(
     dir: &Path,
     validate: &ValidateOptions,
 ) -> Result<bool, RunOutcome> {
-    use super::decks::{run_reference, ReferenceOptions, RunStatus, RunnerOptions};
+    use super::decks::{
+        run_reference, DeckError, ReferenceError, ReferenceOptions, RunStatus, RunnerOptions,
+    };
     let reference = match code {
         Code::Liggghts => Code::Liggghts,
         _ => Code::Lammps,
@@ -439,7 +500,7 @@ fn run_reference_code(
     if reference == Code::Liggghts
         && matches!(scene.contact, cgdem_core::scene::ContactSettings::Wca(_))
     {
-        return Err(RunOutcome::Skipped(
+        return Err(RunOutcome::Unsupported(
             "LIGGGHTS cannot express the seed's WCA model (model = \"wca\"); it runs Hertz cases"
                 .into(),
         ));
@@ -471,7 +532,12 @@ fn run_reference_code(
         }
         options.postprocess_only = false;
     }
-    let run = run_reference(&coarse, dir, &options).map_err(RunOutcome::Failed)?;
+    let run = run_reference(&coarse, dir, &options).map_err(|e| match e {
+        ReferenceError::CannotExpress(DeckError::Unsupported { file, reason }) => {
+            RunOutcome::Unsupported(format!("{name} cannot express {file}: {reason}"))
+        }
+        ReferenceError::Failed(e) => RunOutcome::Failed(e),
+    })?;
     match run.status {
         RunStatus::Completed { .. } => Ok(false),
         RunStatus::Skipped {
@@ -510,6 +576,11 @@ fn fill_from_summary(record: &mut RunRecord) {
         }
     };
     let f = |key: &str| value.get(key).and_then(|v| v.as_f64());
+    record.notes = value["warnings"].as_array().map_or(Vec::new(), |w| {
+        w.iter()
+            .filter_map(|n| n.as_str().map(str::to_string))
+            .collect()
+    });
     record.n_particles = value.get("n_particles").and_then(|v| v.as_u64());
     record.steps = value.get("steps").and_then(|v| v.as_u64());
     record.wall_s = f("wall_s");
@@ -552,6 +623,7 @@ mod tests {
             (Outcome::Ok, "ok"),
             (Outcome::Failed, "failed"),
             (Outcome::Skipped, "skipped"),
+            (Outcome::Unsupported, "unsupported"),
         ] {
             let json = format!("\"{word}\"");
             assert_eq!(serde_json::to_string(&outcome).unwrap(), json);
@@ -559,6 +631,79 @@ mod tests {
             assert_eq!(outcome.to_string(), word);
         }
         assert!(serde_json::from_str::<Outcome>("\"completed\"").is_err());
+    }
+
+    /// A scene a reference code cannot express is recorded as `unsupported` with the feature
+    /// and why, before anything runs (no code needs to be installed), and the case's notes
+    /// carry the reason for that code.
+    #[test]
+    fn a_feature_a_code_cannot_express_is_recorded_as_unsupported_with_the_reason() {
+        crate::at_repo_root();
+        let mut scene = Scene::load(Path::new("tests/data/tiny_drop.toml")).unwrap();
+        let dir = std::env::temp_dir().join(format!("cgdem_unsupported_{}", std::process::id()));
+        let options = ValidateOptions::default();
+        let run = |scene: &Scene, code: Code| {
+            run_one(
+                scene,
+                code,
+                1,
+                CoarseGrainRule::Seed,
+                1,
+                &dir.join(code.name()),
+                &options,
+            )
+        };
+        // LIGGGHTS has no WCA model.
+        let liggghts = run(&scene, Code::Liggghts);
+        assert_eq!(liggghts.status, Outcome::Unsupported);
+        assert!(
+            liggghts.reason.as_deref().unwrap().contains("WCA"),
+            "{liggghts:?}"
+        );
+        // The LAMMPS seed-model deck refuses a [[delete]] box (it would run another case).
+        let lo = cgdem_core::math::Vec3::new(0.0, 0.0, 0.0);
+        scene
+            .deletions
+            .push((lo, cgdem_core::math::Vec3::new(0.12, 0.05, 0.01)));
+        let lammps = run(&scene, Code::Lammps);
+        assert_eq!(lammps.status, Outcome::Unsupported, "{lammps:?}");
+        let reason = lammps.reason.clone().unwrap();
+        assert!(
+            reason.starts_with("LAMMPS cannot express")
+                && reason.contains("tiny_drop.toml")
+                && reason.contains("no [[delete]]"),
+            "{reason}"
+        );
+        assert!(!dir.join("lammps").join("deck.in").exists());
+        let notes = notes_by_code(&[liggghts, lammps]);
+        assert_eq!(notes.len(), 2);
+        assert_eq!(
+            (notes[1].code, &notes[1].unsupported),
+            (Code::Lammps, &vec![reason])
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn notes_are_listed_per_code_each_once() {
+        let record = |code: Code, seed: u64, notes: &[&str]| RunRecord {
+            notes: notes.iter().map(|n| n.to_string()).collect(),
+            ..RunRecord::ok("c".into(), code, 1, CoarseGrainRule::Seed, seed, "d".into())
+        };
+        let runs = [
+            record(Code::Cgdem, 1, &[]),
+            record(Code::Liggghts, 1, &["sliver", "vanished"]),
+            record(Code::Liggghts, 2, &["vanished"]),
+        ];
+        let notes = notes_by_code(&runs);
+        assert_eq!(
+            notes,
+            vec![CodeNotes {
+                code: Code::Liggghts,
+                unsupported: vec![],
+                notes: vec!["sliver".into(), "vanished".into()]
+            }]
+        );
     }
 
     #[test]

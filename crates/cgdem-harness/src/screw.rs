@@ -200,7 +200,9 @@ pub fn write_screw_section(
         let status = match r.status {
             Outcome::Ok if r.partial => Cell::skipped(r.reason.clone().unwrap_or_default()),
             Outcome::Ok => Cell::pass("ok"),
-            Outcome::Skipped => Cell::skipped(r.reason.clone().unwrap_or_default()),
+            Outcome::Skipped | Outcome::Unsupported => {
+                Cell::skipped(r.reason.clone().unwrap_or_default())
+            }
             Outcome::Failed => Cell::fail(r.reason.clone().unwrap_or_default()),
         };
         table.row([

@@ -112,6 +112,10 @@ fn points_table(points: &[AccuracyPoint], measures: &[Measure]) -> Table {
             Outcome::Skipped => {
                 Cell::skipped(format!("skipped: {}", p.reason.clone().unwrap_or_default()))
             }
+            Outcome::Unsupported => Cell::skipped(format!(
+                "unsupported: {}",
+                p.reason.clone().unwrap_or_default()
+            )),
             Outcome::Failed => {
                 Cell::fail(format!("failed: {}", p.reason.clone().unwrap_or_default()))
             }

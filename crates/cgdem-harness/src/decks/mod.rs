@@ -28,7 +28,7 @@ pub mod version;
 
 pub use dump::{parse_dump, read_dump, DumpError, Frame};
 pub use postprocess::{postprocess, write_summary, PostprocessError};
-pub use run::{run_reference, ReferenceOptions, ReferenceRun};
+pub use run::{run_reference, ReferenceError, ReferenceOptions, ReferenceRun};
 pub use runner::{RunStatus, RunnerOptions, INSTALL_HINT};
 
 use std::path::{Path, PathBuf};
@@ -136,6 +136,21 @@ pub struct DeckPlan {
     pub dump_every: u64,
     /// (stage, time after the stage starts, dump file) of each repose sample.
     pub repose_dumps: Vec<(String, Real, String)>,
+}
+
+/// What every reference deck leaves to cgdem, whatever the code, as notes for the run's
+/// summary (shown with the case in the report; reference/MAPPING.md, "Scene features").
+pub(crate) fn scene_notes(scene: &Scene, code: &str) -> Vec<String> {
+    let mut notes = Vec::new();
+    if scene.integrator == cgdem_core::integrate::Integrator::Pcvv {
+        notes.push(format!("{code} integrates with velocity Verlet (`nve/sphere`), cgdem with the predictor-corrector the scene asks for (integrator = \"pcvv\"): both second order, their step errors differ"));
+    }
+    if scene.packing.is_some() {
+        notes.push(format!(
+            "{code}: the porosity and pore sizes of [packing] are measured in cgdem's runs only"
+        ));
+    }
+    notes
 }
 
 /// The deck text, the data file text and the plan.

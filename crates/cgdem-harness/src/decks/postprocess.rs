@@ -233,6 +233,7 @@ pub fn postprocess(
     let frames = read_dump(&traj_path)?;
     let last_state = write_timeseries(scene, dir, &marks, &frames, &traj_path, dt)?;
     let mut warnings = plan.notes.clone();
+    warnings.extend(super::scene_notes(scene, plan.code));
     let samples = write_repose(
         scene,
         dir,

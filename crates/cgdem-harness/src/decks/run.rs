@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::{dialect, postprocess, run_deck, write_deck, write_summary, DECK_FILE};
-use super::{RunStatus, RunnerOptions};
+use super::{DeckError, RunStatus, RunnerOptions};
 use crate::code::Code;
 use cgdem_core::output_format::RunSummary;
 use cgdem_core::scene::Scene;
@@ -47,22 +47,39 @@ pub struct ReferenceRun {
     pub partial_error: Option<String>,
 }
 
+/// Why `run_reference` made no run: the code cannot express the scene (its comparison is not
+/// made, for that reason), or anything else went wrong.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ReferenceError {
+    #[error(transparent)]
+    CannotExpress(#[from] DeckError),
+    #[error("{0}")]
+    Failed(String),
+}
+
+impl From<String> for ReferenceError {
+    fn from(message: String) -> Self {
+        ReferenceError::Failed(message)
+    }
+}
+
 /// Writes the deck for `scene` (already coarse-grained) into `out`, runs the reference code
-/// (`options.code`) there and post-processes its dumps into cgdem's output files. Returns how the run ended, with the
-/// summary when there is one (also for a timed-out, partial run).
+/// (`options.code`) there and post-processes its dumps into cgdem's output files. Returns how
+/// the run ended, with the summary when there is one (also for a timed-out, partial run); a
+/// scene the code cannot express is [`ReferenceError::CannotExpress`], before anything runs.
 pub fn run_reference(
     scene: &Scene,
     out: &Path,
     options: &ReferenceOptions,
-) -> Result<ReferenceRun, String> {
+) -> Result<ReferenceRun, ReferenceError> {
     let (dt, scales, dt_warning) =
         cgdem_core::run::time_step(scene, options.force_dt).map_err(|e| e.to_string())?;
     let particles =
         cgdem_core::run::initial_particles_clear_of_bodies(scene).map_err(|e| e.to_string())?;
     let Some(dialect) = dialect(options.code) else {
-        return Err("cgdem is not a reference code".into());
+        return Err("cgdem is not a reference code".to_string().into());
     };
-    let deck = write_deck(options.code, scene, &particles, dt).map_err(|e| e.to_string())?;
+    let deck = write_deck(options.code, scene, &particles, dt)?;
     let status = if options.postprocess_only {
         let path = out.join(DECK_FILE);
         let previous = std::fs::read_to_string(&path)
@@ -71,7 +88,8 @@ pub fn run_reference(
             return Err(format!(
                 "--postprocess-only: {} was not written for this case, lambda and seed",
                 path.display()
-            ));
+            )
+            .into());
         }
         RunStatus::Completed { wall_s: f64::NAN }
     } else {
@@ -100,7 +118,7 @@ pub fn run_reference(
             run.partial_error = Some(e.to_string());
             return Ok(run);
         }
-        Err(e) => return Err(e.to_string()),
+        Err(e) => return Err(e.to_string().into()),
     };
     if let RunStatus::TimedOut { after_s, cpu_s, .. } = &run.status {
         summary.warnings.push(format!(

@@ -57,12 +57,15 @@ pub(crate) struct Periodic {
 }
 
 /// What a code's deck adds to the shared stage lines: `unfix(wall)` removes a wall,
-/// `begin(stage)` adds what starts with a stage (a body's motion, a top-up), and
-/// `periodic(stage)` gives lines to run every so many steps of a duration stage.
+/// `begin(stage)` adds what starts with a stage (a body's motion, a top-up),
+/// `periodic(stage)` gives lines to run every so many steps of a duration stage, and
+/// `run(n)` is the line that runs `n` steps after the first setup ([`run_without_setup`],
+/// or LIGGGHTS's deletion chunks).
 pub(crate) struct StageHooks<'a> {
     pub unfix: &'a dyn Fn(&str) -> String,
     pub begin: &'a dyn Fn(&str) -> String,
     pub periodic: &'a dyn Fn(&str) -> Option<Periodic>,
+    pub run: &'a dyn Fn(u64) -> String,
 }
 
 impl StageHooks<'_> {
@@ -72,8 +75,14 @@ impl StageHooks<'_> {
             unfix,
             begin: &|_| String::new(),
             periodic: &|_| None,
+            run: &run_without_setup,
         }
     }
+}
+
+/// `run n pre no post no`: `n` steps without a new setup (see [`stage_lines`]).
+pub(crate) fn run_without_setup(n: u64) -> String {
+    format!("run             {n} pre no post no\n")
 }
 
 /// Where a duration stage stops: repose sample `j` at time `t`, or periodic stop `n`.
@@ -85,8 +94,8 @@ enum Stop {
 
 /// The scene's stages as deck lines (LAMMPS and LIGGGHTS take the same commands), appended to
 /// `d` after the trajectory dump is defined; returns the repose samples (stage, time after
-/// its start, file). One `run 0` sets the system up; every later run is `pre no`, so it is set
-/// up exactly once: LAMMPS's `fix wall/gran ... damping tsuji` applies its polynomial to its
+/// its start, file). One `run 0` sets the system up; every later run is `hooks.run`, which in
+/// the LAMMPS decks is `pre no` ([`run_without_setup`]), so it is set up exactly once: LAMMPS's `fix wall/gran ... damping tsuji` applies its polynomial to its
 /// stored coefficient in every setup (measured: a second setup turned the wall restitution
 /// 0.49998 into 0.60055, a third into 0.49247; `reference/HERTZ_COLLAPSE.md`), and the LAMMPS
 /// decks pad their fix list for the `unfix` that follows ([`removal_pads`]). A stage first
@@ -150,7 +159,7 @@ pub(crate) fn stage_lines(
                 let mut done = 0;
                 for (at, stop) in stops {
                     if at > done {
-                        let _ = writeln!(d, "run             {} pre no post no", at - done);
+                        *d += &(hooks.run)(at - done);
                         done = at;
                     }
                     match stop {
@@ -168,7 +177,7 @@ pub(crate) fn stage_lines(
                     }
                 }
                 if total > done {
-                    let _ = writeln!(d, "run             {} pre no post no", total - done);
+                    *d += &(hooks.run)(total - done);
                 }
                 let _ = writeln!(
                     d,
@@ -186,7 +195,7 @@ pub(crate) fn stage_lines(
                 let (var, label) = (format!("chunk{k}"), format!("stage{k}"));
                 let _ = writeln!(d, "variable        {var} loop {max_chunks}");
                 let _ = writeln!(d, "label           loop_{label}");
-                let _ = writeln!(d, "run             {dump_every} pre no post no");
+                *d += &(hooks.run)(dump_every);
                 // Fixed-time repose samples inside a stage that ends by itself: the loop
                 // counts chunks of one output interval, so sample j is chunk round(t_j / chunk).
                 for (j, &t) in repose_times.iter().enumerate() {

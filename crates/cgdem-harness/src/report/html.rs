@@ -307,6 +307,11 @@ impl Report {
         self.sections.last_mut().expect("just pushed")
     }
 
+    /// The section written last, to add to (none before the first).
+    pub fn last_section(&mut self) -> Option<&mut Section> {
+        self.sections.last_mut()
+    }
+
     /// The page as a string; links to CSV/SVG files are made relative to
     /// `page_dir`, the directory the page will be written to.
     pub fn render(&self, page_dir: &Path) -> String {

@@ -32,7 +32,7 @@ use crate::suite::{Suite, SuiteCase};
 use cgdem_core::io::write_atomic;
 use cgdem_core::scene::Scene;
 use measurement::compare;
-use report::{provenance, write_case_section, write_intro};
+use report::{provenance, write_case_section, write_code_notes, write_intro};
 use runs::run_case;
 
 /// What `cgdem validate` found, as `summary.json` holds it.
@@ -213,6 +213,7 @@ fn run_cases(
                 verdict.as_ref().map(|c| (c.verdict, c.detail.as_str())),
                 &options.out,
             )?;
+            write_code_notes(report, &case_runs);
             runs.extend(case_runs);
             comparisons.extend(verdict);
             continue;
@@ -220,6 +221,7 @@ fn run_cases(
         if scene.conveying.is_some() {
             // A screw case is judged by its mass flow against Eq. (7), code by code.
             super::screw::write_screw_section(report, &scene, &case, &case_runs, &options.out)?;
+            write_code_notes(report, &case_runs);
             runs.extend(case_runs);
             continue;
         }
@@ -232,6 +234,7 @@ fn run_cases(
             &case_comparisons,
             &options.out,
         )?;
+        write_code_notes(report, &case_runs);
         runs.extend(case_runs);
         comparisons.extend(case_comparisons);
     }

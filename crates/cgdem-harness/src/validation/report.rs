@@ -391,6 +391,21 @@ pub(super) fn write_case_section(
     Ok(())
 }
 
+/// At the end of the case's section (written last): per code, what it could not express (its
+/// comparisons not made) and what its runs noted (a deck's approximations of the scene).
+pub(super) fn write_code_notes(report: &mut Report, runs: &[RunRecord]) {
+    let Some(section) = report.last_section() else {
+        return;
+    };
+    for c in crate::runs::notes_by_code(runs) {
+        section.paragraph(format!("{} runs:", c.code.label()));
+        let unsupported = (c.unsupported.iter())
+            .map(|r| Cell::skipped(format!("not compared, cannot express the case: {r}")));
+        let notes = c.notes.iter().map(Cell::text);
+        section.list(unsupported.chain(notes).collect());
+    }
+}
+
 /// The case's similarity section: for every compared pair, the final state and the dynamics
 /// judged separately (a pair is similar only if both pass), and the flow histories behind the
 /// dynamics, mean over seeds, one line per code, level and rule.
@@ -759,6 +774,10 @@ pub(super) fn write_intro(
             Outcome::Skipped => {
                 Cell::skipped(format!("skipped: {}", r.reason.clone().unwrap_or_default()))
             }
+            Outcome::Unsupported => Cell::skipped(format!(
+                "unsupported: {}",
+                r.reason.clone().unwrap_or_default()
+            )),
             Outcome::Failed => {
                 Cell::fail(format!("failed: {}", r.reason.clone().unwrap_or_default()))
             }

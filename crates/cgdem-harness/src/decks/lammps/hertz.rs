@@ -29,12 +29,15 @@ use crate::decks::hertz::{hertz_settings, material, wall_material, HERTZ_COLUMNS
 use crate::decks::lines::{
     block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
-use crate::decks::stages::{stage_lines, trajectory_lines, Periodic, StageHooks};
+use crate::decks::stages::{
+    run_without_setup, stage_lines, trajectory_lines, Periodic, StageHooks,
+};
 use crate::decks::{Deck, DeckError, DeckPlan};
 use cgdem_core::contact::normal::Material;
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
 use cgdem_core::scene::{ContactTables, HertzSettings, RollingKind, Scene};
+use cgdem_core::simulation::DELETE_EVERY;
 
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
 /// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
@@ -42,8 +45,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     // A scene with material tables: one `pair_coeff I J` per species pair and one wall fix
-    // per wall and mobile species (`super::tables`); without, the
-    // one material of `[contact]`.
+    // per wall and mobile species (`super::tables`); without, the one material of `[contact]`.
     let tables = if scene.gives_material_tables() {
         if !scene.bodies.is_empty() {
             return Err(unsupported("LAMMPS decks with bodies take the one material and coefficients of [contact] and [wall_contact]: this scene has materials per species or pair (LIGGGHTS decks take them)".into()));
@@ -99,7 +101,7 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
         }
     }
     d += &removal_pads(scene, wall_groups.len());
-    d += &deletion_lines(scene, integrated, dump_every);
+    d += &deletion_lines(scene, integrated);
     let top_ups = top_up_lines(scene, integrated, dt, &mut files);
     d += &top_ups.setup;
     let dumps = trajectory_lines(
@@ -137,13 +139,14 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
             },
             begin: &begin,
             periodic: &periodic,
+            run: &run_without_setup,
         },
     );
     let mut notes = bodies.notes;
     if !bodies.refix_walls.is_empty() && later_setups {
         notes.push("LAMMPS: the body region's wall fix is defined anew at each setup (when the screw starts, at each top-up), so grains sliding on the casing lose their tangential history then".into());
     }
-    notes.extend(model_notes(scene, h, dump_every));
+    notes.extend(model_notes(h));
     Ok(Deck {
         input: d,
         data,
@@ -271,15 +274,15 @@ fn wall_fix_lines(scene: &Scene, wall_model: &str) -> Result<String, DeckError> 
     Ok(lines)
 }
 
-/// `[[delete]]` boxes: grains whose centres enter one are removed, checked every output
-/// interval.
-fn deletion_lines(scene: &Scene, integrated: &str, dump_every: u64) -> String {
+/// `[[delete]]` boxes: grains whose centres enter one are removed, checked every
+/// [`DELETE_EVERY`] steps as in cgdem.
+fn deletion_lines(scene: &Scene, integrated: &str) -> String {
     let mut d = String::new();
     for (k, (lo, hi)) in scene.deletions.iter().enumerate() {
         d += &block_region(&format!("delete_{k}"), *lo, *hi);
         let _ = writeln!(
             d,
-            "fix             delete_{k} {integrated} evaporate {dump_every} 1000000 delete_{k} {}",
+            "fix             delete_{k} {integrated} evaporate {DELETE_EVERY} 1000000 delete_{k} {}",
             DEPOSIT_SEEDS[k % DEPOSIT_SEEDS.len()]
         );
     }
@@ -287,11 +290,8 @@ fn deletion_lines(scene: &Scene, integrated: &str, dump_every: u64) -> String {
 }
 
 /// Where this LAMMPS deck's model differs from cgdem's and LIGGGHTS's.
-fn model_notes(scene: &Scene, h: &HertzSettings, dump_every: u64) -> Vec<String> {
+fn model_notes(h: &HertzSettings) -> Vec<String> {
     let mut notes = Vec::new();
-    if !scene.deletions.is_empty() {
-        notes.push(format!("LAMMPS deletes grains in a [[delete]] box every {dump_every} steps (fix evaporate), cgdem every step"));
-    }
     if h.rolling == RollingKind::Epsd2 {
         notes.push(format!("LAMMPS rolling sds has a constant stiffness (that of the Hertz tangential spring at the largest overlap of a {} m/s impact), LIGGGHTS/cgdem epsd2 the current k_t R*^2 (reference/MAPPING.md)", h.characteristic_velocity));
     }

@@ -159,6 +159,11 @@ fn wca_settings(scene: &Scene, dt: Real) -> Result<(WcaSettings, Vec<Real>), Dec
             "LAMMPS seed-model decks take planar walls only (no [[body]], no [[delete]])".into(),
         ));
     }
+    if scene.insertions.iter().any(|i| i.refill.is_some()) {
+        return Err(unsupported(
+            "LAMMPS seed-model decks take no top-ups ([[insert]] refill): the region would not be refilled".into(),
+        ));
+    }
     let masses: Vec<Real> = scene.species.iter().map(|s| s.mass()).collect();
     let wall_mass = masses[0];
     if !scene.walls.is_empty()

@@ -21,12 +21,13 @@ use crate::decks::hertz::{hertz_settings, wall_axis, HERTZ_COLUMNS};
 use crate::decks::lines::{
     block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
 };
-use crate::decks::stages::{stage_lines, trajectory_lines, StageHooks};
+use crate::decks::stages::{run_without_setup, stage_lines, trajectory_lines, StageHooks};
 use crate::decks::{Deck, DeckError, DeckPlan};
 use cgdem_core::contact::normal::Material;
 use cgdem_core::math::Real;
 use cgdem_core::particles::Particles;
 use cgdem_core::scene::{ContactTables, HertzSettings, PairProperties, RollingKind, Scene};
+use cgdem_core::simulation::DELETE_EVERY;
 
 /// LIGGGHTS 3.8 rejects a Young's modulus below this in SI units.
 pub const MIN_YOUNGS_MODULUS: Real = 5e6;
@@ -93,6 +94,8 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
         }
         lines
     };
+    d += &deletion_regions(scene);
+    let run = |n: u64| run_lines(scene, n);
     let repose_dumps = stage_lines(
         &mut d,
         scene,
@@ -103,6 +106,7 @@ pub fn write_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck
             unfix: &unfix,
             begin: &begin,
             periodic: &|_| None,
+            run: &run,
         },
     );
     Ok(Deck {
@@ -356,10 +360,34 @@ fn mesh_lines(scene: &Scene, types: &AtomTypes, rolling: &str) -> Result<MeshLin
         names.len(),
         names.join(" ")
     );
-    if !scene.deletions.is_empty() {
-        out.notes.push("LIGGGHTS 3.8 has no `fix evaporate`: grains in a [[delete]] box are not deleted there; they fall on and leave through the box's lower face (`thermo_modify lost ignore`), which changes nothing upstream of the box".into());
-    }
     Ok(out)
+}
+
+/// The `[[delete]]` boxes as regions `delete_K`.
+fn deletion_regions(scene: &Scene) -> String {
+    (scene.deletions.iter().enumerate())
+        .map(|(k, (lo, hi))| block_region(&format!("delete_{k}"), *lo, *hi))
+        .collect()
+}
+
+/// The line that runs `n` steps of a stage. LIGGGHTS 3.8 has no `fix evaporate`: with
+/// `[[delete]]` boxes, the run goes in chunks of cgdem's [`DELETE_EVERY`] steps (counted from
+/// the run's start; cgdem counts from the first step, a phase that changes nothing), each
+/// followed by `delete_atoms region delete_K compress no` (ids kept, so the post-processing
+/// counts the grains that vanished as deleted). Deleting atoms invalidates the neighbour
+/// lists, so every chunk is set up again (`pre yes`): measured on the hopper check,
+/// reference/MAPPING.md. Without boxes, `run n pre no post no`.
+fn run_lines(scene: &Scene, n: u64) -> String {
+    if scene.deletions.is_empty() {
+        return run_without_setup(n);
+    }
+    let deletes: Vec<String> = (0..scene.deletions.len())
+        .map(|k| format!("\"delete_atoms region delete_{k} compress no\""))
+        .collect();
+    format!(
+        "run             {n} pre yes post no every {DELETE_EVERY} {}\n",
+        deletes.join(" ")
+    )
 }
 
 /// `fix move/mesh ... rotate` for each piece of a turning body: LIGGGHTS turns
@@ -529,7 +557,9 @@ mod tests {
         assert!(walls < settle && settle < turn && turn < top_up && top_up < convey);
         assert!(!d.contains("move_casing"));
         at(d, "dump            traj all custom");
-        assert!(deck.plan.notes.iter().any(|n| n.contains("fix evaporate")));
+        // The outlet's [[delete]] box is emptied every 100 steps, not left out with a note.
+        assert!(d[convey..].contains("every 100 \"delete_atoms region delete_0 compress no\""));
+        assert!(deck.plan.notes.iter().all(|n| !n.contains("evaporate")));
     }
 
     /// tests/data/tiny_two_material_collapse.toml: species bead (type 1) and grit (2), the
@@ -618,6 +648,41 @@ mod tests {
         let unfix = at(d, "unfix           w_gate\nrun             0 post no\n");
         let discharge = at(d, "CGDEM_STAGE discharge start");
         assert!(mesh < unfix && unfix < discharge);
+    }
+
+    /// LIGGGHTS 3.8 has no `fix evaporate`: a [[delete]] box is a region emptied with
+    /// `delete_atoms` (ids kept) after every 100 steps of every stage run, each chunk set up
+    /// again; a deck without boxes runs its stages without a new setup.
+    #[test]
+    fn a_delete_box_is_emptied_between_run_chunks_at_cgdems_cadence() {
+        crate::at_repo_root();
+        let scene =
+            Scene::load(std::path::Path::new("validation/cases/silo_reduced.toml")).unwrap();
+        let deck = write_deck(&scene, &Particles::new(true), 1.25e-5).unwrap();
+        let d = &deck.input;
+        at(d, "region          delete_0 block");
+        let chunk = format!(
+            "pre yes post no every {DELETE_EVERY} \"delete_atoms region delete_0 compress no\"\n"
+        );
+        // The fill's settle loop (one output interval, 800 steps) and the 0.6 s discharge.
+        at(d, &format!("run             800 {chunk}"));
+        at(d, &format!("run             48000 {chunk}"));
+        let stage_runs: Vec<&str> = d.lines().filter(|l| l.starts_with("run ")).collect();
+        assert!(
+            stage_runs
+                .iter()
+                .all(|l| l.ends_with(&chunk[..chunk.len() - 1]) || l.contains(" 0 post no")),
+            "{stage_runs:?}"
+        );
+        assert!(deck.plan.notes.iter().all(|n| !n.contains("[[delete]]")));
+
+        let (scene, particles) = collapse_scene_and_particle();
+        assert!(scene.deletions.is_empty());
+        let d = write_deck(&scene, &particles, 5e-5).unwrap().input;
+        assert!(
+            d.contains(" pre no post no\n") && !d.contains("delete_atoms"),
+            "{d}"
+        );
     }
 
     #[test]
