@@ -235,11 +235,12 @@ fn counts(summary: &ValidationSummary) -> String {
         );
     }
     format!(
-        "suite {}: {} runs ({} failed, {} skipped), {} comparisons ({} fail, {known} known differences){extra}",
+        "suite {}: {} runs ({} failed, {} skipped: code missing, {} unsupported: code cannot express the case), {} comparisons ({} fail, {known} known differences){extra}",
         summary.suite,
         summary.runs.len(),
         runs(Outcome::Failed),
         runs(Outcome::Skipped),
+        runs(Outcome::Unsupported),
         summary.comparisons.len(),
         failed,
     )

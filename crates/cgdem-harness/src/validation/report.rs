@@ -221,7 +221,8 @@ fn not_made(summary: &ValidationSummary) -> Vec<Cell> {
         Some((_, n)) => *n += 1,
         None => lines.push((line, 1)),
     };
-    for r in summary.runs.iter().filter(|r| r.status == Outcome::Skipped) {
+    let not_run = |o: Outcome| matches!(o, Outcome::Skipped | Outcome::Unsupported);
+    for r in summary.runs.iter().filter(|r| not_run(r.status)) {
         add(format!(
             "{} in {}: {}",
             r.case,
@@ -230,7 +231,7 @@ fn not_made(summary: &ValidationSummary) -> Vec<Cell> {
         ));
     }
     let points = summary.accuracy.as_ref().map_or(&[][..], |a| &a.points[..]);
-    for p in points.iter().filter(|p| p.status == Outcome::Skipped) {
+    for p in points.iter().filter(|p| not_run(p.status)) {
         add(format!(
             "{} (accuracy sweep) in {}: {}",
             p.case,

@@ -70,6 +70,7 @@ pub struct StatusCounts {
     pub known_differences: usize,
     pub passed_comparisons: usize,
     pub failed_runs: usize,
+    /// Runs not made: the code is missing (skipped) or cannot express the case (unsupported).
     pub skipped_runs: usize,
     /// cgdem's failed stability verdicts (a reference code failing a stiff case is its
     /// own affair, reported but not red).
@@ -98,7 +99,8 @@ impl StatusCounts {
             known_differences: verdicts(Verdict::KnownDifference),
             passed_comparisons: verdicts(Verdict::Pass),
             failed_runs: runs(Outcome::Failed),
-            skipped_runs: runs(Outcome::Skipped),
+            // Not made: a code missing, or unable to express the case.
+            skipped_runs: runs(Outcome::Skipped) + runs(Outcome::Unsupported),
             failed_stability: summary
                 .stability
                 .iter()
