@@ -626,7 +626,11 @@ mod tests {
                     .filter(|r| r.text(setting).unwrap() != "reference")
                     .map(|r| {
                         (
-                            r.text(rule).unwrap().to_string(),
+                            // Stored before the rule's rename: "seed" is relative-overlap.
+                            CoarseGrainRule::from_name(r.text(rule).unwrap())
+                                .unwrap()
+                                .name()
+                                .to_string(),
                             r.parse::<u32>(lambda).unwrap(),
                             r.parse::<f64>(error).unwrap(),
                             r.parse::<f64>(reach).unwrap(),
