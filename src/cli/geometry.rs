@@ -11,8 +11,8 @@ use cgdem_harness::report::sdf_study::write_sdf_accuracy_study;
 
 #[derive(Subcommand)]
 pub(super) enum GeometryCommand {
-    /// Write screw.stl, casing.stl, hopper.stl and insertion.stl of paper A's screw feeder
-    /// (reference/SCREW_GEOMETRY.md) and print the layout.
+    /// Write screw.stl, casing.stl, hopper.stl and insertion.stl of the screw feeder of
+    /// Hirose's paper (reference/SCREW_GEOMETRY.md) and print the layout.
     ScrewFeeder {
         #[arg(long)]
         out: PathBuf,

@@ -73,7 +73,7 @@ enum Command {
         #[command(subcommand)]
         code: reference::ReferenceCommand,
     },
-    /// Geometry tools: the seed's screw-feeder meshes and the SDF accuracy study.
+    /// Geometry tools: the meshes of Hirose's screw feeder and the SDF accuracy study.
     Geometry {
         #[command(subcommand)]
         command: geometry::GeometryCommand,
@@ -95,11 +95,13 @@ impl Cli {
     }
 }
 
-/// The coarse-graining rules as command-line values (`seed`, `bulk-viscosity`,
-/// `scaled-particle`, `liggghts-pfm`).
+/// The coarse-graining rules as command-line values (`relative-overlap`, `bulk-viscosity`,
+/// `scaled-particle`, `liggghts-pfm`); `seed`, the first name of `relative-overlap`, is still
+/// accepted.
 #[derive(Clone, Copy, ValueEnum)]
 enum CgRule {
-    Seed,
+    #[value(alias = "seed")]
+    RelativeOverlap,
     BulkViscosity,
     ScaledParticle,
     LiggghtsPfm,
@@ -108,7 +110,7 @@ enum CgRule {
 impl From<CgRule> for CoarseGrainRule {
     fn from(rule: CgRule) -> Self {
         match rule {
-            CgRule::Seed => CoarseGrainRule::Seed,
+            CgRule::RelativeOverlap => CoarseGrainRule::RelativeOverlap,
             CgRule::BulkViscosity => CoarseGrainRule::BulkViscosity,
             CgRule::ScaledParticle => CoarseGrainRule::ScaledParticle,
             CgRule::LiggghtsPfm => CoarseGrainRule::LiggghtsPfm,
@@ -121,16 +123,18 @@ impl From<CgRule> for CoarseGrainRule {
 #[derive(Args)]
 struct SceneArgs {
     /// Coarse-graining level: a power of two (1 = the original, uncoarsened system).
-    /// Diameters grow by lambda, the particle count falls by lambda^3 (paper A Eq. 3-6).
+    /// Diameters grow by lambda, the particle count falls by lambda^3 (Hirose, Eq. 3-6).
     #[arg(long, default_value_t = 1)]
     lambda: u32,
-    /// Coarse-graining rule. WCA: `seed` (paper A: eps' = lambda^3 eps, gamma' = lambda^2
-    /// gamma) or `bulk-viscosity` (eps' = lambda eps, gamma' = lambda gamma: keeps gamma/d,
-    /// so viscous flows keep their speed). Hertz: `seed` (every contact force x lambda^2),
+    /// Coarse-graining rule. WCA: `relative-overlap` (Hirose's rule: eps' = lambda^3 eps,
+    /// gamma' = lambda^2 gamma; keeps each contact's restitution and its overlap relative to
+    /// the diameter; `seed` is its former name) or `bulk-viscosity` (eps' = lambda eps,
+    /// gamma' = lambda gamma: keeps gamma/d, so viscous flows keep their speed). Hertz:
+    /// `relative-overlap` (every contact force x lambda^2),
     /// `scaled-particle` (the same material in larger particles) or `liggghts-pfm`
     /// (LIGGGHTS-PFM's coarsegraining, cohesion scaled like the weight). What each keeps:
     /// reference/COARSE_GRAINING.md.
-    #[arg(long, value_enum, default_value_t = CgRule::Seed)]
+    #[arg(long, value_enum, default_value_t = CgRule::RelativeOverlap)]
     cg_rule: CgRule,
     /// Insertion seed: insertion k uses seed + k (default: the seeds in the case file).
     #[arg(long)]

@@ -14,8 +14,8 @@ use cgdem_harness::decks::{
 
 #[derive(Subcommand)]
 pub(super) enum ReferenceCommand {
-    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP): the seed's WCA model (reference/lammps/SEED_MODEL.md)
-    /// and Hertz scenes (reference/MAPPING.md).
+    /// LAMMPS (`lmp` on PATH or $CGDEM_LMP): the WCA model of Hirose
+    /// (reference/lammps/SEED_MODEL.md) and Hertz scenes (reference/MAPPING.md).
     Lammps(ReferenceArgs),
     /// LIGGGHTS (`liggghts` on PATH or $CGDEM_LIGGGHTS): Hertz scenes with LIGGGHTS's keywords.
     Liggghts(ReferenceArgs),

@@ -47,7 +47,7 @@ pub(super) struct RunArgs {
     #[arg(long)]
     keep_going: bool,
     /// Refuse to coarse-grain where the rule cannot keep what it states for a parameter of
-    /// the scene (e.g. the seed rule with van der Waals cohesion under gravity: the Bond
+    /// the scene (e.g. the relative-overlap rule with van der Waals cohesion under gravity: the Bond
     /// number), naming the rule and the parameter, instead of warning.
     #[arg(long)]
     strict: bool,
@@ -351,10 +351,11 @@ impl RunPlan {
     }
 }
 
-/// `runs/<case>-lambda<N>`, with the rule appended when it is not the seed's.
+/// `runs/<case>-lambda<N>`, with the rule appended when it is not the default
+/// (`relative-overlap`).
 fn default_out_dir(scene: &Scene) -> PathBuf {
     let mut name = format!("{}-lambda{}", scene.name, scene.lambda);
-    if scene.cg_rule != cgdem_core::coarse_graining::CoarseGrainRule::Seed {
+    if scene.cg_rule != cgdem_core::coarse_graining::CoarseGrainRule::RelativeOverlap {
         name += &format!("-{}", scene.cg_rule.name());
     }
     PathBuf::from("runs").join(name)

@@ -335,7 +335,7 @@ fn strict_names_the_rule_and_the_parameter_it_cannot_keep() {
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("--strict: the seed rule")
+        stderr.contains("--strict: the relative-overlap rule")
             && stderr.contains("hamaker_constant")
             && stderr.contains("Bond number"),
         "{stderr}"

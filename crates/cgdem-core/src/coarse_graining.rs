@@ -47,7 +47,7 @@ pub enum CoarseGrainError {
 /// friction and rolling friction unchanged; Yang's `gamma_n` (s) times lambda; Hamaker
 /// constant times lambda^3, `h_min` and the cohesion cut-off times lambda.
 pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
-    coarse_grain_hertz_by(h, l, CoarseGrainRule::Seed)
+    coarse_grain_hertz_by(h, l, CoarseGrainRule::RelativeOverlap)
 }
 
 /// Hertz parameters under `rule` (reference/COARSE_GRAINING.md, "Hertz-Mindlin rules"). The
@@ -65,7 +65,7 @@ pub fn coarse_grain_hertz(h: &HertzSettings, l: f64) -> HertzSettings {
 /// (`coarse_grain_by` refuses them first).
 pub fn coarse_grain_hertz_by(h: &HertzSettings, l: f64, rule: CoarseGrainRule) -> HertzSettings {
     let (damping, hamaker) = match rule {
-        CoarseGrainRule::Seed => (1, 3),
+        CoarseGrainRule::RelativeOverlap => (1, 3),
         CoarseGrainRule::LiggghtsPfm => (1, 4),
         CoarseGrainRule::ScaledParticle | CoarseGrainRule::BulkViscosity => return h.clone(),
     };
@@ -157,7 +157,7 @@ pub fn coarse_grain_checks(scene: &Scene, lambda: u32, rule: CoarseGrainRule) ->
     }
     if let CohesionKind::VanDerWaals { .. } = h.cohesion {
         match (rule, gravity) {
-            (CoarseGrainRule::Seed, true) => push("hamaker_constant", CgSeverity::Inconsistent, format!("the Hamaker constant scales as lambda^3 so the cohesion follows the contact forces (lambda^2), not the weight (lambda^3): the Bond number F_vdw(h_min) / (m g) falls {l}x at lambda = {lambda}, and cohesion-controlled structure (the porosity of fine powders) is not kept; the liggghts-pfm rule keeps it")),
+            (CoarseGrainRule::RelativeOverlap, true) => push("hamaker_constant", CgSeverity::Inconsistent, format!("the Hamaker constant scales as lambda^3 so the cohesion follows the contact forces (lambda^2), not the weight (lambda^3): the Bond number F_vdw(h_min) / (m g) falls {l}x at lambda = {lambda}, and cohesion-controlled structure (the porosity of fine powders) is not kept; the liggghts-pfm rule keeps it")),
             (CoarseGrainRule::ScaledParticle, _) => push("hamaker_constant", CgSeverity::Inconsistent, format!("same material: the van der Waals force near contact grows only as R (lambda) while contact forces grow as lambda^2 and weights as lambda^3: the Bond number F_vdw(h_min) / (m g) falls {}x at lambda = {lambda}", l * l)),
             (CoarseGrainRule::LiggghtsPfm, false) => push("hamaker_constant", CgSeverity::Inconsistent, format!("the rule scales the cohesion like the weight (Hamaker constant x lambda^4) to keep the Bond number; without gravity there is no weight, and the cohesion only grows {l}x relative to the contact forces at lambda = {lambda}")),
             (CoarseGrainRule::LiggghtsPfm, true) => push("hamaker_constant", CgSeverity::Note, format!("the Bond number is kept (Hamaker constant x lambda^4, h_min x lambda), but the cohesion, like the weight, grows lambda times relative to the unchanged elastic stiffness: cohesive overlaps per diameter grow lambda^(2/3) = {:.2} times at lambda = {lambda}", l.powf(2.0 / 3.0))),
@@ -173,7 +173,7 @@ pub fn coarse_grain_checks(scene: &Scene, lambda: u32, rule: CoarseGrainRule) ->
 /// Returns the scene coarse-grained by `lambda` relative to its current level, by the
 /// seed's rule.
 pub fn coarse_grain(scene: &Scene, lambda: u32) -> Result<Scene, CoarseGrainError> {
-    coarse_grain_by(scene, lambda, CoarseGrainRule::Seed)
+    coarse_grain_by(scene, lambda, CoarseGrainRule::RelativeOverlap)
 }
 
 /// Returns the scene coarse-grained by `lambda` relative to its current level.
@@ -493,8 +493,8 @@ mod hertz_tests {
         };
         // (rule, lambda, gamma_n, Hamaker, h_min and cut-off factors)
         let expected = [
-            (CoarseGrainRule::Seed, 2.0, 2.0, 8.0, 2.0),
-            (CoarseGrainRule::Seed, 4.0, 4.0, 64.0, 4.0),
+            (CoarseGrainRule::RelativeOverlap, 2.0, 2.0, 8.0, 2.0),
+            (CoarseGrainRule::RelativeOverlap, 4.0, 4.0, 64.0, 4.0),
             (CoarseGrainRule::ScaledParticle, 2.0, 1.0, 1.0, 1.0),
             (CoarseGrainRule::ScaledParticle, 4.0, 1.0, 1.0, 1.0),
             (CoarseGrainRule::LiggghtsPfm, 2.0, 2.0, 16.0, 2.0),
@@ -538,7 +538,7 @@ mod hertz_tests {
         let r = 2.5e-5;
         for l in [2.0, 4.0] {
             for (rule, power) in [
-                (CoarseGrainRule::Seed, 2),
+                (CoarseGrainRule::RelativeOverlap, 2),
                 (CoarseGrainRule::LiggghtsPfm, 3),
             ] {
                 let (a1, h1, _) = vdw(&coarse_grain_hertz_by(&h, l, rule));
@@ -590,7 +590,7 @@ mod hertz_tests {
     #[test]
     fn without_yang_damping_or_cohesion_the_hertz_rules_coincide() {
         let scene = case("aor_hertz.toml");
-        let seed = coarse_grain_by(&scene, 4, CoarseGrainRule::Seed).unwrap();
+        let seed = coarse_grain_by(&scene, 4, CoarseGrainRule::RelativeOverlap).unwrap();
         for rule in [
             CoarseGrainRule::ScaledParticle,
             CoarseGrainRule::LiggghtsPfm,
@@ -605,8 +605,8 @@ mod hertz_tests {
     #[test]
     fn checks_name_the_rule_and_the_parameter_and_strict_refuses_only_inconsistencies() {
         let settle = case("hertz_settle.toml");
-        assert!(coarse_grain_checks(&settle, 1, CoarseGrainRule::Seed).is_empty());
-        let notes = coarse_grain_checks(&settle, 2, CoarseGrainRule::Seed);
+        assert!(coarse_grain_checks(&settle, 1, CoarseGrainRule::RelativeOverlap).is_empty());
+        let notes = coarse_grain_checks(&settle, 2, CoarseGrainRule::RelativeOverlap);
         let names: Vec<_> = notes.iter().map(|c| (c.parameter, c.severity)).collect();
         assert_eq!(
             names,
@@ -615,9 +615,12 @@ mod hertz_tests {
                 ("rolling_friction", CgSeverity::Note)
             ]
         );
-        assert!(
-            coarse_grain_checks(&case("aor_collapse.toml"), 8, CoarseGrainRule::Seed).is_empty()
-        );
+        assert!(coarse_grain_checks(
+            &case("aor_collapse.toml"),
+            8,
+            CoarseGrainRule::RelativeOverlap
+        )
+        .is_empty());
         let packing = case("packing_vdw.toml");
         let inconsistent = |rule| {
             coarse_grain_checks(&packing, 4, rule)
@@ -626,19 +629,22 @@ mod hertz_tests {
                 .map(|c| c.parameter)
                 .collect::<Vec<_>>()
         };
-        assert_eq!(inconsistent(CoarseGrainRule::Seed), ["hamaker_constant"]);
+        assert_eq!(
+            inconsistent(CoarseGrainRule::RelativeOverlap),
+            ["hamaker_constant"]
+        );
         assert_eq!(
             inconsistent(CoarseGrainRule::ScaledParticle),
             ["hamaker_constant", "gamma_n_yang"]
         );
         assert!(inconsistent(CoarseGrainRule::LiggghtsPfm).is_empty());
-        let c = &coarse_grain_checks(&packing, 4, CoarseGrainRule::Seed)
+        let c = &coarse_grain_checks(&packing, 4, CoarseGrainRule::RelativeOverlap)
             .into_iter()
             .find(|c| c.severity == CgSeverity::Inconsistent)
             .unwrap();
         let text = c.to_string();
         assert!(
-            text.starts_with("seed rule, hamaker_constant:") && text.contains("4x"),
+            text.starts_with("relative-overlap rule, hamaker_constant:") && text.contains("4x"),
             "{text}"
         );
         // Without gravity the Bond-number law has no weight to follow.
@@ -648,7 +654,7 @@ mod hertz_tests {
             inconsistent_of(&weightless, CoarseGrainRule::LiggghtsPfm),
             ["hamaker_constant"]
         );
-        assert!(inconsistent_of(&weightless, CoarseGrainRule::Seed).is_empty());
+        assert!(inconsistent_of(&weightless, CoarseGrainRule::RelativeOverlap).is_empty());
     }
 
     fn inconsistent_of(scene: &Scene, rule: CoarseGrainRule) -> Vec<&'static str> {

@@ -437,7 +437,7 @@ mod tests {
     /// Fine reference 30 deg; the seed rule drifts by 0.5 deg per level, the bulk-viscosity
     /// rule by 1.5 deg but with seed noise at lambda 8.
     fn matrix() -> Vec<AccuracyPoint> {
-        use CoarseGrainRule::{BulkViscosity as B, Seed as S};
+        use CoarseGrainRule::{BulkViscosity as B, RelativeOverlap as S};
         let mut points = Vec::new();
         for seed in 1..=3 {
             let noise = [0.0, 0.1, -0.1][seed as usize - 1];
@@ -466,7 +466,7 @@ mod tests {
         // Within 1.6 deg: seed rule up to lambda 8 (error 1.5, no spread) .
         let a = advise(f, &points, "aor", Measure::Angle, 1.6).unwrap();
         let l = a.advised.as_ref().unwrap();
-        assert_eq!((l.lambda, l.cg_rule.as_str()), (8, "seed"));
+        assert_eq!((l.lambda, l.cg_rule.as_str()), (8, "relative-overlap"));
         assert!(
             (l.error - 1.5).abs() < 1e-9 && l.spread.unwrap() < 1e-9,
             "{l:?}"
@@ -476,15 +476,15 @@ mod tests {
         // (1.5) does not qualify.
         let a = advise(f, &points, "aor-fidelity", Measure::Angle, 1.2).unwrap();
         let l = a.advised.as_ref().unwrap();
-        assert_eq!((l.lambda, l.cg_rule.as_str()), (4, "seed"));
+        assert_eq!((l.lambda, l.cg_rule.as_str()), (4, "relative-overlap"));
         assert!(a
             .text(Measure::Angle)
-            .contains("lambda = 4 under the seed rule"));
+            .contains("lambda = 4 under the relative-overlap rule"));
         // Within 0.3 deg: none, the closest being the seed rule's lambda 2 (0.5).
         let a = advise(f, &points, "aor", Measure::Angle, 0.3).unwrap();
         assert!(a.advised.is_none());
         let b = a.best_reached.as_ref().unwrap();
-        assert_eq!((b.lambda, b.cg_rule.as_str()), (2, "seed"));
+        assert_eq!((b.lambda, b.cg_rule.as_str()), (2, "relative-overlap"));
         assert!(a.text(Measure::Angle).contains("none; the closest"));
     }
 
@@ -495,7 +495,7 @@ mod tests {
         // target below 7.96 admits it, though its mean is 4.5.
         let a = advise(Path::new("m"), &points, "aor", Measure::Angle, 5.0).unwrap();
         let l = a.advised.unwrap();
-        assert_eq!((l.lambda, l.cg_rule.as_str()), (8, "seed"));
+        assert_eq!((l.lambda, l.cg_rule.as_str()), (8, "relative-overlap"));
         let bv8 = a
             .considered
             .iter()
@@ -626,7 +626,11 @@ mod tests {
                     .filter(|r| r.text(setting).unwrap() != "reference")
                     .map(|r| {
                         (
-                            r.text(rule).unwrap().to_string(),
+                            // Stored before the rule's rename: "seed" is relative-overlap.
+                            CoarseGrainRule::from_name(r.text(rule).unwrap())
+                                .unwrap()
+                                .name()
+                                .to_string(),
                             r.parse::<u32>(lambda).unwrap(),
                             r.parse::<f64>(error).unwrap(),
                             r.parse::<f64>(reach).unwrap(),

@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
+use crate::verdict::renamed_rule;
+use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::io::write_atomic;
 
 /// One metric of one night.
@@ -122,7 +124,10 @@ pub fn night_metrics(summary: &serde_json::Value) -> BTreeMap<String, Metric> {
             r["case"].as_str().unwrap_or("?"),
             r["code"].as_str().unwrap_or("?"),
             r["lambda"].as_u64().unwrap_or(0),
-            r["cg_rule"].as_str().unwrap_or("?"),
+            r["cg_rule"]
+                .as_str()
+                .map_or("?", |n| CoarseGrainRule::from_name(n)
+                    .map_or(n, |r| r.name())),
         );
         let entry = groups.entry(key).or_insert_with(|| {
             (
@@ -398,7 +403,7 @@ pub fn since_previous(
                         let key = format!(
                             "{} {}, {}",
                             c["case"].as_str().unwrap_or("?"),
-                            c["what"].as_str().unwrap_or("?"),
+                            renamed_rule(c["what"].as_str().unwrap_or("?")),
                             c["part"].as_str().unwrap_or("?")
                         );
                         let verdict = match c["verdict"].as_str() {
@@ -452,12 +457,21 @@ pub fn read_history(path: &Path) -> Result<Vec<Night>, HistoryError> {
 
 /// The nights in the text of the history file `path` (named in errors, with serde's line and
 /// column).
+/// column). Metrics recorded under the rule's first name `seed` are read under
+/// `relative-overlap`, so their trends continue.
 pub fn parse_history(text: &str, path: &Path) -> Result<Vec<Night>, HistoryError> {
-    serde_json::from_str(text).map_err(|e| HistoryError::Invalid {
+    let mut nights: Vec<Night> = serde_json::from_str(text).map_err(|e| HistoryError::Invalid {
         file: path.to_path_buf(),
         what: "history file (a JSON list of nights)",
         message: e.to_string(),
-    })
+    })?;
+    for night in &mut nights {
+        night.metrics = std::mem::take(&mut night.metrics)
+            .into_iter()
+            .map(|(name, metric)| (renamed_rule(&name), metric))
+            .collect();
+    }
+    Ok(nights)
 }
 
 fn relative_to(path: &Path, base: &Path) -> String {
@@ -614,12 +628,12 @@ mod tests {
     #[test]
     fn metrics_are_seed_means_and_median_throughput_with_the_suite_tolerance() {
         let m = night_metrics(&summary(30.0, 1e6));
-        let angle = &m["c cgdem lambda=8 seed: repose angle"];
+        let angle = &m["c cgdem lambda=8 relative-overlap: repose angle"];
         assert_eq!(
             (angle.value, angle.tolerance, angle.relative),
             (30.0, 1.5, false)
         );
-        let rate = &m["c cgdem lambda=8 seed: throughput"];
+        let rate = &m["c cgdem lambda=8 relative-overlap: throughput"];
         assert_eq!((rate.value, rate.relative), (2e6, true));
     }
 
@@ -656,8 +670,8 @@ mod tests {
         assert_eq!(
             names,
             [
-                "c cgdem lambda=8 seed: repose angle",
-                "c cgdem lambda=8 seed: throughput"
+                "c cgdem lambda=8 relative-overlap: repose angle",
+                "c cgdem lambda=8 relative-overlap: throughput"
             ]
         );
     }

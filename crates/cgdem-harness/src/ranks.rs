@@ -279,7 +279,7 @@ mod tests {
         assert!(line.starts_with("mpirun --allow-run-as-root"), "{line}");
         assert!(
             line.contains(&format!(
-                "-np 2 -wdir {} /opt/cgdem run /tmp/x/scene.json --cg-rule seed --grid 2x1x1 --balance 1.2 --threads 1 --quiet --out /tmp/x --checkpoint-every 0.25 --keep-going",
+                "-np 2 -wdir {} /opt/cgdem run /tmp/x/scene.json --cg-rule relative-overlap --grid 2x1x1 --balance 1.2 --threads 1 --quiet --out /tmp/x --checkpoint-every 0.25 --keep-going",
                 here.display()
             )),
             "{line}"

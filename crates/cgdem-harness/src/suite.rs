@@ -279,7 +279,7 @@ fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError
         ));
     }
     let cg_rules = if c.cg_rules.is_empty() {
-        vec![CoarseGrainRule::Seed]
+        vec![CoarseGrainRule::RelativeOverlap]
     } else {
         c.cg_rules
             .iter()
@@ -404,7 +404,7 @@ fn parse_known_difference(
         ));
     }
     Ok(KnownDifference {
-        comparison: kd.comparison,
+        comparison: crate::verdict::renamed_rule(&kd.comparison),
         criterion: kd.criterion,
         reason: kd.reason,
         evidence: evidence.display().to_string(),

@@ -15,6 +15,8 @@
 
 use serde::Serialize;
 
+use cgdem_core::coarse_graining::CoarseGrainRule;
+
 /// How many combined standard errors a difference may exceed its physical tolerance by.
 /// Two: a side-by-side pair of unchanged codes passes about 95% of single criteria by
 /// chance alone when the noise is well estimated.
@@ -67,6 +69,19 @@ impl KnownDifference {
         let allowance = K_NOISE * noise;
         value >= self.band[0] - allowance && value <= self.band[1] + allowance
     }
+}
+
+/// A comparison or metric name with the first name of the `relative-overlap` rule, `seed`,
+/// replaced by the current one (`"cgdem lambda = 8 vs 16 (seed)"`, `"... lambda=8 seed:
+/// repose angle"`), so that suite files, summaries and nightly histories written before the
+/// rename keep matching the comparisons and trends of later runs.
+pub(crate) fn renamed_rule(name: &str) -> String {
+    let (old, new) = (
+        CoarseGrainRule::OLD_RELATIVE_OVERLAP,
+        CoarseGrainRule::RelativeOverlap.name(),
+    );
+    name.replace(&format!("({old})"), &format!("({new})"))
+        .replace(&format!(" {old}: "), &format!(" {new}: "))
 }
 
 /// One sub-criterion of a comparison with its own verdict.

@@ -427,7 +427,7 @@ mod tests {
         RunInvocation {
             case: PathBuf::from("/cases/heap.toml"),
             lambda: 2,
-            cg_rule: CoarseGrainRule::Seed,
+            cg_rule: CoarseGrainRule::RelativeOverlap,
             seed: None,
             set: Vec::new(),
             variant: None,

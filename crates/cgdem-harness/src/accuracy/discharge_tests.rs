@@ -73,7 +73,7 @@ fn measured(lambda: u32, per_sample: u64, until: f64, name: &str) -> AccuracyPoi
         "silo".into(),
         Code::Cgdem,
         lambda,
-        CoarseGrainRule::Seed,
+        CoarseGrainRule::RelativeOverlap,
         1,
         dir.clone(),
     );
@@ -122,7 +122,7 @@ fn a_run_of_another_orifice_than_the_suites_is_refused_with_both_diameters() {
         "silo".into(),
         Code::Cgdem,
         1,
-        CoarseGrainRule::Seed,
+        CoarseGrainRule::RelativeOverlap,
         1,
         dir.clone(),
     );
@@ -221,7 +221,7 @@ fn the_hertz_rules_give_the_silo_the_same_parameters() {
     use cgdem_core::coarse_graining::coarse_grain_by;
     let scene = silo();
     for lambda in [2, 4] {
-        let seed = coarse_grain_by(&scene, lambda, CoarseGrainRule::Seed).unwrap();
+        let seed = coarse_grain_by(&scene, lambda, CoarseGrainRule::RelativeOverlap).unwrap();
         for rule in [
             CoarseGrainRule::ScaledParticle,
             CoarseGrainRule::LiggghtsPfm,
@@ -249,7 +249,7 @@ fn every_level_of_the_silo_inserts_the_same_solid_mass() {
     };
     let fine = mass(&scene);
     for lambda in [2, 4] {
-        let coarse = coarse_grain_by(&scene, lambda, CoarseGrainRule::Seed).unwrap();
+        let coarse = coarse_grain_by(&scene, lambda, CoarseGrainRule::RelativeOverlap).unwrap();
         assert!(
             (mass(&coarse) / fine - 1.0).abs() < 1e-12,
             "lambda {lambda}"

@@ -194,7 +194,7 @@ impl AccuracySweep {
                 .ok_or_else(|| invalid(field, format!("\"{name}\""), &rule_names()))
         };
         let sweep_rule = match &raw.cg_rule {
-            None => CoarseGrainRule::Seed,
+            None => CoarseGrainRule::RelativeOverlap,
             Some(name) => parse_rule(name, "cg_rule")?,
         };
         let lambda_ok = |v: f64| v >= 1.0 && v.fract() == 0.0 && (v as u32).is_power_of_two();

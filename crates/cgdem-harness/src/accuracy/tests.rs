@@ -53,7 +53,7 @@ pub(crate) fn run(
         value,
         setting: format!("{series} = {value}"),
         lambda: 1,
-        cg_rule: CoarseGrainRule::Seed,
+        cg_rule: CoarseGrainRule::RelativeOverlap,
         seed,
         status: Outcome::Ok,
         reason: None,
@@ -270,7 +270,10 @@ fn a_rule_series_at_the_reference_level_is_also_its_own_matrix() {
         p.angle_error_deg = Some(99.0);
         p
     };
-    let (seed_rule, bv) = (CoarseGrainRule::Seed, CoarseGrainRule::BulkViscosity);
+    let (seed_rule, bv) = (
+        CoarseGrainRule::RelativeOverlap,
+        CoarseGrainRule::BulkViscosity,
+    );
     let mut points = Vec::new();
     for seed in [1, 2] {
         points.push(point("reference", 8, seed_rule, seed, 40.0));

@@ -302,7 +302,7 @@ fn a_reference_run_whose_trajectory_is_gone_keeps_its_rate_and_says_why_it_has_n
         "silo_reduced".into(),
         crate::code::Code::Liggghts,
         1,
-        cgdem_core::scene::CoarseGrainRule::Seed,
+        cgdem_core::scene::CoarseGrainRule::RelativeOverlap,
         1,
         dir.clone(),
     );

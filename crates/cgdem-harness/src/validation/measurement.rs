@@ -149,7 +149,7 @@ fn pair_name(kind: &str, a: GroupKey, b: GroupKey) -> String {
 /// seed rule between 1 (inertial collapse) and the lambda ratio (viscous collapse).
 fn predicted_time_ratio(kind: &str, a: GroupKey, b: GroupKey) -> String {
     match (kind, rule_of(a.0)) {
-        ("levels", CoarseGrainRule::Seed) => format!(
+        ("levels", CoarseGrainRule::RelativeOverlap) => format!(
             "1 (inertial) to {} (viscous): bulk viscosity ~ lambda gamma/d",
             b.1 as f64 / a.1 as f64
         ),

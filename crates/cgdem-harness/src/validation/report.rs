@@ -331,7 +331,7 @@ fn read_profile(path: &Path, case: &SuiteCase) -> Result<Vec<Vec<f64>>, Validate
 
 fn label(code: Code, lambda: u32, rule: CoarseGrainRule) -> String {
     match rule {
-        CoarseGrainRule::Seed => format!("{} lambda={lambda}", code.name()),
+        CoarseGrainRule::RelativeOverlap => format!("{} lambda={lambda}", code.name()),
         other => format!("{} lambda={lambda} {}", code.name(), other.name()),
     }
 }
@@ -502,7 +502,7 @@ fn angles_figure(scene: &Scene, runs: &[RunRecord]) -> Figure {
     }
     for ((rule, code), (points, errors)) in series {
         let name = match rule_of(rule) {
-            CoarseGrainRule::Seed => code.name().to_string(),
+            CoarseGrainRule::RelativeOverlap => code.name().to_string(),
             other => format!("{} {}", code.name(), other.name()),
         };
         angles.series.push(
@@ -528,7 +528,7 @@ fn throughput_bars(
                 .collect();
             let (mean, spread) = mean_spread(&values)?;
             let group = match rule {
-                CoarseGrainRule::Seed => format!("lambda={lambda}"),
+                CoarseGrainRule::RelativeOverlap => format!("lambda={lambda}"),
                 other => format!("lambda={lambda} {}", other.name()),
             };
             Some((group, code.name().to_string(), mean, Some(spread)))

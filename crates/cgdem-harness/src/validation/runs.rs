@@ -17,7 +17,7 @@ fn run_dir(
     seed: u64,
 ) -> PathBuf {
     let mut name = format!("{}-lambda{lambda}", code.name());
-    if rule != CoarseGrainRule::Seed {
+    if rule != CoarseGrainRule::RelativeOverlap {
         name += &format!("-{}", rule.name());
     }
     runs.join(&scene.name).join(format!("{name}-seed{seed}"))

@@ -40,7 +40,7 @@ fn fake_run(
         "aor_hertz_smoke".into(),
         code,
         1,
-        CoarseGrainRule::Seed,
+        CoarseGrainRule::RelativeOverlap,
         seed,
         dir,
     );
