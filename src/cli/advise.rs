@@ -221,7 +221,8 @@ fn scene_alone(args: &AdviseArgs, scene: &Scene) -> bool {
         .filter_map(|s| s.case_name(&suite.source).ok())
         .collect();
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    advise::resolve_case(&refs, &scene.name).is_err()
+    // Several variants of it (a suite's): the answer asks for one of them by name.
+    matches!(advise::resolve_case(&refs, &scene.name), Err(v) if v.is_empty())
 }
 
 /// `advise --run`: the case's sweeps made into the matrix's runs; the directory of the
@@ -402,14 +403,9 @@ fn describe_cost(cost: &advise::MatrixCost, throughput: Option<&(f64, String)>) 
     match throughput {
         Some((rate, from)) => text.push_str(&format!(
             "; about {} on this machine at {rate:.3e} particle-steps/s, measured by {from}",
-            if (remaining.1 - remaining.0).abs() <= 1e-9 * remaining.1 {
-                wall_time(remaining.1 / rate)
-            } else {
-                format!(
-                    "{} to {}",
-                    wall_time(remaining.0 / rate),
-                    wall_time(remaining.1 / rate)
-                )
+            match (wall_time(remaining.0 / rate), wall_time(remaining.1 / rate)) {
+                (lo, hi) if lo == hi => hi,
+                (lo, hi) => format!("{lo} to {hi}"),
             }
         )),
         None if remaining.1 == 0.0 => text.push_str("; nothing left to run"),

@@ -465,4 +465,6 @@ fn levels(all: &[Setting], reference: &Setting, m: Measure) -> Vec<Level> {
 }
 
 #[cfg(test)]
+mod scene_tests;
+#[cfg(test)]
 mod tests;
