@@ -335,31 +335,39 @@ fn simulated_s(scene: &Scene) -> f64 {
         .max(1e-9)
 }
 
-/// The machine's throughput for the estimate, with where it comes from: the runs already
-/// made, else a probe of the finest level; None when nothing is left to make or the probe
-/// failed (said).
+/// The machine's throughput for the estimate: particle-steps per second, seconds of setup
+/// per run (None: not measured), and where they come from: the runs already made, else a
+/// probe of the finest level; None when nothing is left to make or the probe failed (said).
+type Throughput = (f64, Option<f64>, String);
+
 fn throughput(
     plan: &SceneMatrix,
     cost: &advise::MatrixCost,
     dir: &Path,
     options: &ValidateOptions,
-) -> Option<(f64, String)> {
+) -> Option<Throughput> {
     if cost.remaining().1 == 0.0 {
         return None;
     }
     if let Some((rate, n)) = cost.measured_throughput() {
-        return Some((rate, format!("the {n} run(s) of this matrix already made")));
+        return Some((
+            rate,
+            None,
+            format!("the {n} run(s) of this matrix already made (their setup not counted)"),
+        ));
     }
     match advise::probe(plan, &dir.join("probe"), advise::PROBE_STEPS, options.stop.clone()) {
         Ok(p) => Some((
             p.particle_steps_per_s,
+            Some(p.setup_s),
             format!(
-                "a probe of {} steps of the first stage at lambda = {} ({} particles, {:.2} s on {} thread(s)); a denser flow than the probe's may run slower",
+                "a probe of {} steps of the first stage at lambda = {} ({} particles, {:.2} s on {} thread(s), after {:.1} s of setup, counted once per run); a denser flow than the probe's may run slower",
                 p.steps,
                 p.lambda,
                 p.particles,
                 p.wall_s,
-                rayon::current_num_threads()
+                rayon::current_num_threads(),
+                p.setup_s
             ),
         )),
         Err(e) => {
@@ -389,25 +397,31 @@ fn wall_time(s: f64) -> String {
     }
 }
 
-/// The expected cost, in words: particle-steps still to make and in all, and hours.
-fn describe_cost(cost: &advise::MatrixCost, throughput: Option<&(f64, String)>) -> String {
+/// The expected cost, in words: particle-steps still to make and in all, and wall time.
+fn describe_cost(cost: &advise::MatrixCost, throughput: Option<&Throughput>) -> String {
     let remaining = cost.remaining();
+    let left = cost.runs.len() - cost.done();
     let mut text = format!(
-        "expected cost (an estimate): {} particle-steps still to make in {} run(s), of {} in all ({} run(s), {} already made); particles and steps of each run counted from the scene at its level, each settling stage between its min_duration and max_duration",
+        "expected cost (an estimate): {} particle-steps still to make in {left} run(s), of {} in all ({} run(s), {} already made); particles and steps of each run counted from the scene at its level, each settling stage between its min_duration and max_duration",
         range(remaining),
-        cost.runs.len() - cost.done(),
         range(cost.total()),
         cost.runs.len(),
         cost.done()
     );
     match throughput {
-        Some((rate, from)) => text.push_str(&format!(
-            "; about {} on this machine at {rate:.3e} particle-steps/s, measured by {from}",
-            match (wall_time(remaining.0 / rate), wall_time(remaining.1 / rate)) {
-                (lo, hi) if lo == hi => hi,
-                (lo, hi) => format!("{lo} to {hi}"),
-            }
-        )),
+        Some((rate, setup, from)) => {
+            let setup = setup.unwrap_or(0.0) * left as f64;
+            text.push_str(&format!(
+                "; about {} on this machine at {rate:.3e} particle-steps/s, measured by {from}",
+                match (
+                    wall_time(remaining.0 / rate + setup),
+                    wall_time(remaining.1 / rate + setup)
+                ) {
+                    (lo, hi) if lo == hi => hi,
+                    (lo, hi) => format!("{lo} to {hi}"),
+                }
+            ))
+        }
         None if remaining.1 == 0.0 => text.push_str("; nothing left to run"),
         None => {}
     }

@@ -144,6 +144,9 @@ pub struct Probe {
     pub steps: u64,
     pub wall_s: f64,
     pub particle_steps_per_s: f64,
+    /// Seconds before the first step (SDF grids, insertion): each run of the matrix spends
+    /// about as much again (at most: coarser levels insert fewer particles).
+    pub setup_s: f64,
 }
 
 /// The scene of the probe: the matrix's finest level, first rule and seed, running its first
@@ -188,7 +191,9 @@ pub fn probe(
         stop,
         ..Default::default()
     };
+    let started = std::time::Instant::now();
     let summary = cgdem_core::run::run(&scene, &options).map_err(|e| e.to_string());
+    let elapsed = started.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(dir);
     let summary = summary?;
     Ok(Probe {
@@ -197,5 +202,6 @@ pub fn probe(
         steps: summary.steps,
         wall_s: summary.wall_s,
         particle_steps_per_s: summary.particle_steps_per_s,
+        setup_s: (elapsed - summary.wall_s).max(0.0),
     })
 }
