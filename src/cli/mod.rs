@@ -64,8 +64,12 @@ enum Command {
     History(history::HistoryArgs),
     /// Which coarse-graining level and rule keeps a quantity within a target, from a stored
     /// matrix (a `cgdem validate` report whose sweeps vary lambda under each rule against a
-    /// fine reference): the coarsest setting whose mean error over seeds plus twice its
-    /// standard error is within the target, with its saving; "none" and the closest otherwise.
+    /// fine reference; with --run, made first, for a scene file of one's own from the scene
+    /// alone): the coarsest setting whose mean error over seeds plus twice its standard error
+    /// is within the target, with its saving; "none" and the closest otherwise.
+    #[command(
+        after_help = "Exit status: 0 a setting meets the target; 1 none does (the answer says \"none\"); 2 bad arguments or input (an unknown quantity, a bad target, an unreadable scene, a scene that cannot measure the quantity, a matrix with no points for the case) or a run that cannot be written; 130 interrupted by SIGINT (Ctrl-C), 143 by SIGTERM: the runs already made are kept, and the same command again goes on from them."
+    )]
     Advise(advise::AdviseArgs),
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).

@@ -2,6 +2,7 @@
 //! determinism across thread counts, scene validation, the solver guards, the command line and
 //! the multi-stage Hertz decks in LIGGGHTS and LAMMPS.
 
+mod advise_scene;
 mod bodies;
 mod cli;
 mod cli_reference;

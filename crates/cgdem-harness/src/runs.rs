@@ -647,7 +647,7 @@ mod tests {
                 scene,
                 code,
                 1,
-                CoarseGrainRule::Seed,
+                CoarseGrainRule::RelativeOverlap,
                 1,
                 &dir.join(code.name()),
                 &options,
@@ -688,7 +688,14 @@ mod tests {
     fn notes_are_listed_per_code_each_once() {
         let record = |code: Code, seed: u64, notes: &[&str]| RunRecord {
             notes: notes.iter().map(|n| n.to_string()).collect(),
-            ..RunRecord::ok("c".into(), code, 1, CoarseGrainRule::Seed, seed, "d".into())
+            ..RunRecord::ok(
+                "c".into(),
+                code,
+                1,
+                CoarseGrainRule::RelativeOverlap,
+                seed,
+                "d".into(),
+            )
         };
         let runs = [
             record(Code::Cgdem, 1, &[]),

@@ -45,6 +45,7 @@ use std::path::Path;
 use crate::report::Report;
 use crate::runs::{ValidateError, ValidateOptions};
 use report::write_sweep_section;
+pub(crate) use runs::planned_runs;
 use runs::{own_rule_sweeps, run_sweep};
 
 /// Spread = this many standard errors of the mean over seeds (the matrix's columns and

@@ -103,36 +103,36 @@ fn sweep_jobs(sweep: &AccuracySweep) -> Vec<SweepJob> {
     jobs
 }
 
-/// Runs, seed by seed, the reference of every code, then each series point; codes alternate
-/// within each point so machine drift hits all alike. With `--jobs`, that many of these runs
-/// are made at a time, in the same order.
-pub(crate) fn run_sweep(
+/// One run of a sweep, prepared: its scene (before coarse-graining), level, code, rule and
+/// seed, the labels it is reported under and its directory.
+pub(crate) struct PlannedRun {
+    pub scene: std::sync::Arc<Scene>,
+    pub lambda: u32,
+    pub code: Code,
+    pub rule: CoarseGrainRule,
+    pub seed: u64,
+    pub series: String,
+    pub setting: String,
+    pub value: f64,
+    pub dir: PathBuf,
+}
+
+/// Every run of the sweep in the order it is made (seed by seed, the reference of every
+/// code, then each series point; codes alternate within each point so machine drift hits
+/// all alike), with the case's name. `cgdem advise` counts their cost from the same list.
+pub(crate) fn planned_runs(
     sweep: &AccuracySweep,
     origin: &Path,
     options: &ValidateOptions,
-) -> Result<Vec<AccuracyPoint>, ValidateError> {
+) -> Result<(String, Vec<PlannedRun>), ValidateError> {
     let case_error = |message: String| ValidateError::Case {
         file: sweep.file.clone(),
         message,
     };
     let (reference_scene, _) = sweep.scene(&sweep.reference, origin).map_err(case_error)?;
     let case = reference_scene.name.clone();
-    let jobs = sweep_jobs(sweep);
-    // Every run prepared first (scene, directory, labels), then made `--jobs` at a time:
-    // the seeds and levels of a sweep are independent runs.
-    struct PointRun {
-        scene: std::sync::Arc<Scene>,
-        lambda: u32,
-        code: Code,
-        rule: CoarseGrainRule,
-        seed: u64,
-        series: String,
-        setting: String,
-        value: f64,
-        dir: PathBuf,
-    }
     let mut runs = Vec::new();
-    for (series, knob, value, codes, rule, seed) in jobs {
+    for (series, knob, value, codes, rule, seed) in sweep_jobs(sweep) {
         let mut knobs = sweep.reference.clone();
         let (setting, name) = match series.as_str() {
             "reference" => ("reference".to_string(), format!("reference-seed{seed}")),
@@ -155,7 +155,7 @@ pub(crate) fn run_sweep(
         let (scene, lambda) = sweep.scene(&knobs, origin).map_err(case_error)?;
         let scene = std::sync::Arc::new(scene);
         for code in codes {
-            runs.push(PointRun {
+            runs.push(PlannedRun {
                 scene: scene.clone(),
                 lambda,
                 code,
@@ -173,6 +173,19 @@ pub(crate) fn run_sweep(
             });
         }
     }
+    Ok((case, runs))
+}
+
+/// Makes the sweep's runs (`planned_runs`), `--jobs` at a time: the seeds and levels of a
+/// sweep are independent runs.
+pub(crate) fn run_sweep(
+    sweep: &AccuracySweep,
+    origin: &Path,
+    options: &ValidateOptions,
+) -> Result<Vec<AccuracyPoint>, ValidateError> {
+    let (case, runs) = planned_runs(sweep, origin, options)?;
+    // "[k/n]" in each run's line: how far the sweep has come.
+    let finished = std::sync::atomic::AtomicUsize::new(0);
     let points = run_concurrently(&runs, options.jobs, |run| {
         let point = run_point(
             &run.scene,
@@ -189,9 +202,11 @@ pub(crate) fn run_sweep(
             setting: run.setting.clone(),
             ..point
         };
+        let k = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         if !options.quiet {
             eprintln!(
-                "{case} accuracy {} {} (seed {}): {}{}",
+                "[{k}/{}] {case} accuracy {} {} (seed {}): {}{}",
+                runs.len(),
                 run.code.name(),
                 p.setting,
                 run.seed,
