@@ -118,6 +118,14 @@ elif [ "$smoke_status" != 0 ]; then
     echo "smoke suite: exit status $smoke_status (1 red, 2 could not run, 3 incomplete); see $report/index.html" >&2
     exit 1
 fi
+# The guide's commands, run as a reader would (a reduced hopper through run, validate and
+# advise; the first case shortened): the guide cannot drift from the program. Its
+# comparisons need LIGGGHTS.
+if [ "$references" = installed ]; then
+    stage guide python3 scripts/check-guide-commands.py docs/getting-started.md docs/tutorial.md
+else
+    echo "note: reference codes not installed; the guide's commands not run"
+fi
 # The report in headless Chromium, beside the planted faults (which write their own reports
 # under $report/planted-faults/ and leave index.html alone).
 if [ "$(id -u)" = 0 ] || command -v chromium >/dev/null 2>&1; then

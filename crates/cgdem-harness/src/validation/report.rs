@@ -190,10 +190,10 @@ fn write_status(
         intro.paragraph("Red and amber rows:");
         intro.list(flagged);
     }
-    let not_made = not_made(summary);
+    let not_made = super::status::not_made(summary);
     if !not_made.is_empty() {
         intro.paragraph("Runs not made (their comparisons are missing; the status is incomplete):");
-        intro.list(not_made);
+        intro.list(not_made.into_iter().map(Cell::text).collect());
     }
     match &options.history {
         None => {
@@ -211,48 +211,6 @@ fn write_status(
             }
         }
     }
-}
-
-/// The runs that were not made, grouped by case, code and reason (a missing code skips
-/// every run of it alike: one line says so).
-fn not_made(summary: &ValidationSummary) -> Vec<Cell> {
-    let mut lines: Vec<(String, usize)> = Vec::new();
-    let mut add = |line: String| match lines.iter_mut().find(|(l, _)| *l == line) {
-        Some((_, n)) => *n += 1,
-        None => lines.push((line, 1)),
-    };
-    let not_run = |o: Outcome| matches!(o, Outcome::Skipped | Outcome::Unsupported);
-    for r in summary.runs.iter().filter(|r| not_run(r.status)) {
-        add(format!(
-            "{} in {}: {}",
-            r.case,
-            r.code.label(),
-            r.reason.as_deref().unwrap_or("not run")
-        ));
-    }
-    let points = summary.accuracy.as_ref().map_or(&[][..], |a| &a.points[..]);
-    for p in points.iter().filter(|p| not_run(p.status)) {
-        add(format!(
-            "{} (accuracy sweep) in {}: {}",
-            p.case,
-            p.code.label(),
-            p.reason.as_deref().unwrap_or("not run")
-        ));
-    }
-    for r in &summary.stability {
-        if r.verdict == crate::stability::Verdict::Skipped {
-            add(format!(
-                "{} (stability) in {}: {}",
-                r.case,
-                r.code.label(),
-                r.message
-            ));
-        }
-    }
-    lines
-        .into_iter()
-        .map(|(line, n)| Cell::text(format!("{line} ({n} runs)")))
-        .collect()
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {

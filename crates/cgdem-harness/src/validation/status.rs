@@ -114,3 +114,45 @@ impl StatusCounts {
         }
     }
 }
+
+/// The runs that were not made, grouped by case, code and reason (a missing code skips
+/// every run of it alike: one line says so).
+pub(super) fn not_made(summary: &ValidationSummary) -> Vec<String> {
+    let mut lines: Vec<(String, usize)> = Vec::new();
+    let mut add = |line: String| match lines.iter_mut().find(|(l, _)| *l == line) {
+        Some((_, n)) => *n += 1,
+        None => lines.push((line, 1)),
+    };
+    let not_run = |o: Outcome| matches!(o, Outcome::Skipped | Outcome::Unsupported);
+    for r in summary.runs.iter().filter(|r| not_run(r.status)) {
+        add(format!(
+            "{} in {}: {}",
+            r.case,
+            r.code.label(),
+            r.reason.as_deref().unwrap_or("not run")
+        ));
+    }
+    let points = summary.accuracy.as_ref().map_or(&[][..], |a| &a.points[..]);
+    for p in points.iter().filter(|p| not_run(p.status)) {
+        add(format!(
+            "{} (accuracy sweep) in {}: {}",
+            p.case,
+            p.code.label(),
+            p.reason.as_deref().unwrap_or("not run")
+        ));
+    }
+    for r in &summary.stability {
+        if r.verdict == crate::stability::Verdict::Skipped {
+            add(format!(
+                "{} (stability) in {}: {}",
+                r.case,
+                r.code.label(),
+                r.message
+            ));
+        }
+    }
+    lines
+        .into_iter()
+        .map(|(line, n)| format!("{line} ({n} runs)"))
+        .collect()
+}
