@@ -251,6 +251,7 @@ pub fn run_case(
     let mine = Suite {
         cases: Vec::new(),
         stability: Vec::new(),
+        chung_ooi: Vec::new(),
         accuracy: suite
             .accuracy
             .iter()

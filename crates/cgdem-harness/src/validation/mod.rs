@@ -46,6 +46,9 @@ pub struct ValidationSummary {
     /// The `[[stability]]` cases' verdicts, one per case and code.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub stability: Vec<super::stability::StabilityRecord>,
+    /// The `[[chung_ooi]]` benchmark's verdicts, one per law, test and criterion.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub chung_ooi: Vec<super::chung_ooi::ChungOoiVerdict>,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -71,6 +74,11 @@ pub fn validate_suite(
             file: suite.source.clone(),
             message,
         })?;
+    let chung_ooi = super::chung_ooi::run_chung_ooi(&suite.chung_ooi, options, &mut report)
+        .map_err(|message| ValidateError::Case {
+            file: suite.source.clone(),
+            message,
+        })?;
     let summary = ValidationSummary {
         suite: suite.name.clone(),
         provenance,
@@ -78,6 +86,7 @@ pub fn validate_suite(
         comparisons,
         accuracy,
         stability,
+        chung_ooi,
     };
     write_intro(&mut report, &summary, suite, options);
     let json_path = options.out.join("summary.json");
