@@ -70,6 +70,11 @@ echo "stability suite: $(( $(date +%s) - started )) s wall time"
 find "$night/stability/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete 2>/dev/null || true
 stability_failed=$(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print(sum(r['code']=='cgdem' and r['verdict']=='failed' for r in s.get('stability', [])))" "$night/stability/summary.json" 2>/dev/null || echo 1)
 
+# The Chung & Ooi benchmark (seconds): no red criterion, and a planted change to the tangential law
+# caught (scripts/chung-ooi.sh); either failing fails the night.
+chung_ooi_failed=0
+bash scripts/chung-ooi.sh "$night/chung_ooi" "$cgdem" || chung_ooi_failed=1
+
 # Keep the night small: run directories hold dumps and VTK files; the report needs only
 # its summaries, CSV and figures.
 find "$night/runs" -type f \( -name '*.dump' -o -name '*.vtu' -o -name '*.pvd' -o -name 'particles.data' \) -delete
@@ -83,7 +88,10 @@ echo "$flags"
 if [ "$stability_failed" != 0 ]; then
     echo "flag: stability: $stability_failed cgdem run(s) failed (see $night/stability/index.html)"
 fi
-if [ "$suite_status" = 1 ] || [ "$stability_failed" != 0 ] || grep -q '^flag:' <<<"$flags"; then
+if [ "$chung_ooi_failed" != 0 ]; then
+    echo "flag: chung_ooi: a red criterion or the planted fault not caught (see $night/chung_ooi/index.html)"
+fi
+if [ "$suite_status" = 1 ] || [ "$stability_failed" != 0 ] || [ "$chung_ooi_failed" != 0 ] || grep -q '^flag:' <<<"$flags"; then
     exit 1
 fi
 if [ "$suite_status" = 3 ]; then

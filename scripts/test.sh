@@ -104,6 +104,9 @@ side_checks() {
 }
 beside side-checks side_checks
 
+# The Chung & Ooi benchmark (seconds): no red criterion, a planted change to the tangential law caught.
+stage chung-ooi bash scripts/chung-ooi.sh target/chung-ooi-report "$bin"
+
 # The smoke suite: every part of the harness on a small collapse (a few minutes).
 report=target/smoke-report
 rm -rf "$report"

@@ -388,6 +388,8 @@ mod hertz_tests {
                 cutoff: None,
             },
             characteristic_velocity: 1.0,
+            limit_force: false,
+            tangential_damping: true,
             pairs: Vec::new(),
         }
     }

@@ -29,6 +29,7 @@ pub mod sweep;
 // Suite kinds.
 pub mod accuracy;
 pub mod bench;
+pub mod chung_ooi;
 pub mod stability;
 pub mod validation;
 // Building blocks.

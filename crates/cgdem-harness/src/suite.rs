@@ -75,6 +75,8 @@ pub struct Suite {
     pub accuracy: Vec<AccuracySweep>,
     /// `[[stability]]` cases (`harness::stability`).
     pub stability: Vec<super::stability::StabilityCase>,
+    /// `[[chung_ooi]]` laws (`harness::chung_ooi`).
+    pub chung_ooi: Vec<super::chung_ooi::ChungOoiLaw>,
 }
 
 #[derive(Deserialize)]
@@ -89,6 +91,8 @@ struct RawSuite {
     accuracy: Vec<RawSweep>,
     #[serde(default)]
     stability: Vec<super::stability::RawStabilityCase>,
+    #[serde(default)]
+    chung_ooi: Vec<super::chung_ooi::RawChungOoiLaw>,
 }
 
 #[derive(Deserialize)]
@@ -165,12 +169,13 @@ impl Suite {
             .map(|(k, a)| AccuracySweep::from_raw(a, k, path))
             .collect::<Result<Vec<_>, _>>()?;
         let stability = super::stability::parse_cases(raw.stability, path)?;
-        if cases.is_empty() && accuracy.is_empty() && stability.is_empty() {
+        let chung_ooi = super::chung_ooi::parse_laws(raw.chung_ooi, path)?;
+        if cases.is_empty() && accuracy.is_empty() && stability.is_empty() && chung_ooi.is_empty() {
             return Err(invalid(
                 path,
                 "case".into(),
                 "(none)".into(),
-                "at least one [[case]], [[accuracy]] or [[stability]]",
+                "at least one [[case]], [[accuracy]], [[stability]] or [[chung_ooi]]",
             ));
         }
         Ok(Suite {
@@ -180,6 +185,7 @@ impl Suite {
             cases,
             accuracy,
             stability,
+            chung_ooi,
         })
     }
 }
@@ -234,6 +240,7 @@ impl Suite {
             cases: vec![case],
             accuracy: Vec::new(),
             stability: Vec::new(),
+            chung_ooi: Vec::new(),
         })
     }
 

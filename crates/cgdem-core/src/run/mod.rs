@@ -15,7 +15,8 @@ mod setup;
 pub mod state_file;
 
 pub use laws::hertz::{
-    hertz_coulomb_wall, hertz_history_wall, hertz_law, hertz_wall, FromScene, SUPPORTED,
+    hertz_coulomb_wall, hertz_coulomb_wall_limited, hertz_history_wall, hertz_history_wall_limited,
+    hertz_law, hertz_wall, FromScene, SUPPORTED,
 };
 pub use laws::{seed_laws, with_laws, LawVisitor};
 pub use observers::stage_end_data_path;

@@ -11,7 +11,7 @@ mod validate;
 pub use cg_rule::CoarseGrainRule;
 pub use error::SceneError;
 pub use materials::{ContactTables, PairProperties};
-pub use overrides::Override;
+pub use overrides::{apply_overrides, Override};
 pub use validate::given_particles_from_data;
 
 use std::path::{Path, PathBuf};
@@ -183,6 +183,14 @@ pub struct HertzSettings {
     pub cohesion: CohesionKind,
     /// Impact speed (m/s) at which Hertz contacts are linearized for the time step.
     pub characteristic_velocity: Real,
+    /// `limit_force = true` (LIGGGHTS `limitForce on`): the normal force of particles and
+    /// walls is clamped at zero, so the dashpot never pulls at the end of a contact.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub limit_force: bool,
+    /// `tangential_damping = false` (LIGGGHTS `tangential_damping off`): the Mindlin spring
+    /// without its dashpot, for particles and walls.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub tangential_damping: bool,
     /// `[[contact.pair]]`: species pairs whose coefficients are not the defaults above (each
     /// unordered pair at most once).
     #[serde(default)]
@@ -203,9 +211,25 @@ impl std::fmt::Debug for HertzSettings {
             .field("rolling", &self.rolling)
             .field("cohesion", &self.cohesion)
             .field("characteristic_velocity", &self.characteristic_velocity);
+        optional_field(&mut s, "limit_force", &self.limit_force);
+        if !self.tangential_damping {
+            s.field("tangential_damping", &false);
+        }
         optional_field(&mut s, "pairs", &self.pairs);
         s.finish()
     }
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// `[[contact.pair]] species = ["a", "b"]`: the coefficients of one species pair (LIGGGHTS
@@ -858,6 +882,8 @@ mod tests {
             rolling: RollingKind::Epsd2,
             cohesion: CohesionKind::None,
             characteristic_velocity: 1.0,
+            limit_force: false,
+            tangential_damping: true,
             pairs: Vec::new(),
         };
         assert_eq!(

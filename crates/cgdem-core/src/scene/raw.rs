@@ -164,6 +164,8 @@ pub struct RawContact {
     pub h_min: Option<f64>,
     pub cohesion_cutoff: Option<f64>,
     pub characteristic_velocity: Option<f64>,
+    pub limit_force: Option<bool>,
+    pub tangential_damping: Option<bool>,
     /// `[[contact.pair]]`: coefficients of one species pair.
     #[serde(default, rename = "pair")]
     pub pairs: Vec<RawContactPair>,

@@ -25,6 +25,10 @@
 //! `CoulombMindlin` (`"coulomb"`), whose bound on the rolling torque (`cap_load`) applies here
 //! too. All tables are by the particle's species and the wall's material
 //! (`WallContact::pair_index`).
+//!
+//! `LIMIT_FORCE` (`limit_force = true`, LIGGGHTS `limitForce on`) clamps the normal force at
+//! zero, as `contact::damping::LimitForce` does for pairs; a compile-time switch, so the
+//! default wall is the same code as before.
 
 use super::{HertzWall, WallContact, WallLaw};
 use crate::contact::damping::liggghts_damping_factor;
@@ -34,7 +38,7 @@ use crate::contact::TangentialModel;
 use crate::math::{Real, Vec3};
 
 #[derive(Clone, Debug)]
-pub struct HertzHistoryWall<T = Mindlin> {
+pub struct HertzHistoryWall<T = Mindlin, const LIMIT_FORCE: bool = false> {
     /// The stateless law for bodies and the time step; its normal and damping slots give the
     /// normal force here too.
     pub stateless: HertzWall,
@@ -66,7 +70,9 @@ impl HertzHistoryWall<Mindlin> {
     }
 }
 
-impl<T: TangentialModel<History = Vec3> + MindlinSpring> WallLaw for HertzHistoryWall<T> {
+impl<T: TangentialModel<History = Vec3> + MindlinSpring, const LIMIT_FORCE: bool> WallLaw
+    for HertzHistoryWall<T, LIMIT_FORCE>
+{
     const NEEDS_ROTATION: bool = true;
     /// (shear displacement, stored rolling torque).
     type History = (Vec3, Vec3);
@@ -95,7 +101,10 @@ impl<T: TangentialModel<History = Vec3> + MindlinSpring> WallLaw for HertzHistor
         let pair = c.pair_index(self.stateless.materials);
         let contact = c.as_pair(pair, c.relative_velocity, normal_speed, slip);
         let stateless = &self.stateless;
-        let normal_force = normal_force(&stateless.normal, &stateless.damping, &contact);
+        let mut normal_force = normal_force(&stateless.normal, &stateless.damping, &contact);
+        if LIMIT_FORCE {
+            normal_force = normal_force.max(0.0);
+        }
         let tangential = self.tangential.force(&contact, normal_force, shear, dt);
         let mut torque = (-arm * n).cross(tangential);
 

@@ -279,6 +279,7 @@ pub fn run_case(
     let mine = Suite {
         cases: Vec::new(),
         stability: Vec::new(),
+        chung_ooi: Vec::new(),
         accuracy: suite
             .accuracy
             .iter()
@@ -318,6 +319,7 @@ pub fn run_scene_matrix(
         cases: Vec::new(),
         accuracy: vec![matrix.sweep.clone()],
         stability: Vec::new(),
+        chung_ooi: Vec::new(),
     };
     let options = ValidateOptions {
         suite: suite.source.clone(),

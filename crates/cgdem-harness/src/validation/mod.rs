@@ -50,6 +50,9 @@ pub struct ValidationSummary {
     /// The `[[stability]]` cases' verdicts, one per case and code.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub stability: Vec<super::stability::StabilityRecord>,
+    /// The `[[chung_ooi]]` benchmark's verdicts, one per law, test and criterion.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub chung_ooi: Vec<super::chung_ooi::ChungOoiVerdict>,
 }
 
 /// Runs every case of the suite with every code, level, rule and seed; a run that fails is
@@ -76,6 +79,11 @@ pub fn validate_suite(
             file: suite.source.clone(),
             message,
         })?;
+    let chung_ooi = super::chung_ooi::run_chung_ooi(&suite.chung_ooi, options, &mut report)
+        .map_err(|message| ValidateError::Case {
+            file: suite.source.clone(),
+            message,
+        })?;
     let mut summary = ValidationSummary {
         suite: suite.name.clone(),
         status: Status::Green,
@@ -84,6 +92,7 @@ pub fn validate_suite(
         comparisons,
         accuracy,
         stability,
+        chung_ooi,
     };
     summary.status = Status::of(&summary);
     write_intro(&mut report, &summary, suite, options, &warnings);

@@ -4,7 +4,9 @@
 
 use super::LawVisitor;
 use crate::contact::cohesion::{vdw_reach, NoCohesion, VanDerWaals};
-use crate::contact::damping::{liggghts_damping_factor, HertzDamping, YangDamping};
+use crate::contact::damping::{
+    clamped_damping_factor, liggghts_damping_factor, HertzDamping, LimitForce, YangDamping,
+};
 use crate::contact::normal::Hertz;
 use crate::contact::rolling::{ConstantTorque, Epsd2, NoRolling};
 use crate::contact::tangential::{CoulombMindlin, Mindlin, MindlinSpring, YangTangential};
@@ -44,6 +46,26 @@ impl FromScene for HertzDamping {
     }
 }
 
+/// The clamped dashpot with the coefficient that restitutes each pair's `e` when clamped.
+impl FromScene for LimitForce<HertzDamping> {
+    fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
+        let t = tables(scene, h);
+        LimitForce(HertzDamping {
+            factor: t.pair_table(|a, b| clamped_damping_factor(t.pair(a, b).restitution)),
+        })
+    }
+}
+
+/// The Mindlin dashpot's `2 sqrt(5/6) |beta(e)|` of restitution `e`, or 0 with
+/// `tangential_damping = false` (the table is zeroed once, here; the force loop is the same).
+fn tangential_damping_factor(h: &HertzSettings, restitution: Real) -> Real {
+    if h.tangential_damping {
+        liggghts_damping_factor(restitution)
+    } else {
+        0.0
+    }
+}
+
 impl FromScene for YangDamping {
     fn from_scene(scene: &Scene, h: &HertzSettings) -> Self {
         let HertzDampingKind::Yang { gamma_n } = h.damping else {
@@ -60,7 +82,8 @@ impl FromScene for Mindlin {
         let t = tables(scene, h);
         Mindlin {
             g_eff: t.pair_table(|a, b| t.g_eff(a, b)),
-            damping_factor: t.pair_table(|a, b| liggghts_damping_factor(t.pair(a, b).restitution)),
+            damping_factor: t
+                .pair_table(|a, b| tangential_damping_factor(h, t.pair(a, b).restitution)),
             friction: t.pair_table(|a, b| t.pair(a, b).friction),
         }
     }
@@ -184,6 +207,22 @@ pub fn hertz_history_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall<
     history_wall(scene, h, |t| t)
 }
 
+/// `hertz_history_wall` with the normal force clamped at zero (`limit_force = true`).
+pub fn hertz_history_wall_limited(
+    scene: &Scene,
+    h: &HertzSettings,
+) -> HertzHistoryWall<Mindlin, true> {
+    history_wall(scene, h, |t| t)
+}
+
+/// `hertz_coulomb_wall` with the normal force clamped at zero (`limit_force = true`).
+pub fn hertz_coulomb_wall_limited(
+    scene: &Scene,
+    h: &HertzSettings,
+) -> HertzHistoryWall<CoulombMindlin, true> {
+    history_wall(scene, h, CoulombMindlin)
+}
+
 /// The wall for `tangential = "coulomb"`: `hertz_history_wall`'s springs with the pair law's
 /// Coulomb bound on their sum.
 pub fn hertz_coulomb_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall<CoulombMindlin> {
@@ -191,11 +230,11 @@ pub fn hertz_coulomb_wall(scene: &Scene, h: &HertzSettings) -> HertzHistoryWall<
 }
 
 /// The history wall with the tangential slot `slot` makes of the wall pairs' `Mindlin`.
-fn history_wall<T: TangentialModel<History = Vec3> + MindlinSpring>(
+fn history_wall<T: TangentialModel<History = Vec3> + MindlinSpring, const LIMIT_FORCE: bool>(
     scene: &Scene,
     h: &HertzSettings,
     slot: impl FnOnce(Mindlin) -> T,
-) -> HertzHistoryWall<T> {
+) -> HertzHistoryWall<T, LIMIT_FORCE> {
     let t = tables(scene, h);
     let rolling_friction = match h.rolling {
         RollingKind::Epsd2 => t.wall_table(|a, k| t.wall_pair(a, k).rolling_friction),
@@ -206,11 +245,11 @@ fn history_wall<T: TangentialModel<History = Vec3> + MindlinSpring>(
         g_eff: t.wall_table(|a, k| t.wall_g_eff(a, k)),
         damping_factor: restitution
             .iter()
-            .map(|&e| liggghts_damping_factor(e))
+            .map(|&e| tangential_damping_factor(h, e))
             .collect(),
         friction: t.wall_table(|a, k| t.wall_pair(a, k).friction),
     };
-    let stateless = HertzWall::from_tables(
+    let mut stateless = HertzWall::from_tables(
         t.n_wall_materials(),
         t.wall_table(|a, k| t.wall_y_eff(a, k)),
         &restitution,
@@ -218,6 +257,13 @@ fn history_wall<T: TangentialModel<History = Vec3> + MindlinSpring>(
         vec![0.0; t.wall_pairs.len()],
         h.characteristic_velocity,
     );
+    if LIMIT_FORCE {
+        // The clamped wall contact restitutes e with its own coefficient, as pairs do.
+        stateless.damping.factor = restitution
+            .iter()
+            .map(|&e| clamped_damping_factor(e))
+            .collect();
+    }
     HertzHistoryWall {
         stateless,
         tangential: slot(tangential),
@@ -230,8 +276,9 @@ fn history_wall<T: TangentialModel<History = Vec3> + MindlinSpring>(
 /// its keywords) and the name listed in errors. `SUPPORTED` and the dispatch are both made
 /// from this one list.
 macro_rules! compiled_hertz_laws {
-    ($( ($d:pat, $t:pat, $r:pat, $c:pat) => <$D:ty, $T:ty, $R:ty, $C:ty>, $wall:ident, $name:literal; )*) => {
-        /// The compiled combinations, as (damping, tangential, rolling, cohesion) keywords.
+    ($( ($d:pat, $l:pat, $t:pat, $r:pat, $c:pat) => <$D:ty, $T:ty, $R:ty, $C:ty>, $wall:ident, $name:literal; )*) => {
+        /// The compiled combinations, as (damping, tangential, rolling, cohesion) keywords
+        /// (`+limit_force` when the normal force is clamped).
         pub const SUPPORTED: &[&str] = &[$($name),*];
 
         /// Calls `visitor` with the one compiled law that matches the scene's keywords.
@@ -245,14 +292,17 @@ macro_rules! compiled_hertz_laws {
             #[allow(unused_imports)]
             use HertzDampingKind::{Restitution, Yang};
             type K = TangentialKind;
-            match (h.damping, h.tangential, h.rolling, h.cohesion) {
-                $( ($d, $t, $r, $c) => Ok(visitor.visit(
+            match (h.damping, h.limit_force, h.tangential, h.rolling, h.cohesion) {
+                $( ($d, $l, $t, $r, $c) => Ok(visitor.visit(
                     hertz_law::<$D, $T, $R, $C>(scene, h),
                     $wall(scene, h),
                 )), )*
-                (d, t, r, c) => Err(RunError::Unsupported {
+                (d, l, t, r, c) => Err(RunError::Unsupported {
                     file: scene.source.display().to_string(),
-                    combination: format!("{d:?}/{t:?}/{r:?}/{c:?}"),
+                    combination: format!(
+                        "{d:?}/{t:?}/{r:?}/{c:?}{}",
+                        if l { "+limit_force" } else { "" }
+                    ),
                     supported: SUPPORTED.join(", "),
                 }),
             }
@@ -261,25 +311,29 @@ macro_rules! compiled_hertz_laws {
 }
 
 compiled_hertz_laws! {
-    (Restitution, K::History, RollingKind::None, NoVdw)
+    (Restitution, false, K::History, RollingKind::None, NoVdw)
         => <HertzDamping, Mindlin, NoRolling, NoCohesion>, hertz_history_wall, "hertz/history/none/none";
-    (Restitution, K::History, RollingKind::ConstantTorque, NoVdw)
+    (Restitution, false, K::History, RollingKind::ConstantTorque, NoVdw)
         => <HertzDamping, Mindlin, ConstantTorque, NoCohesion>, hertz_wall, "hertz/history/constant_torque/none";
-    (Restitution, K::History, RollingKind::ConstantTorque, Vdw { .. })
+    (Restitution, false, K::History, RollingKind::ConstantTorque, Vdw { .. })
         => <HertzDamping, Mindlin, ConstantTorque, VanDerWaals>, hertz_wall, "hertz/history/constant_torque/vdw";
-    (Restitution, K::History, RollingKind::Epsd2, NoVdw)
+    (Restitution, false, K::History, RollingKind::Epsd2, NoVdw)
         => <HertzDamping, Mindlin, Epsd2, NoCohesion>, hertz_history_wall, "hertz/history/epsd2/none";
-    (Restitution, K::History, RollingKind::Epsd2, Vdw { .. })
+    (Restitution, false, K::History, RollingKind::Epsd2, Vdw { .. })
         => <HertzDamping, Mindlin, Epsd2, VanDerWaals>, hertz_history_wall, "hertz/history/epsd2/vdw";
-    (Restitution, K::Coulomb, RollingKind::None, NoVdw)
+    (Restitution, false, K::Coulomb, RollingKind::None, NoVdw)
         => <HertzDamping, CoulombMindlin, NoRolling, NoCohesion>, hertz_coulomb_wall, "hertz/coulomb/none/none";
-    (Restitution, K::Coulomb, RollingKind::Epsd2, NoVdw)
+    (Restitution, false, K::Coulomb, RollingKind::Epsd2, NoVdw)
         => <HertzDamping, CoulombMindlin, Epsd2, NoCohesion>, hertz_coulomb_wall, "hertz/coulomb/epsd2/none";
-    (Restitution, K::Coulomb, RollingKind::Epsd2, Vdw { .. })
+    (Restitution, false, K::Coulomb, RollingKind::Epsd2, Vdw { .. })
         => <HertzDamping, CoulombMindlin, Epsd2, VanDerWaals>, hertz_coulomb_wall, "hertz/coulomb/epsd2/vdw";
-    (Yang { .. }, K::Yang, RollingKind::None, NoVdw)
+    (Restitution, true, K::History, RollingKind::None, NoVdw)
+        => <LimitForce<HertzDamping>, Mindlin, NoRolling, NoCohesion>, hertz_history_wall_limited, "hertz/history/none/none+limit_force";
+    (Restitution, true, K::Coulomb, RollingKind::None, NoVdw)
+        => <LimitForce<HertzDamping>, CoulombMindlin, NoRolling, NoCohesion>, hertz_coulomb_wall_limited, "hertz/coulomb/none/none+limit_force";
+    (Yang { .. }, false, K::Yang, RollingKind::None, NoVdw)
         => <YangDamping, YangTangential, NoRolling, NoCohesion>, hertz_wall, "yang/yang/none/none";
-    (Yang { .. }, K::Yang, RollingKind::ConstantTorque, Vdw { .. })
+    (Yang { .. }, false, K::Yang, RollingKind::ConstantTorque, Vdw { .. })
         => <YangDamping, YangTangential, ConstantTorque, VanDerWaals>, hertz_wall, "yang/yang/constant_torque/vdw (paper B)";
 }
 
@@ -287,6 +341,62 @@ compiled_hertz_laws! {
 mod tests {
     use super::*;
     use crate::run::RunOptions;
+
+    #[test]
+    fn tangential_damping_off_zeroes_the_dashpots_and_limit_force_recalibrates_the_walls() {
+        let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .join("validation/cases/hertz_settle.toml");
+        let mut scene = Scene::load(&path).unwrap();
+        let crate::scene::ContactSettings::Hertz(h) = &mut scene.contact else {
+            panic!("not hertz")
+        };
+        let mut h = h.clone();
+        assert!(Mindlin::from_scene(&scene, &h)
+            .damping_factor
+            .iter()
+            .all(|&f| f > 0.0));
+        let plain = hertz_history_wall(&scene, &h);
+        h.tangential_damping = false;
+        h.limit_force = true;
+        assert!(Mindlin::from_scene(&scene, &h)
+            .damping_factor
+            .iter()
+            .all(|&f| f == 0.0));
+        let wall = hertz_history_wall_limited(&scene, &h);
+        assert!(wall.tangential.damping_factor.iter().all(|&f| f == 0.0));
+        let e = scene.wall_contact.restitution;
+        assert!(e < 1.0);
+        for (clamped, free) in wall
+            .stateless
+            .damping
+            .factor
+            .iter()
+            .zip(&plain.stateless.damping.factor)
+        {
+            assert_eq!(*clamped, clamped_damping_factor(e));
+            assert!(clamped > free);
+        }
+    }
+
+    #[test]
+    fn without_its_dashpot_a_sticking_mindlin_contact_is_elastic() {
+        // Load the spring by a slip and take it back: the force returns to zero (no energy
+        // lost), and at any slip speed it is the spring's alone, -k_t u.
+        let m = Mindlin {
+            g_eff: vec![1e6],
+            damping_factor: vec![0.0],
+            friction: vec![0.5],
+        };
+        let mut c = crate::contact::tests::contact_at(1e-5, 5e-4);
+        let k_t = 8.0 * 1e6 * (5e-4_f64 * 1e-5).sqrt();
+        let mut u = Vec3::ZERO;
+        c.tangential_velocity = Vec3::new(0.0, 1e-3, 0.0);
+        let loaded = m.force(&c, 100.0, &mut u, 1e-3);
+        assert!((loaded.y + k_t * 1e-6).abs() < 1e-12 * k_t);
+        c.tangential_velocity = -c.tangential_velocity;
+        let unloaded = m.force(&c, 100.0, &mut u, 1e-3);
+        assert_eq!((unloaded, u), (Vec3::ZERO, Vec3::ZERO));
+    }
 
     #[test]
     fn an_uncompiled_combination_is_refused_with_the_supported_list() {

@@ -38,6 +38,8 @@ fn wca_contact(
         ("damping", rc.damping.is_some()),
         ("gamma_n_yang", rc.gamma_n_yang.is_some()),
         ("tangential", rc.tangential.is_some()),
+        ("limit_force", rc.limit_force.is_some()),
+        ("tangential_damping", rc.tangential_damping.is_some()),
         ("rolling", rc.rolling.is_some()),
         ("cohesion", rc.cohesion.is_some()),
         ("hamaker_constant", rc.hamaker_constant.is_some()),
@@ -154,6 +156,7 @@ fn hertz_contact(
     )?;
     let (damping, restitution) = hertz_damping(c, rc)?;
     let tangential = tangential(c, rc)?;
+    let (limit_force, tangential_damping) = mindlin_options(c, rc, damping, tangential)?;
     let rolling = rolling(c, rc)?;
     let cohesion = cohesion(c, rc)?;
     let mut h = HertzSettings {
@@ -170,6 +173,8 @@ fn hertz_contact(
             "contact.characteristic_velocity",
             rc.characteristic_velocity.unwrap_or(1.0),
         )?,
+        limit_force,
+        tangential_damping,
         pairs: Vec::new(),
     };
     h.pairs = materials::contact_pairs(c, &rc.pairs, species, &h)?;
@@ -243,6 +248,37 @@ fn tangential(c: &Checker, rc: &RawContact) -> Result<TangentialKind, SceneError
             "\"history\" (LIGGGHTS tangential history, default), \"coulomb\" (the same spring and dashpot, their sum capped at mu max(F_n, 0)) or \"yang\" (paper B Eq. 5)",
         )),
     }
+}
+
+/// `limit_force` and `tangential_damping` (LIGGGHTS `limitForce`, `tangential_damping`): options
+/// of the restitution dashpot and of the Mindlin spring, so only with `damping = "hertz"` and
+/// `tangential = "history"` or `"coulomb"`.
+fn mindlin_options(
+    c: &Checker,
+    rc: &RawContact,
+    damping: HertzDampingKind,
+    tangential: TangentialKind,
+) -> Result<(bool, bool), SceneError> {
+    let mindlin = damping == HertzDampingKind::Restitution
+        && matches!(
+            tangential,
+            TangentialKind::History | TangentialKind::Coulomb
+        );
+    let limit_force = rc.limit_force.unwrap_or(false);
+    let tangential_damping = rc.tangential_damping.unwrap_or(true);
+    for (field, non_default, value) in [
+        ("limit_force", limit_force, "true"),
+        ("tangential_damping", !tangential_damping, "false"),
+    ] {
+        if non_default && !mindlin {
+            return Err(c.invalid(
+                format!("contact.{field}"),
+                value,
+                "only with damping = \"hertz\" and tangential = \"history\" or \"coulomb\"",
+            ));
+        }
+    }
+    Ok((limit_force, tangential_damping))
 }
 
 /// `rolling = "none" | "constant_torque" | "epsd2"` (its friction is checked with the pairs).
