@@ -479,8 +479,7 @@ fn finished_digest(dir: &Path) -> Option<String> {
 }
 
 /// Runs LAMMPS or LIGGGHTS, or with `--reuse` takes the run already in `dir`; true when
-/// reused. A scene the code cannot express (LIGGGHTS and the seed's WCA model, or a feature
-/// a deck writer refuses) is `Unsupported`, with the reason.
+/// reused. LIGGGHTS cannot express the WCA model of Hirose: its runs of such a case are skipped.
 fn run_reference_code(
     code: Code,
     scene: &Scene,
@@ -501,7 +500,7 @@ fn run_reference_code(
         && matches!(scene.contact, cgdem_core::scene::ContactSettings::Wca(_))
     {
         return Err(RunOutcome::Unsupported(
-            "LIGGGHTS cannot express the seed's WCA model (model = \"wca\"); it runs Hertz cases"
+            "LIGGGHTS cannot express the WCA model of Hirose (model = \"wca\"); it runs Hertz cases"
                 .into(),
         ));
     }

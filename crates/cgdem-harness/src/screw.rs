@@ -1,6 +1,6 @@
 //! The report section of a screw-feeder case (a scene with `[conveying]`): mass flow against
 //! screw speed for every code with its block-average standard error, beside Eq. (7) with
-//! each code's measured fill ratio (paper A Fig. 8), and a table of the numbers. Every code's
+//! each code's measured fill ratio (Hirose, Fig. 8), and a table of the numbers. Every code's
 //! flow is measured the same way (`analysis::conveying`: cgdem from its state, LIGGGHTS and
 //! LAMMPS from their dumps, `decks::postprocess::conveying_samples`).
 
@@ -104,7 +104,7 @@ pub fn write_screw_overview(
     out: &Path,
 ) -> Result<(), ValidateError> {
     let mut figure = Figure::new(
-        "Screw feeder: mass flow against speed, every code and screw (paper A Fig. 8)",
+        "Screw feeder: mass flow against speed, every code and screw (Hirose, Fig. 8)",
         "screw speed (rpm)",
         "mass flow (kg/s)",
     );
@@ -163,7 +163,7 @@ pub fn write_screw_section(
         section.paragraph("cgdem's guards only warn in this case (suite entry `keep_going = true`): grains wedge between the flight's tip and the casing, a clearance narrower than a grain, deeper than the overlap guard allows; the warnings and the deepest overlap are in each run's summary.json.");
     }
     let mut figure = Figure::new(
-        "Screw feeder: mass flow against speed (paper A Fig. 8)",
+        "Screw feeder: mass flow against speed (Hirose, Fig. 8)",
         "screw speed (rpm)",
         "mass flow (kg/s)",
     );

@@ -71,7 +71,7 @@ fn run_code(
         Code::Liggghts | Code::Lammps if !case.reference_codes => {
             result.status = "skipped".into();
             result.reason = Some(format!(
-                "the reference decks are written for Hertz scenes; `{}` uses the seed's WCA model (cgdem alone)",
+                "the reference decks are written for Hertz scenes; `{}` uses the WCA model of Hirose (cgdem alone)",
                 case.name
             ));
             return (result, None);

@@ -99,7 +99,7 @@ pub(crate) fn not_applicable(code: Code, scene: &Scene) -> Option<String> {
         }
     }
     if code == Code::Liggghts && matches!(scene.contact, ContactSettings::Wca(_)) {
-        return Some("LIGGGHTS cannot express the seed's WCA model (model = \"wca\")".into());
+        return Some("LIGGGHTS cannot express the WCA model of Hirose (model = \"wca\")".into());
     }
     None
 }

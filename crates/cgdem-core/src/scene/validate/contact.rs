@@ -18,7 +18,7 @@ pub(super) fn contact(
         other => Err(c.invalid(
             "contact.model",
             format!("\"{other}\""),
-            "\"wca\" (the seed's model) or \"hertz\"",
+            "\"wca\" (the WCA model of Hirose) or \"hertz\"",
         )),
     }
 }

@@ -110,7 +110,7 @@ pub(crate) fn body_lines(
             }
             _ => {
                 return Err(unsupported(format!(
-                    "body[{k}] `{}`: LAMMPS has no mesh walls; its decks take bodies built of particles, the seed's fixed casing and hopper (`screw-feeder:casing`, `screw-feeder:hopper`) and the fixed built-in silo (`silo:wall`) only",
+                    "body[{k}] `{}`: LAMMPS has no mesh walls; its decks take bodies built of particles, the fixed casing and hopper of Hirose's screw feeder (`screw-feeder:casing`, `screw-feeder:hopper`) and the fixed built-in silo (`silo:wall`) only",
                     b.name
                 )))
             }
@@ -120,7 +120,7 @@ pub(crate) fn body_lines(
         static_parts.sort_unstable();
         if static_parts != ["casing", "hopper"] {
             return Err(unsupported(format!(
-                "bodies {static_parts:?}: the LAMMPS deck writes the seed's casing and hopper together, as one region (each once)"
+                "bodies {static_parts:?}: the LAMMPS deck writes the screw feeder's casing and hopper together, as one region (each once)"
             )));
         }
         out.setup += &casing_and_hopper_region(&ScrewFeederSpec::default(), CASING_REGION);
@@ -133,7 +133,7 @@ pub(crate) fn body_lines(
     }
     if !static_parts.is_empty() && !silos.is_empty() || silos.len() > 1 {
         return Err(unsupported(
-            "the LAMMPS deck writes one region wall: the seed's casing and hopper, or one silo"
+            "the LAMMPS deck writes one region wall: the casing and hopper of Hirose's screw feeder, or one silo"
                 .into(),
         ));
     }

@@ -142,7 +142,7 @@ fn wca_settings(scene: &Scene, dt: Real) -> Result<(WcaSettings, Vec<Real>), Dec
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let ContactSettings::Wca(wca) = scene.contact else {
         return Err(unsupported(
-            "not the seed's WCA model: Hertz scenes get `hertz::write_hertz_deck`".into(),
+            "not the WCA model of Hirose: Hertz scenes get `hertz::write_hertz_deck`".into(),
         ));
     };
     if wca.gamma_n <= 0.0 {
