@@ -192,9 +192,9 @@ impl Suite {
 
 impl Suite {
     /// The suite `cgdem validate CASE.toml` runs for a scene file of one's own: one case
-    /// with the default tolerances, run by `codes` at `lambdas` under paper A's rule with
-    /// `seeds`, measured as its scene's observers say (`[repose]`, `[conveying]`,
-    /// `[discharge]`, `[packing]`). `name` is the scene's.
+    /// with the default tolerances, run by `codes` at `lambdas` under the default rule
+    /// (relative-overlap) with `seeds`, measured as its scene's observers say (`[repose]`,
+    /// `[conveying]`, `[discharge]`, `[packing]`). `name` is the scene's.
     pub fn for_scene(
         file: &Path,
         name: &str,
