@@ -160,7 +160,7 @@ fn advise_run_on_a_scene_alone_prints_its_cost_answers_and_exits_by_the_answer()
     assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
     assert!(
         stdout.starts_with(
-            "my_heap-advise: repose_angle within 90.00 deg: lambda = 2 under the seed rule"
+            "my_heap-advise: repose_angle within 90.00 deg: lambda = 2 under the relative-overlap rule"
         ),
         "{stdout}"
     );

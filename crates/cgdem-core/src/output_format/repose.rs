@@ -33,8 +33,9 @@ pub struct ReposeSample {
     pub trigger: SampleTrigger,
     pub repose_angle_deg: Option<Real>,
     pub repose_fit_r2: Option<Real>,
-    /// Why the angle could not be measured, when it could not.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// Why the angle could not be measured, when it could not. Always written (no
+    /// `skip_serializing_if`): restart files hold the samples in bincode, which cannot skip.
+    #[serde(default)]
     pub not_measured: Option<String>,
     pub runout_m: Real,
     pub wall_height_m: Real,
