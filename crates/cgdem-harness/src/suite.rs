@@ -527,4 +527,22 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn every_shipped_suite_loads_and_every_case_scene_with_its_overrides() {
+        crate::at_repo_root();
+        let mut suites = 0;
+        for entry in std::fs::read_dir("validation/suites").unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                let suite = Suite::load(&path).unwrap_or_else(|e| panic!("{e}"));
+                for case in &suite.cases {
+                    case.load_scene()
+                        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                }
+                suites += 1;
+            }
+        }
+        assert!(suites >= 10, "only {suites} suite files found");
+    }
 }
