@@ -5,11 +5,13 @@
 # CSVs the same --grid writes on threads in one process, that `validate --np 2` runs the
 # harness's cgdem runs as ranks with the same CSVs, and that its ranks resume a killed run
 # from the restart files threads or ranks wrote (`--checkpoint-every`, `--reuse`), bitwise.
-# A few seconds beyond the build
-# (none when scripts/test.sh has built the workspace with --features mpi already).
-# Usage: bash scripts/mpi-check.sh [--prepare]
+# A few seconds beyond the build (none when given a binary built with MPI).
+# Usage: bash scripts/mpi-check.sh [--prepare | BINARY]
 #   --prepare: only install what the MPI build needs; exit 0 when it is there, 1 when not
 #   (scripts/test.sh then builds everything once with --features mpi, or without).
+#   BINARY: a cgdem built with --features mpi (scripts/test.sh passes the one its tests
+#   built); without it the script builds one. `cargo build` resolves the dependencies'
+#   features apart from `cargo test`, so building here after the tests recompiles everything.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 prepare=${1:-}
@@ -34,8 +36,17 @@ if ((${#missing[@]} > 0)); then
 fi
 [ "$prepare" = --prepare ] && exit 0
 
-cargo build --release --features mpi
-bin=target/release/cgdem
+if [ -n "$prepare" ]; then
+    bin=$prepare
+    [ -x "$bin" ] || { echo "mpi-check: $bin is not an executable cgdem" >&2; exit 2; }
+    "$bin" --version | grep -q "built with MPI" || {
+        echo "mpi-check: $bin was built without MPI ('$("$bin" --version)'); build it with --features mpi" >&2
+        exit 2
+    }
+else
+    cargo build --release --features mpi
+    bin=target/release/cgdem
+fi
 out=target/mpi-check
 rm -rf "$out"
 case_file=tests/data/tiny_hertz_collapse.toml

@@ -96,11 +96,16 @@ bin=target/release/cgdem
 # Beside the smoke suite: the VTK series read by meshio (installed from PyPI if missing) and
 # checked against cgdem's own state on three short runs (seconds); a full disk while writing
 # outputs (a clear error and the files written before intact); the MPI transport of --grid
-# (2 and 4 ranks against the threaded run, CSVs compared with cmp; no build left to do).
+# (2 and 4 ranks against the threaded run, CSVs compared with cmp, on the binary the tests
+# built with MPI: no build left to do).
 side_checks() {
     bash scripts/check-vtk-meshio.sh "$bin"
     bash scripts/check-full-disk.sh "$bin"
-    bash scripts/mpi-check.sh
+    if ((${#features[@]} > 0)); then
+        bash scripts/mpi-check.sh "$bin"
+    else
+        bash scripts/mpi-check.sh
+    fi
 }
 beside side-checks side_checks
 
