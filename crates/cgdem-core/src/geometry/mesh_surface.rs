@@ -105,7 +105,7 @@ impl MeshSurface {
                 edges[i] = e / lengths[i];
             }
             let normal = edges[0].cross(edges[1]);
-            if lengths.iter().any(|&l| l == 0.0) || normal.length() < 1e-12 {
+            if lengths.contains(&0.0) || normal.length() < 1e-12 {
                 return Err(format!(
                     "triangle {} (corners {:?}, {:?}, {:?}) has no area",
                     t + 1,
