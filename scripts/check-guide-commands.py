@@ -2,7 +2,9 @@
 """Runs the command blocks of a guide page, in order, so the guide cannot drift from the
 program (as trycmd and mdBook's `test` do for theirs).
 
-Usage: python3 scripts/check-guide-commands.py PAGE.md [PAGE.md ...]
+Usage: python3 scripts/check-guide-commands.py [--full] PAGE.md [PAGE.md ...]
+  --full  run the pages at their own size (the `replace` directives ignored), each command's
+          output printed, and the scratch directories kept: the figures a page quotes
 
 A page is read top to bottom:
 - a fenced block whose first line is `# file: NAME` (toml, python, ...) is written to NAME in
@@ -54,7 +56,7 @@ def blocks(text):
         k += 1
 
 
-def check(page):
+def check(page, full=False):
     text = page.read_text()
     scratch = Path(tempfile.mkdtemp(prefix=f"guide-{page.stem}-"))
     cwd = scratch
@@ -72,7 +74,8 @@ def check(page):
             elif d.startswith("exit "):
                 expected = {int(x) for x in d.split()[1].split(",")}
             elif m := REPLACE.fullmatch(d):
-                replacements.append((m.group(1), m.group(2)))
+                if not full:
+                    replacements.append((m.group(1), m.group(2)))
             else:
                 sys.exit(f"{page}: unknown guide-check directive {d!r}")
         if skip:
@@ -97,18 +100,24 @@ def check(page):
             took = time.time() - started
             status = "ok" if p.returncode in expected else "FAILED"
             print(f"{page.name}: {status} ({took:.0f} s, exit {p.returncode}, expected {sorted(expected)}): {command}")
+            if full:
+                print(p.stdout)
+                print(p.stderr, file=sys.stderr)
             if p.returncode not in expected:
                 failures += 1
                 print(p.stdout[-3000:])
                 print(p.stderr[-3000:], file=sys.stderr)
+    if full:
+        print(f"{page.name}: its files and outputs are in {cwd if cwd != ROOT else scratch}")
     return failures
 
 
 def main():
-    pages = [Path(p) for p in sys.argv[1:]]
+    full = "--full" in sys.argv[1:]
+    pages = [Path(p) for p in sys.argv[1:] if p != "--full"]
     if not pages:
         sys.exit(__doc__)
-    failures = sum(check(p) for p in pages)
+    failures = sum(check(p, full) for p in pages)
     if failures:
         print(f"{failures} guide commands did not run as the guide says", file=sys.stderr)
     sys.exit(1 if failures else 0)

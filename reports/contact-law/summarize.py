@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Per-law means, their difference and its standard error, from a `cgdem validate` summary.json
-of validation/suites/contact_law.toml (each run's law is its `tangential` field).
+of validation/suites/contact_law.toml or contact_preset.toml. A run's law is its case's
+variant (`aor_hertz-coulomb`, `aor_hertz-chung-ooi`), `history` without one.
 
-Usage: summarize.py OUT/summary.json > bulk_effect.csv (the runs to stdout as well: runs.csv
-with --runs)."""
+Usage: summarize.py OUT/summary.json [--law coulomb|chung-ooi] > bulk_effect.csv (the law
+compared with history; default coulomb), or with --runs: the runs (runs.csv)."""
 import csv
 import json
 import math
@@ -16,40 +17,53 @@ QUANTITIES = {
 }
 
 
+LAWS = ["coulomb", "chung-ooi"]
+
+
 def base(case):
-    return case[: -len("-coulomb")] if case.endswith("-coulomb") else case
+    for law in LAWS:
+        if case.endswith("-" + law):
+            return case[: -len(law) - 1]
+    return case
+
+
+def law_of(case):
+    return next((law for law in LAWS if case.endswith("-" + law)), "history")
 
 
 def main():
     summary = json.load(open(sys.argv[1]))
     runs = [r for r in summary["runs"] if r["status"] == "ok"]
+    law = sys.argv[sys.argv.index("--law") + 1] if "--law" in sys.argv else "coulomb"
+    if law not in LAWS:
+        sys.exit(f"summarize.py: --law must be one of {', '.join(LAWS)}, not {law!r}")
     if "--runs" in sys.argv:
         out = csv.writer(sys.stdout)
-        out.writerow(["case", "tangential", "seed", "rpm", "repose_angle_deg", "runout_m",
+        out.writerow(["case", "law", "seed", "rpm", "repose_angle_deg", "runout_m",
                       "mass_flow_kg_s", "mass_flow_std_error_kg_s", "fill_ratio", "steps", "wall_s"])
         for r in runs:
-            out.writerow([base(r["case"]), r.get("tangential"), r["seed"], r.get("rpm", ""),
+            out.writerow([base(r["case"]), law_of(r["case"]), r["seed"], r.get("rpm", ""),
                           r.get("repose_angle_deg", ""), r.get("runout_m", ""),
                           r.get("mass_flow_kg_s", ""), r.get("mass_flow_std_error_kg_s", ""),
                           r.get("fill_ratio", ""), r.get("steps", ""), r.get("wall_s", "")])
         return
     out = csv.writer(sys.stdout)
-    out.writerow(["case", "quantity", "n_history", "mean_history", "sd_history", "n_coulomb",
-                  "mean_coulomb", "sd_coulomb", "coulomb_minus_history", "std_error",
+    out.writerow(["case", "quantity", "n_history", "mean_history", "sd_history", f"n_{law}",
+                  f"mean_{law}", f"sd_{law}", f"{law}_minus_history", "std_error",
                   "n_paired", "paired_difference", "paired_std_error"])
     for case, quantities in QUANTITIES.items():
         for q in quantities:
             by_law = {}
             for r in runs:
                 if base(r["case"]) == case and r.get(q) is not None:
-                    by_law.setdefault(r.get("tangential"), []).append(r[q])
+                    by_law.setdefault(law_of(r["case"]), []).append(r[q])
             by_seed = {}
             for r in runs:
                 if base(r["case"]) == case and r.get(q) is not None:
-                    by_seed.setdefault(r["seed"], {})[r.get("tangential")] = r[q]
+                    by_seed.setdefault(r["seed"], {})[law_of(r["case"])] = r[q]
             # The same insertion seed under both laws: the same grains dropped the same way.
-            paired = [v["coulomb"] - v["history"] for v in by_seed.values() if len(v) == 2]
-            h, c = by_law.get("history", []), by_law.get("coulomb", [])
+            paired = [v[law] - v["history"] for v in by_seed.values() if law in v and "history" in v]
+            h, c = by_law.get("history", []), by_law.get(law, [])
             if not h or not c:
                 continue
             stats = []

@@ -16,11 +16,14 @@
 //! - **Suite kinds**, each a folder of its phases (`suite`, `runs`, `measurement`,
 //!   `report`): the cases of [`validation`], the error-against-run-time sweeps of
 //!   [`accuracy`], the stress cases of [`stability`], and [`mod@bench`]'s timed runs.
+//! - **Measured quantities**, one file (or folder) each in [`quantity`]: the repose angle
+//!   and profile, a collapse's flow, a screw's mass flow, a discharge rate, a packing's
+//!   porosity; each with its measurement from a run, its noise over seeds, its criterion and
+//!   its figures, which the suite kinds and [`advise`] combine.
 //! - **Building blocks**: [`suite`] and [`suite_entry`] (suite files), [`runs`] (one run of
 //!   any code, reuse, concurrency), [`decks`] (the reference codes: a LAMMPS and a LIGGGHTS
 //!   dialect, runner, dump parser, post-processing), [`ranks`] (cgdem as MPI ranks),
-//!   [`verdict`], [`dynamics`], [`screw`], [`silo`], [`report`] (figures and HTML), [`csv_table`],
-//!   [`code`].
+//!   [`verdict`], [`report`] (figures and HTML), [`csv_table`], [`code`].
 
 // Commands.
 pub mod advise;
@@ -32,16 +35,15 @@ pub mod bench;
 pub mod chung_ooi;
 pub mod stability;
 pub mod validation;
+// Measured quantities.
+pub mod quantity;
 // Building blocks.
 pub mod code;
 pub mod csv_table;
 pub mod decks;
-pub mod dynamics;
 pub mod ranks;
 pub mod report;
 pub mod runs;
-pub mod screw;
-pub mod silo;
 pub mod suite;
 pub mod suite_entry;
 pub mod verdict;

@@ -7,6 +7,8 @@ use serde::Deserialize;
 
 use super::accuracy::{AccuracySweep, RawSweep};
 use super::verdict::KnownDifference;
+use crate::quantity::flow::FlowTolerances;
+use crate::quantity::CaseOrigin;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::{Override, Scene, SceneError};
 
@@ -54,14 +56,34 @@ pub struct SuiteCase {
     /// feeder's tip clearance is narrower than a grain); the warnings stay in each run's
     /// summary, and the reference codes, which have no such guard, run it alike.
     pub keep_going: bool,
-    /// Measured as a silo discharge (`[case.discharge]`, `crate::silo`).
-    pub discharge: Option<crate::silo::DischargeSettings>,
+    /// Measured as a silo discharge (`[case.discharge]`, `crate::quantity::discharge`).
+    pub discharge: Option<crate::quantity::discharge::DischargeSettings>,
 }
 
 impl SuiteCase {
     /// The case's scene: its file with the overrides applied, named after the variant.
     pub fn load_scene(&self) -> Result<Scene, SceneError> {
         load_variant(&self.file, &self.overrides, self.variant.as_deref())
+    }
+
+    /// What the quantities' sections say of this case.
+    pub fn origin(&self) -> CaseOrigin<'_> {
+        CaseOrigin {
+            file: &self.file,
+            seeds: &self.seeds,
+            rpms: &self.rpms,
+            keep_going: self.keep_going,
+        }
+    }
+
+    /// The tolerances of the dynamics criteria.
+    pub fn flow_tolerances(&self) -> FlowTolerances {
+        FlowTolerances {
+            time_ratio: self.time_ratio_tolerance,
+            front: self.front_tolerance,
+            wall_height: self.wall_height_tolerance,
+            kinetic_energy: self.kinetic_energy_tolerance,
+        }
     }
 }
 
@@ -118,7 +140,7 @@ struct RawCase {
     rpms: Vec<f64>,
     #[serde(default)]
     keep_going: bool,
-    discharge: Option<crate::silo::RawDischarge>,
+    discharge: Option<crate::quantity::discharge::RawDischarge>,
 }
 
 #[derive(Deserialize)]
@@ -133,12 +155,12 @@ struct RawKnownDifference {
 
 /// The criteria a comparison is judged by (`verdict::Criterion::name`).
 pub const CRITERIA: [&str; 6] = [
-    "repose angle",
+    crate::quantity::repose::CRITERION,
     "t_half ratio",
     "front gap",
     "wall height gap",
     "kinetic energy gap",
-    crate::silo::CRITERION,
+    crate::quantity::discharge::CRITERION,
 ];
 
 impl Suite {
@@ -358,7 +380,7 @@ fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError
         keep_going: c.keep_going,
         discharge: c
             .discharge
-            .map(|d| crate::silo::parse_discharge(d, &format!("case[{k}]"), path))
+            .map(|d| crate::quantity::discharge::parse_discharge(d, &format!("case[{k}]"), path))
             .transpose()?,
     })
 }
@@ -526,5 +548,23 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    #[test]
+    fn every_shipped_suite_loads_and_every_case_scene_with_its_overrides() {
+        crate::at_repo_root();
+        let mut suites = 0;
+        for entry in std::fs::read_dir("validation/suites").unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                let suite = Suite::load(&path).unwrap_or_else(|e| panic!("{e}"));
+                for case in &suite.cases {
+                    case.load_scene()
+                        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                }
+                suites += 1;
+            }
+        }
+        assert!(suites >= 10, "only {suites} suite files found");
     }
 }

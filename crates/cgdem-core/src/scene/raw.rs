@@ -168,6 +168,8 @@ pub struct RawContact {
     pub characteristic_velocity: Option<f64>,
     pub limit_force: Option<bool>,
     pub tangential_damping: Option<bool>,
+    /// A named combination of the options above (`preset = "chung-ooi"`).
+    pub preset: Option<String>,
     /// `[[contact.pair]]`: coefficients of one species pair.
     #[serde(default, rename = "pair")]
     pub pairs: Vec<RawContactPair>,

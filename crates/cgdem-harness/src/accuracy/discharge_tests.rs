@@ -7,8 +7,8 @@ use super::discharge::measure_discharge;
 use super::*;
 use crate::advise::advise;
 use crate::code::Code;
+use crate::quantity::discharge::DischargeSettings;
 use crate::runs::RunRecord;
-use crate::silo::DischargeSettings;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::Scene;
 

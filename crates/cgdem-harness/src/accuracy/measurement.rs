@@ -2,14 +2,14 @@
 //! same seed, settings averaged over their seeds, the floor of the reference runs, the
 //! Pareto front and the cheapest setting within a target.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
 use super::{Targets, SPREAD_STANDARD_ERRORS};
 use crate::code::Code;
-use crate::csv_table::CsvTable;
-use crate::dynamics::{flow_difference, FlowSeries, FLOW_GRID_S};
+use crate::quantity::flow::{front_history_gap, FlowSeries};
+use crate::quantity::repose::{profile_distance, read_profile};
 use crate::runs::Outcome;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 
@@ -77,7 +77,7 @@ pub struct AccuracyPoint {
     #[serde(default)]
     pub front_error: Option<f64>,
     /// A silo's discharge rate, kg/s (mass: a parcel counts lambda^3 grains), over the
-    /// sweep's window, with its block standard error (`crate::silo::discharge_rate`).
+    /// sweep's window, with its block standard error (`crate::quantity::discharge::discharge_rate`).
     #[serde(default)]
     pub discharge_rate_kg_s: Option<f64>,
     #[serde(default)]
@@ -311,45 +311,6 @@ pub fn cheapest_within(points: &[(f64, f64)], target: f64) -> Option<usize> {
         })
 }
 
-/// RMS gap between two heap profiles `(x, h)` (x ascending), over the reference's largest
-/// height: both are interpolated linearly on the union of their abscissae from the first to
-/// the last, and a profile is zero beyond its last point (no deposit) and constant before its
-/// first (the bins start half a width from the wall).
-pub fn profile_distance(reference: &[(f64, f64)], other: &[(f64, f64)]) -> Option<f64> {
-    let height = reference.iter().map(|p| p.1).fold(0.0, f64::max);
-    if reference.is_empty() || other.is_empty() || height <= 0.0 {
-        return None;
-    }
-    let at = |profile: &[(f64, f64)], x: f64| -> f64 {
-        let k = profile.partition_point(|p| p.0 < x);
-        if k == 0 {
-            profile[0].1
-        } else if k == profile.len() {
-            0.0
-        } else {
-            let (a, b) = (profile[k - 1], profile[k]);
-            a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
-        }
-    };
-    let mut xs: Vec<f64> = reference.iter().chain(other).map(|p| p.0).collect();
-    xs.sort_by(f64::total_cmp);
-    xs.dedup();
-    let sum: f64 = xs
-        .iter()
-        .map(|&x| (at(reference, x) - at(other, x)).powi(2))
-        .sum();
-    Some((sum / xs.len() as f64).sqrt() / height)
-}
-
-/// The run's heap profile (`profile.csv`); empty when the run wrote none or it cannot be read
-/// (the point then has no profile error).
-fn read_profile(dir: &Path) -> Vec<(f64, f64)> {
-    CsvTable::read(&dir.join("profile.csv"))
-        .and_then(|t| t.numbers(&["x_m", "height_m"]))
-        .map(|rows| rows.iter().map(|r| (r[0], r[1])).collect())
-        .unwrap_or_default()
-}
-
 /// Fills each point's errors against its code's reference run with the same seed.
 pub(crate) fn measure(points: &mut [AccuracyPoint]) {
     let references: Vec<AccuracyPoint> = points
@@ -378,26 +339,6 @@ pub(crate) fn measure(points: &mut [AccuracyPoint]) {
     }
 }
 
-/// The front history's gap: each run's front as the fraction of its own largest advance it
-/// has covered, and the largest difference of the two fractions over the flow (on a common
-/// time grid; the run that ended first holds its last value). 0.1 means "a tenth of the
-/// run-out apart at worst". How far the fronts get is the heap's (angle, profile); this is
-/// how they get there. Each run's own advance also takes out the front's definition in
-/// particle diameters (where the deposit is two diameters deep), which puts a coarser
-/// level's front further back by about two diameters over the toe's slope. None when a
-/// front never advanced.
-pub fn front_history_gap(reference: &FlowSeries, other: &FlowSeries) -> Option<f64> {
-    let covered = |flow: &FlowSeries| -> Option<FlowSeries> {
-        let start = *flow.front_m.first()?;
-        let advance = flow.front_m.iter().map(|x| x - start).fold(0.0, f64::max);
-        (advance > 0.0).then(|| FlowSeries {
-            front_m: flow.front_m.iter().map(|x| (x - start) / advance).collect(),
-            ..flow.clone()
-        })
-    };
-    Some(flow_difference(&covered(reference)?, &covered(other)?, 1.0, FLOW_GRID_S)?.front_max)
-}
-
 /// How far run `p` is from run `r` under measure `m` (None where either measured nothing).
 fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
     let finite = |v: f64| Some(v).filter(|v| v.is_finite());
@@ -406,7 +347,9 @@ fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
         Measure::Profile => {
             p.repose_angle_deg?;
             r.repose_angle_deg?;
-            profile_distance(&read_profile(&r.dir), &read_profile(&p.dir))
+            // A profile that cannot be read gives the point no profile error.
+            let profile = |q: &AccuracyPoint| read_profile(&q.dir).unwrap_or_default();
+            profile_distance(&profile(r), &profile(p))
         }
         Measure::MassFlow => finite((p.mass_flow_kg_s? / r.mass_flow_kg_s? - 1.0).abs()),
         Measure::Eq7 => finite((p.eq7_error? - r.eq7_error?).abs()),

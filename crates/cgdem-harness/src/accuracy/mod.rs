@@ -17,8 +17,8 @@
 //! Its phases, one file each: `suite` (the `[[accuracy]]` entry), `runs` (every setting
 //! with every seed and code), `measurement` (errors, means over seeds, the cheapest setting)
 //! and `report` (the subsection, its figures, `points.csv` and the coarse-graining matrix);
-//! `discharge` measures and reports a silo's discharge rate (a sweep with a `discharge`
-//! table).
+//! `discharge` puts a silo's discharge rate into the points and the report (a sweep with a
+//! `discharge` table). What each run measures, and how, is `crate::quantity`'s.
 
 mod discharge;
 #[cfg(test)]
@@ -30,12 +30,13 @@ mod suite;
 #[cfg(test)]
 pub(crate) mod tests;
 
+pub use crate::quantity::flow::front_history_gap;
+pub use crate::quantity::repose::profile_distance;
 pub(crate) use measurement::{
     cheapest_setting, measure, measure_named, settings, Cost, Setting, SettingMean,
 };
 pub use measurement::{
-    cheapest_within, front_history_gap, pareto_front, profile_distance, AccuracyPoint,
-    AccuracySummary, CheapestSetting, Measure,
+    cheapest_within, pareto_front, AccuracyPoint, AccuracySummary, CheapestSetting, Measure,
 };
 pub(crate) use suite::RawSweep;
 pub use suite::{AccuracySweep, Knob, KnobSeries, Targets};

@@ -7,9 +7,11 @@ use std::path::{Path, PathBuf};
 use super::discharge::measure_discharge;
 use super::{AccuracyPoint, AccuracySweep, Knob, KnobSeries};
 use crate::code::Code;
-use crate::dynamics::FlowSeries;
+use crate::quantity::discharge::DischargeSettings;
+use crate::quantity::flow::{flow_stage, measured_t_half};
+use crate::quantity::mass_flow::conveying_value;
+use crate::quantity::porosity::{pore_diameter_in_diameters, porosity};
 use crate::runs::{run_concurrently, run_one, Outcome, ValidateError, ValidateOptions};
-use crate::silo::DischargeSettings;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::Scene;
 
@@ -244,8 +246,8 @@ fn run_point(
     if record.status == Outcome::Ok
         && discharge.is_none()
         && record.repose_angle_deg.is_none()
-        && summary["conveying"]["mass_flow_kg_s"].as_f64().is_none()
-        && summary["packing"]["porosity"].as_f64().is_none()
+        && conveying_value(&summary, "mass_flow_kg_s").is_none()
+        && porosity(&summary).is_none()
     {
         record.status = Outcome::Failed;
         record.reason = Some(format!(
@@ -254,11 +256,7 @@ fn run_point(
         ));
     }
     let ok = record.status == Outcome::Ok;
-    let conveying = |key: &str| {
-        summary["conveying"][key]
-            .as_f64()
-            .filter(|v| ok && v.is_finite())
-    };
+    let conveying = |key: &str| conveying_value(&summary, key).filter(|_| ok);
     let particle_steps = summary["particle_steps"]
         .as_f64()
         .or_else(|| Some(record.n_particles? as f64 * record.steps? as f64));
@@ -287,26 +285,13 @@ fn run_point(
         mass_flow_error: None,
         eq7_mass_flow_kg_s: conveying("eq7_mass_flow_kg_s"),
         eq7_error: None,
-        t_half_s: scene
-            .repose
-            .as_ref()
-            .filter(|_| ok)
-            .and_then(|r| FlowSeries::read(dir, &r.stage)?.t_half()),
+        t_half_s: measured_t_half(scene, dir).filter(|_| ok),
         t_half_error: None,
-        flow_stage: scene
-            .repose
-            .as_ref()
-            .filter(|_| ok)
-            .map(|r| r.stage.clone()),
+        flow_stage: flow_stage(scene).filter(|_| ok).map(str::to_string),
         front_error: None,
-        porosity: summary["packing"]["porosity"]
-            .as_f64()
-            .filter(|v| ok && v.is_finite()),
+        porosity: porosity(&summary).filter(|_| ok),
         porosity_error: None,
-        pore_diameter_d: summary["packing"]["mean_pore_diameter_m"]
-            .as_f64()
-            .map(|pore| pore / (scene.max_diameter() * lambda as f64))
-            .filter(|v| ok && v.is_finite() && *v > 0.0),
+        pore_diameter_d: pore_diameter_in_diameters(&summary, scene, lambda).filter(|_| ok),
         pore_size_error: None,
         discharge_rate_kg_s: None,
         discharge_rate_std_error_kg_s: None,

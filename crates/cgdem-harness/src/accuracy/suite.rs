@@ -103,7 +103,7 @@ pub struct AccuracySweep {
     pub targets: Targets,
     /// How each run is measured as a discharge (`discharge`, as a suite case's): the silo's
     /// rate, as mass, against the reference's.
-    pub discharge: Option<crate::silo::DischargeSettings>,
+    pub discharge: Option<crate::quantity::discharge::DischargeSettings>,
 }
 
 #[derive(Deserialize)]
@@ -125,7 +125,7 @@ pub(crate) struct RawSweep {
     porosity_target: Option<f64>,
     pore_size_target: Option<f64>,
     discharge_rate_target: Option<f64>,
-    discharge: Option<crate::silo::RawDischarge>,
+    discharge: Option<crate::quantity::discharge::RawDischarge>,
 }
 
 #[derive(Deserialize)]
@@ -274,7 +274,9 @@ impl AccuracySweep {
         let targets = parse_targets(&raw, k, path)?;
         let discharge = raw
             .discharge
-            .map(|d| crate::silo::parse_discharge(d, &format!("accuracy[{k}]"), path))
+            .map(|d| {
+                crate::quantity::discharge::parse_discharge(d, &format!("accuracy[{k}]"), path)
+            })
             .transpose()?;
         Ok(AccuracySweep {
             file: crate::suite_entry::beside_suite(path, &raw.file),

@@ -4,7 +4,7 @@ use super::measurement::floor;
 use super::runs::own_rule_sweeps;
 use super::*;
 use crate::code::Code;
-use crate::dynamics::FlowSeries;
+use crate::quantity::flow::FlowSeries;
 use crate::runs::Outcome;
 use crate::suite::Suite;
 use cgdem_core::coarse_graining::CoarseGrainRule;

@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 use super::AdviseError;
 use crate::accuracy::{AccuracySweep, Knob, KnobSeries, Measure, Targets};
 use crate::code::Code;
-use crate::silo::DischargeSettings;
+pub use crate::quantity::discharge::{discharge_settings, opening, Opening};
 use cgdem_core::coarse_graining::{coarse_grain_by, CoarseGrainRule};
-use cgdem_core::scene::{ContactSettings, MeshSource, Scene, StageEnd};
+use cgdem_core::scene::{ContactSettings, Scene};
 
 /// Fewest particles a default level keeps: below a few hundred, a heap, a bed or a flow is
 /// a handful of parcels whose measurement is mostly their packing.
@@ -42,13 +42,6 @@ pub struct MatrixChoice {
     pub lambdas: Option<Vec<u32>>,
     pub rules: Option<Vec<CoarseGrainRule>>,
     pub seeds: Option<Vec<u64>>,
-}
-
-/// The narrowest opening the grains leave through, and where its width comes from.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Opening {
-    pub diameter_m: f64,
-    pub source: String,
 }
 
 /// One level of the matrix: its particle count and parcel diameter.
@@ -107,95 +100,6 @@ pub fn measurable(scene: &Scene) -> Vec<Measure> {
         out.push(Measure::DischargeRate);
     }
     out
-}
-
-/// How a scene's discharge is measured: as its `[discharge]` table says, else grains of its one species deleted by `[[delete]]`
-/// (no screw), counted from the first stage that removes a wall (the gate; else the last
-/// stage), its first quarter discarded as start-up, the rest in 5 blocks; the fill's bulk
-/// density over its first insertion's box.
-pub fn discharge_settings(scene: &Scene, opening: Option<&Opening>) -> Option<DischargeSettings> {
-    // The scene's own `[discharge]` table says how, when it has one.
-    if let Some(own) = &scene.discharge {
-        return Some(own.into());
-    }
-    if scene.deletions.is_empty() || scene.conveying.is_some() || scene.species.len() != 1 {
-        return None;
-    }
-    let stage = scene
-        .stages
-        .iter()
-        .find(|s| !s.remove_walls.is_empty())
-        .or(scene.stages.last())?;
-    let duration = match stage.end {
-        StageEnd::Duration(d) => d,
-        StageEnd::Settled { max_duration, .. } => max_duration,
-    };
-    let fill = scene.insertions.first()?;
-    Some(DischargeSettings {
-        stage: stage.name.clone(),
-        // Only Beverloo's column of the report uses it; without an opening it says nothing.
-        orifice_diameter_m: opening.map_or(f64::NAN, |o| o.diameter_m),
-        discard_s: 0.25 * duration,
-        blocks: 5,
-        bulk_lo: fill.lo.to_array(),
-        bulk_hi: fill.hi.to_array(),
-    })
-}
-
-/// The narrowest opening of a scene whose grains leave through `[[delete]]`: its
-/// `[discharge]` table's `orifice_diameter`, a built-in
-/// silo's orifice, or for a mesh body that does not move, twice the smallest distance of its
-/// vertices from its vertical axis (the line along gravity through the centre of its
-/// bounding box): the rim of a hopper's orifice.
-pub fn opening(scene: &Scene) -> Option<Opening> {
-    if let Some(own) = &scene.discharge {
-        return Some(Opening {
-            diameter_m: own.orifice_diameter,
-            source: "the scene's [discharge] orifice_diameter".into(),
-        });
-    }
-    if scene.deletions.is_empty() || scene.conveying.is_some() {
-        return None;
-    }
-    let down = scene.gravity.normalize_or_zero();
-    for body in &scene.bodies {
-        match &body.mesh {
-            MeshSource::Silo(_, spec) => {
-                return Some(Opening {
-                    diameter_m: spec.orifice_diameter,
-                    source: format!("body `{}`: the silo's orifice_diameter", body.name),
-                })
-            }
-            MeshSource::Stl(path) if body.rpm == 0.0 && body.velocity.length() == 0.0 => {
-                if down == cgdem_core::math::Vec3::ZERO {
-                    continue;
-                }
-                let Ok(mesh) = body.load_mesh() else { continue };
-                let b = mesh.bounding_box();
-                let centre = 0.5 * (b.min + b.max);
-                let radius = mesh
-                    .vertices
-                    .iter()
-                    .map(|v| {
-                        let r = *v - centre;
-                        (r - r.dot(down) * down).length()
-                    })
-                    .fold(f64::INFINITY, f64::min);
-                if radius.is_finite() && radius > 0.0 {
-                    return Some(Opening {
-                        diameter_m: 2.0 * radius,
-                        source: format!(
-                            "body `{}` ({}): twice its vertices' smallest distance from its vertical axis",
-                            body.name,
-                            path.display()
-                        ),
-                    });
-                }
-            }
-            _ => {}
-        }
-    }
-    None
 }
 
 /// The level `lambda` of `scene`: its particles (the insertions' amounts at that level, as

@@ -1,14 +1,14 @@
 //! What a suite's cases are judged by: the comparisons of codes and levels (final state and
-//! dynamics), each a set of criteria with their noise, tolerance and verdict.
-
-use std::collections::BTreeMap;
+//! dynamics), each a set of criteria with their noise, tolerance and verdict. Which pairs
+//! are compared is this file's; each criterion is its quantity's (`crate::quantity`).
 
 use serde::Serialize;
 
-use crate::dynamics::{flow_difference, flow_noise, FlowSeries, FLOW_GRID_S};
-use crate::runs::{Outcome, RunRecord};
-use crate::suite::{Code, SuiteCase};
-use crate::verdict::{combined_standard_error, mean_sd, Criterion};
+use crate::quantity::flow::{flow_criteria, flows_by_group};
+use crate::quantity::repose::{angle_criterion, angles_by_group};
+use crate::quantity::seeds::{rule_of, GroupKey};
+use crate::runs::RunRecord;
+use crate::suite::SuiteCase;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::Scene;
 
@@ -66,45 +66,6 @@ impl Comparison {
             pass: verdict != crate::verdict::Verdict::Fail,
         }
     }
-}
-
-/// Mean and sample standard deviation.
-pub(super) fn mean_spread(values: &[f64]) -> Option<(f64, f64)> {
-    if values.is_empty() {
-        return None;
-    }
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let spread = if values.len() > 1 {
-        (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-    } else {
-        0.0
-    };
-    Some((mean, spread))
-}
-
-pub(super) type Group = (CoarseGrainRule, u32, Code);
-/// A group of runs: (coarse-graining rule as u8, lambda, code).
-pub(super) type GroupKey = (u8, u32, Code);
-
-pub(super) fn angles_by_group(runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<f64>> {
-    let mut groups: BTreeMap<GroupKey, Vec<f64>> = BTreeMap::new();
-    for r in runs.iter().filter(|r| !r.partial) {
-        if let Some(a) = r.repose_angle_deg {
-            groups
-                .entry((r.cg_rule as u8, r.lambda, r.code))
-                .or_default()
-                .push(a);
-        }
-    }
-    groups
-}
-
-pub(super) fn rule_of(index: u8) -> CoarseGrainRule {
-    CoarseGrainRule::ALL
-        .into_iter()
-        .find(|r| *r as u8 == index)
-        .unwrap_or_default()
 }
 
 /// The pairs a case compares: codes against each other at each level and rule ("codes"),
@@ -172,158 +133,40 @@ pub(super) fn compare(scene: &Scene, case: &SuiteCase, runs: &[RunRecord]) -> Ve
     let mut out = Vec::new();
     for (kind, a, b) in comparison_pairs(&keys) {
         let what = pair_name(kind, a, b);
-        let stats = |k| groups.get(&k).and_then(|v| mean_sd(v));
-        if let (Some((ma, sa, na)), Some((mb, sb, nb))) = (stats(a), stats(b)) {
-            let angle = Criterion::judge(
-                "repose angle",
-                "deg",
-                (ma - mb).abs(),
-                combined_standard_error((sa, na), (sb, nb)),
-                [na, nb],
-                case.angle_tolerance_deg,
-                known(&what, "repose angle"),
-            );
+        let angles = |k| groups.get(&k).map_or(&[][..], Vec::as_slice);
+        let tolerance = case.angle_tolerance_deg;
+        let known_angle = known(&what, crate::quantity::repose::CRITERION);
+        if let Some((angle, detail)) = angle_criterion(angles(a), angles(b), tolerance, known_angle)
+        {
             out.push(Comparison::judged(
                 &scene.name,
                 kind,
                 "final state",
                 &what,
-                format!(
-                    "repose angle {ma:.1} +- {sa:.1} ({na} seeds) vs {mb:.1} +- {sb:.1} ({nb} seeds) deg"
-                ),
+                detail,
                 vec![angle],
             ));
         }
         if let (Some(fa), Some(fb)) = (flows.get(&a), flows.get(&b)) {
-            if let Some(c) = compare_flows(scene, case, kind, &what, (a, fa), (b, fb), box_length) {
-                out.push(c);
+            let dynamics = flow_criteria(
+                fa,
+                fb,
+                box_length,
+                &case.flow_tolerances(),
+                |criterion| known(&what, criterion),
+                &predicted_time_ratio(kind, a, b),
+            );
+            if let Some((criteria, detail)) = dynamics {
+                out.push(Comparison::judged(
+                    &scene.name,
+                    kind,
+                    "dynamics",
+                    &what,
+                    detail,
+                    criteria,
+                ));
             }
         }
     }
     out
-}
-
-/// The dynamics part of a comparison, four criteria: the ratio of the seeds' mean `t_half`
-/// (judged as |ratio - 1|), and the largest gaps between the seed-mean histories of the
-/// front (of the box length), the height at the remaining wall (of its initial height) and
-/// the kinetic energy (of its peak); each against its tolerance plus `K_NOISE` times the
-/// noise the seeds show.
-fn compare_flows(
-    scene: &Scene,
-    case: &SuiteCase,
-    kind: &str,
-    what: &str,
-    (a, fa): (GroupKey, &Vec<FlowSeries>),
-    (b, fb): (GroupKey, &Vec<FlowSeries>),
-    box_length: f64,
-) -> Option<Comparison> {
-    let ta: Vec<f64> = fa.iter().filter_map(FlowSeries::t_half).collect();
-    let tb: Vec<f64> = fb.iter().filter_map(FlowSeries::t_half).collect();
-    let step = FLOW_GRID_S;
-    let mean_a = FlowSeries::mean(fa, step)?;
-    let mean_b = FlowSeries::mean(fb, step)?;
-    let gap = flow_difference(&mean_a, &mean_b, box_length, step)?;
-    let noise = flow_noise(fa, fb, box_length, step)?;
-    let seeds = [fa.len(), fb.len()];
-    let known = |criterion: &str| {
-        case.known_differences
-            .iter()
-            .find(|k| k.applies_to(what, criterion))
-    };
-    let mut criteria = Vec::new();
-    // t_half exists only where the front moved; without it on a side, the gaps still judge.
-    let t_half_text = match (mean_sd(&ta), mean_sd(&tb)) {
-        (Some((ma, sa, na)), Some((mb, sb, nb))) => {
-            let ratio = mb / ma;
-            // Standard error of the ratio from the relative standard errors of the means.
-            let ratio_noise = ratio * combined_standard_error((sa / ma, na), (sb / mb, nb));
-            criteria.push(Criterion::judge(
-                "t_half ratio",
-                "|ratio - 1|",
-                (ratio - 1.0).abs(),
-                ratio_noise,
-                [na, nb],
-                case.time_ratio_tolerance,
-                known("t_half ratio"),
-            ));
-            format!(
-                "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {})",
-                predicted_time_ratio(kind, a, b)
-            )
-        }
-        _ => format!(
-            "t_half not measured (the front did not move in {} of {} and {} of {} runs)",
-            fa.len() - ta.len(),
-            fa.len(),
-            fb.len() - tb.len(),
-            fb.len()
-        ),
-    };
-    criteria.extend([
-        Criterion::judge(
-            "front gap",
-            "of the box length",
-            gap.front_max,
-            noise.front,
-            seeds,
-            case.front_tolerance,
-            known("front gap"),
-        ),
-        Criterion::judge(
-            "wall height gap",
-            "of the initial height",
-            gap.wall_height_max,
-            noise.wall_height,
-            seeds,
-            case.wall_height_tolerance,
-            known("wall height gap"),
-        ),
-        Criterion::judge(
-            "kinetic energy gap",
-            "of the peak",
-            gap.kinetic_energy_max,
-            noise.kinetic_energy,
-            seeds,
-            case.kinetic_energy_tolerance,
-            known("kinetic energy gap"),
-        ),
-    ]);
-    Some(Comparison::judged(
-        &scene.name,
-        kind,
-        "dynamics",
-        what,
-        format!(
-            "{t_half_text}; gaps, largest over time (mean): front {:.3} ({:.3}) of the box \
-             length, wall height {:.3} ({:.3}) of the initial height, kinetic energy {:.3} \
-             ({:.3}) of the peak",
-            gap.front_max,
-            gap.front_mean,
-            gap.wall_height_max,
-            gap.wall_height_mean,
-            gap.kinetic_energy_max,
-            gap.kinetic_energy_mean,
-        ),
-        criteria,
-    ))
-}
-
-/// Every successful run's flow during the measured stage, per group.
-pub(super) fn flows_by_group(
-    scene: &Scene,
-    runs: &[RunRecord],
-) -> BTreeMap<GroupKey, Vec<FlowSeries>> {
-    let mut groups: BTreeMap<GroupKey, Vec<FlowSeries>> = BTreeMap::new();
-    let Some(stage) = scene.repose.as_ref().map(|r| r.stage.as_str()) else {
-        return groups;
-    };
-    for r in runs.iter().filter(|r| r.status == Outcome::Ok) {
-        if let Some(flow) = FlowSeries::read(&r.dir, stage) {
-            groups
-                .entry((r.cg_rule as u8, r.lambda, r.code))
-                .or_default()
-                .push(flow);
-        }
-    }
-    groups
 }

@@ -26,6 +26,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use crate::quantity::{discharge, mass_flow};
 use crate::report::Report;
 use crate::runs::output_error;
 use crate::suite::{Suite, SuiteCase};
@@ -180,20 +181,20 @@ fn run_cases(
         .map(|(s, _, r)| (s, r.as_slice()))
         .collect();
     if screws.len() > 1 {
-        super::screw::write_screw_overview(report, &screws, &options.out)?;
+        mass_flow::write_screw_overview(report, &screws, &options.out)?;
     }
     // Silo cases (`[case.discharge]`) are measured once, shown across orifices, then each.
     let silos: Vec<_> = scenes
         .iter()
         .filter_map(|(s, c, r)| {
             let d = c.discharge.as_ref()?;
-            Some((s, d, super::silo::measure_runs(s, d, r)))
+            Some((s, d, discharge::measure_runs(s, d, r)))
         })
         .collect();
     if !silos.is_empty() {
-        super::silo::write_silo_overview(report, &silos, &options.out)?;
+        discharge::write_silo_overview(report, &silos, &options.out)?;
     }
-    let silos: Vec<(String, Vec<super::silo::SiloRun>)> = silos
+    let silos: Vec<(String, Vec<discharge::SiloRun>)> = silos
         .into_iter()
         .map(|(s, _, m)| (s.name.clone(), m))
         .collect();
@@ -201,22 +202,22 @@ fn run_cases(
         if let Some(settings) = &case.discharge {
             let measured = silos.iter().find(|(n, _)| *n == scene.name).map(|(_, m)| m);
             let measured = measured.map_or(&[][..], |m| m.as_slice());
-            let verdict = super::silo::rate_criterion(measured, &case.known_differences).map(
+            let verdict = discharge::rate_criterion(measured, &case.known_differences).map(
                 |(criterion, text)| {
                     Comparison::judged(
                         &scene.name,
                         "codes",
                         "final state",
-                        super::silo::COMPARISON,
+                        discharge::COMPARISON,
                         text,
                         vec![criterion],
                     )
                 },
             );
-            super::silo::write_silo_section(
+            discharge::write_silo_section(
                 report,
                 &scene,
-                (&case.file, &case.seeds),
+                &case.origin(),
                 settings,
                 measured,
                 verdict.as_ref().map(|c| (c.verdict, c.detail.as_str())),
@@ -229,7 +230,8 @@ fn run_cases(
         }
         if scene.conveying.is_some() {
             // A screw case is judged by its mass flow against Eq. (7), code by code.
-            super::screw::write_screw_section(report, &scene, &case, &case_runs, &options.out)?;
+            let origin = case.origin();
+            mass_flow::write_screw_section(report, &scene, &origin, &case_runs, &options.out)?;
             write_code_notes(report, &case_runs);
             runs.extend(case_runs);
             continue;

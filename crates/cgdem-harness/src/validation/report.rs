@@ -5,15 +5,13 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::measurement::{angles_by_group, flows_by_group, mean_spread, rule_of, Group, GroupKey};
 use super::{Comparison, ValidationSummary};
-use crate::csv_table::CsvTable;
-use crate::dynamics::{FlowSeries, FLOW_GRID_S};
-use crate::report::{
-    write_bar_chart, write_figure, Cell, Figure, Report, Series, SeriesStyle, Table,
-};
+use crate::quantity::flow::flow_figures;
+use crate::quantity::repose::{angle_at_times_figure, angles_figure, profiles_figure};
+use crate::quantity::seeds::{mean_spread, Group};
+use crate::report::{write_bar_chart, write_figure, Cell, Report, Table};
 use crate::runs::{output_error, Outcome, RunRecord, ValidateError, ValidateOptions};
-use crate::suite::{Code, Suite, SuiteCase};
+use crate::suite::{Suite, SuiteCase};
 use crate::verdict::Verdict;
 use cgdem_core::coarse_graining::CoarseGrainRule;
 use cgdem_core::scene::Scene;
@@ -274,26 +272,6 @@ pub(crate) fn machine_provenance() -> BTreeMap<String, String> {
     p
 }
 
-/// The `(x_m, height_m)` rows of a run's `profile.csv`; none when the run wrote no profile.
-fn read_profile(path: &Path, case: &SuiteCase) -> Result<Vec<Vec<f64>>, ValidateError> {
-    if !path.exists() {
-        return Ok(Vec::new());
-    }
-    CsvTable::read(path)
-        .and_then(|t| t.numbers(&["x_m", "height_m"]))
-        .map_err(|e| ValidateError::Case {
-            file: case.file.clone(),
-            message: e.to_string(),
-        })
-}
-
-fn label(code: Code, lambda: u32, rule: CoarseGrainRule) -> String {
-    match rule {
-        CoarseGrainRule::RelativeOverlap => format!("{} lambda={lambda}", code.name()),
-        other => format!("{} lambda={lambda} {}", code.name(), other.name()),
-    }
-}
-
 pub(super) fn write_case_section(
     report: &mut Report,
     scene: &Scene,
@@ -320,7 +298,7 @@ pub(super) fn write_case_section(
         .collect();
     keys.sort_by_key(|k| (k.0 as u8, k.1, k.2));
     keys.dedup();
-    let profiles = profiles_figure(scene, case, &ok_runs, &keys)?;
+    let profiles = profiles_figure(scene, &case.file, &ok_runs, &keys)?;
     let files = write_figure(&dir, "profiles", &profiles).map_err(figure_error)?;
     section.figure(&files, "heap profiles", "Free-surface height against distance from the remaining wall at the measurement time, averaged over seeds.").map_err(|e| output_error(&dir, e))?;
 
@@ -394,82 +372,6 @@ fn write_similarity(
         sub.figure(&files, title, caption).map_err(|e| output_error(dir, e))?;
     }
     Ok(())
-}
-
-/// Heap profiles, averaged over seeds per code, level and rule (`keys`).
-fn profiles_figure(
-    scene: &Scene,
-    case: &SuiteCase,
-    ok_runs: &[&RunRecord],
-    keys: &[Group],
-) -> Result<Figure, ValidateError> {
-    let mut profiles = Figure::new(
-        format!("{}: heap profiles (mean over seeds)", scene.name),
-        "distance from the remaining wall x [m]",
-        "surface height h(x) [m]",
-    );
-    for &(rule, lambda, code) in keys {
-        let members: Vec<&&RunRecord> = ok_runs
-            .iter()
-            .filter(|r| (r.cg_rule, r.lambda, r.code) == (rule, lambda, code))
-            .collect();
-        let mut sum: Vec<(f64, f64)> = Vec::new();
-        for r in &members {
-            for (k, row) in read_profile(&r.dir.join("profile.csv"), case)?
-                .iter()
-                .enumerate()
-            {
-                let (x, h) = (row[0], row[1]);
-                if k < sum.len() {
-                    sum[k].1 += h;
-                } else {
-                    sum.push((x, h));
-                }
-            }
-        }
-        let n = members.len().max(1) as f64;
-        profiles.series.push(
-            Series::new(
-                label(code, lambda, rule),
-                sum.into_iter().map(|(x, h)| (x, h / n)).collect(),
-            )
-            .style(SeriesStyle::Line),
-        );
-    }
-    Ok(profiles)
-}
-
-/// Repose angle per level with its seed spread, one line per rule and code.
-fn angles_figure(scene: &Scene, runs: &[RunRecord]) -> Figure {
-    let mut angles = Figure::new(
-        format!("{}: repose angle per level", scene.name),
-        "coarse-graining level lambda",
-        "repose angle [deg]",
-    )
-    .log_x();
-    let groups = angles_by_group(runs);
-    // (rule, code) -> (lambda, mean angle) points and their seed spreads.
-    type AngleSeries = (Vec<(f64, f64)>, Vec<f64>);
-    let mut series: BTreeMap<(u8, Code), AngleSeries> = BTreeMap::new();
-    for (&(rule, lambda, code), values) in &groups {
-        if let Some((mean, spread)) = mean_spread(values) {
-            let entry = series.entry((rule, code)).or_default();
-            entry.0.push((lambda as f64, mean));
-            entry.1.push(spread);
-        }
-    }
-    for ((rule, code), (points, errors)) in series {
-        let name = match rule_of(rule) {
-            CoarseGrainRule::RelativeOverlap => code.name().to_string(),
-            other => format!("{} {}", code.name(), other.name()),
-        };
-        angles.series.push(
-            Series::new(name, points)
-                .y_err(errors)
-                .style(SeriesStyle::LineMarkers),
-        );
-    }
-    angles
 }
 
 /// Throughput per code, level and rule (`keys`): mean and spread over seeds.
@@ -566,128 +468,6 @@ fn similarity_table(comparisons: &[Comparison]) -> Table {
         ]);
     }
     table
-}
-
-/// The flow histories (front, height at the wall, kinetic energy), mean over seeds, one
-/// line per code, level and rule.
-fn flow_figures(scene: &Scene, runs: &[RunRecord]) -> [Figure; 3] {
-    let flows = flows_by_group(scene, runs);
-    let time_axis = "time after the gate opens t [s]";
-    let mut front = Figure::new(
-        format!("{}: front position (mean over seeds)", scene.name),
-        time_axis,
-        "front position x_f [m]",
-    );
-    let mut height = Figure::new(
-        format!(
-            "{}: height at the remaining wall (mean over seeds)",
-            scene.name
-        ),
-        time_axis,
-        "wall height h_w [m]",
-    );
-    let mut energy = Figure::new(
-        format!("{}: kinetic energy (mean over seeds)", scene.name),
-        time_axis,
-        "kinetic energy per mass [J/kg]",
-    )
-    .log_y();
-    for (&(rule, lambda, code), series) in &flows {
-        let Some(mean) = FlowSeries::mean(series, FLOW_GRID_S) else {
-            continue;
-        };
-        let name = label(code, lambda, rule_of(rule));
-        let points = |v: &[f64]| {
-            mean.time_s
-                .iter()
-                .copied()
-                .zip(v.iter().copied())
-                .collect::<Vec<_>>()
-        };
-        front
-            .series
-            .push(Series::new(name.clone(), points(&mean.front_m)).style(SeriesStyle::Line));
-        height
-            .series
-            .push(Series::new(name.clone(), points(&mean.wall_height_m)).style(SeriesStyle::Line));
-        let positive = points(&mean.kinetic_energy_per_mass)
-            .into_iter()
-            .filter(|p| p.1 > 0.0)
-            .collect();
-        energy
-            .series
-            .push(Series::new(name, positive).style(SeriesStyle::Line));
-    }
-    [front, height, energy]
-}
-
-/// The repose angle at the fixed times after the gate opens, mean and spread over seeds.
-fn angle_at_times_figure(scene: &Scene, runs: &[RunRecord]) -> Figure {
-    let time_axis = "time after the gate opens t [s]";
-    let mut angle = Figure::new(
-        format!(
-            "{}: repose angle at fixed times (mean over seeds)",
-            scene.name
-        ),
-        time_axis,
-        "repose angle [deg]",
-    );
-    let mut keys: Vec<GroupKey> = runs
-        .iter()
-        .filter(|r| r.status == Outcome::Ok)
-        .map(|r| (r.cg_rule as u8, r.lambda, r.code))
-        .collect();
-    keys.sort();
-    keys.dedup();
-    for key in keys {
-        let mut by_time: BTreeMap<u64, Vec<f64>> = BTreeMap::new();
-        for r in runs
-            .iter()
-            .filter(|r| r.status == Outcome::Ok && (r.cg_rule as u8, r.lambda, r.code) == key)
-        {
-            for (t, a) in fixed_time_angles(&r.dir) {
-                by_time.entry(t.to_bits()).or_default().push(a);
-            }
-        }
-        let (points, errors): (Vec<(f64, f64)>, Vec<f64>) = by_time
-            .iter()
-            .filter_map(|(t, v)| mean_spread(v).map(|(m, s)| ((f64::from_bits(*t), m), s)))
-            .unzip();
-        if !points.is_empty() {
-            angle.series.push(
-                Series::new(label(key.2, key.1, rule_of(key.0)), points)
-                    .y_err(errors)
-                    .style(SeriesStyle::LineMarkers),
-            );
-        }
-    }
-    angle
-}
-
-/// (time after the stage start, angle) of a run's fixed-time repose samples.
-fn fixed_time_angles(dir: &Path) -> Vec<(f64, f64)> {
-    let Ok(text) = std::fs::read_to_string(dir.join("summary.json")) else {
-        return Vec::new();
-    };
-    let Ok(value) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return Vec::new();
-    };
-    value
-        .get("repose_samples")
-        .and_then(|v| v.as_array())
-        .map(|samples| {
-            samples
-                .iter()
-                .filter(|s| s.get("trigger").and_then(|v| v.as_str()) == Some("fixed time"))
-                .filter_map(|s| {
-                    Some((
-                        s.get("time_after_start_s")?.as_f64()?,
-                        s.get("repose_angle_deg")?.as_f64()?,
-                    ))
-                })
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// The first screen: the status, what the suite is, the criteria and runs tables and the

@@ -331,6 +331,9 @@ compiled_hertz_laws! {
         => <LimitForce<HertzDamping>, Mindlin, NoRolling, NoCohesion>, hertz_history_wall_limited, "hertz/history/none/none+limit_force";
     (Restitution, true, K::Coulomb, RollingKind::None, NoVdw)
         => <LimitForce<HertzDamping>, CoulombMindlin, NoRolling, NoCohesion>, hertz_coulomb_wall_limited, "hertz/coulomb/none/none+limit_force";
+    // The Chung & Ooi preset on the Hertz collapse, whose beads roll with resistance.
+    (Restitution, true, K::Coulomb, RollingKind::Epsd2, NoVdw)
+        => <LimitForce<HertzDamping>, CoulombMindlin, Epsd2, NoCohesion>, hertz_coulomb_wall_limited, "hertz/coulomb/epsd2/none+limit_force";
     (Yang { .. }, false, K::Yang, RollingKind::None, NoVdw)
         => <YangDamping, YangTangential, NoRolling, NoCohesion>, hertz_wall, "yang/yang/none/none";
     (Yang { .. }, false, K::Yang, RollingKind::ConstantTorque, Vdw { .. })

@@ -40,6 +40,7 @@ fn wca_contact(
         ("tangential", rc.tangential.is_some()),
         ("limit_force", rc.limit_force.is_some()),
         ("tangential_damping", rc.tangential_damping.is_some()),
+        ("preset", rc.preset.is_some()),
         ("rolling", rc.rolling.is_some()),
         ("cohesion", rc.cohesion.is_some()),
         ("hamaker_constant", rc.hamaker_constant.is_some()),
@@ -155,8 +156,9 @@ fn hertz_contact(
         rc.rolling_friction.unwrap_or(0.0),
     )?;
     let (damping, restitution) = hertz_damping(c, rc)?;
-    let tangential = tangential(c, rc)?;
-    let (limit_force, tangential_damping) = mindlin_options(c, rc, damping, tangential)?;
+    let preset = preset(c, rc)?;
+    let tangential = tangential(c, rc, &preset)?;
+    let (limit_force, tangential_damping) = mindlin_options(c, rc, &preset, damping, tangential)?;
     let rolling = rolling(c, rc)?;
     let cohesion = cohesion(c, rc)?;
     let mut h = HertzSettings {
@@ -236,9 +238,72 @@ fn hertz_damping(c: &Checker, rc: &RawContact) -> Result<(HertzDampingKind, Real
     Ok((damping, restitution))
 }
 
-/// `tangential = "history" | "coulomb" | "yang"`.
-fn tangential(c: &Checker, rc: &RawContact) -> Result<TangentialKind, SceneError> {
-    match rc.tangential.as_deref().unwrap_or("history") {
+/// What a `[contact] preset` sets: the values it gives the keys it names, which the scene
+/// may repeat but not contradict.
+#[derive(Default)]
+struct Preset {
+    name: Option<&'static str>,
+    tangential: Option<&'static str>,
+    limit_force: Option<bool>,
+}
+
+/// The presets and what each sets, as the guide's physics chapter names them.
+const PRESETS: &[(&str, &str, bool)] = &[
+    // The law that passes every criterion of the Chung & Ooi (2011) benchmark: Coulomb's
+    // bound on spring plus dashpot, and no dashpot pull at the end of a contact.
+    ("chung-ooi", "coulomb", true),
+];
+
+/// `preset = "chung-ooi"`: a named combination of `tangential` and `limit_force`.
+fn preset(c: &Checker, rc: &RawContact) -> Result<Preset, SceneError> {
+    let Some(name) = rc.preset.as_deref() else {
+        return Ok(Preset::default());
+    };
+    let Some(&(name, tangential, limit_force)) = PRESETS.iter().find(|p| p.0 == name) else {
+        return Err(c.invalid(
+            "contact.preset",
+            format!("\"{name}\""),
+            "\"chung-ooi\" (tangential = \"coulomb\" with limit_force = true: the law that passes the Chung & Ooi (2011) benchmark)",
+        ));
+    };
+    let contradiction = |field: &str, given: String, preset_value: String| {
+        c.invalid(
+            format!("contact.{field}"),
+            given,
+            format!(
+                "{preset_value} or left out: preset = \"{name}\" sets tangential = \"{tangential}\" and limit_force = {limit_force}"
+            ),
+        )
+    };
+    if let Some(t) = rc.tangential.as_deref() {
+        if t != tangential {
+            return Err(contradiction(
+                "tangential",
+                format!("\"{t}\""),
+                format!("\"{tangential}\""),
+            ));
+        }
+    }
+    if let Some(l) = rc.limit_force {
+        if l != limit_force {
+            return Err(contradiction(
+                "limit_force",
+                l.to_string(),
+                limit_force.to_string(),
+            ));
+        }
+    }
+    Ok(Preset {
+        name: Some(name),
+        tangential: Some(tangential),
+        limit_force: Some(limit_force),
+    })
+}
+
+/// `tangential = "history" | "coulomb" | "yang"` (or the preset's).
+fn tangential(c: &Checker, rc: &RawContact, preset: &Preset) -> Result<TangentialKind, SceneError> {
+    let given = rc.tangential.as_deref().or(preset.tangential);
+    match given.unwrap_or("history") {
         "history" => Ok(TangentialKind::History),
         "coulomb" => Ok(TangentialKind::Coulomb),
         "yang" => Ok(TangentialKind::Yang),
@@ -256,6 +321,7 @@ fn tangential(c: &Checker, rc: &RawContact) -> Result<TangentialKind, SceneError
 fn mindlin_options(
     c: &Checker,
     rc: &RawContact,
+    preset: &Preset,
     damping: HertzDampingKind,
     tangential: TangentialKind,
 ) -> Result<(bool, bool), SceneError> {
@@ -264,8 +330,15 @@ fn mindlin_options(
             tangential,
             TangentialKind::History | TangentialKind::Coulomb
         );
-    let limit_force = rc.limit_force.unwrap_or(false);
+    let limit_force = rc.limit_force.or(preset.limit_force).unwrap_or(false);
     let tangential_damping = rc.tangential_damping.unwrap_or(true);
+    if let (Some(name), false) = (preset.name, mindlin) {
+        return Err(c.invalid(
+            "contact.preset",
+            format!("\"{name}\""),
+            "only with damping = \"hertz\" (its options are those of the restitution dashpot and the Mindlin spring)",
+        ));
+    }
     for (field, non_default, value) in [
         ("limit_force", limit_force, "true"),
         ("tangential_damping", !tangential_damping, "false"),
@@ -468,4 +541,90 @@ pub(super) fn walls(
         });
     }
     Ok(walls)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::*;
+    use std::path::Path;
+
+    /// A one-species Hertz scene whose `[contact]` ends with `extra`.
+    fn scene(extra: &str) -> Result<Scene, SceneError> {
+        let text = format!(
+            r#"name = "preset"
+[domain]
+lo = [0.0, 0.0, 0.0]
+hi = [0.01, 0.01, 0.01]
+[[species]]
+name = "a"
+diameter = 1e-3
+density = 2500.0
+[contact]
+model = "hertz"
+youngs_modulus = 5e6
+poisson_ratio = 0.3
+friction = 0.5
+{extra}
+[time]
+dt = 1e-7
+[[stage]]
+name = "s"
+duration = 1e-6
+"#
+        );
+        Scene::parse(&text, Path::new("preset.toml"))
+    }
+
+    fn hertz(scene: Scene) -> HertzSettings {
+        match scene.contact {
+            ContactSettings::Hertz(h) => h,
+            other => panic!("not a Hertz scene: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn the_chung_ooi_preset_is_coulomb_with_the_normal_force_clamped() {
+        let by_preset = hertz(scene("restitution = 0.5\npreset = \"chung-ooi\"").unwrap());
+        let by_hand = hertz(
+            scene("restitution = 0.5\ntangential = \"coulomb\"\nlimit_force = true").unwrap(),
+        );
+        assert_eq!(by_preset.tangential, TangentialKind::Coulomb);
+        assert!(by_preset.limit_force && by_preset.tangential_damping);
+        assert_eq!(by_preset, by_hand);
+        // Repeating what the preset sets is allowed.
+        let repeated = "restitution = 0.5\npreset = \"chung-ooi\"\ntangential = \"coulomb\"";
+        assert_eq!(hertz(scene(repeated).unwrap()), by_hand);
+    }
+
+    #[test]
+    fn a_preset_that_is_unknown_contradicted_or_out_of_place_is_refused_by_name() {
+        for (extra, field, allowed) in [
+            (
+                "restitution = 0.5\npreset = \"kratos\"",
+                "contact.preset",
+                "\"chung-ooi\"",
+            ),
+            (
+                "restitution = 0.5\npreset = \"chung-ooi\"\ntangential = \"history\"",
+                "contact.tangential",
+                "sets tangential = \"coulomb\"",
+            ),
+            (
+                "restitution = 0.5\npreset = \"chung-ooi\"\nlimit_force = false",
+                "contact.limit_force",
+                "limit_force = true",
+            ),
+            (
+                "damping = \"yang\"\ngamma_n_yang = 1e-5\npreset = \"chung-ooi\"",
+                "contact.preset",
+                "only with damping = \"hertz\"",
+            ),
+        ] {
+            let message = scene(extra).unwrap_err().to_string();
+            assert!(
+                message.contains(field) && message.contains(allowed),
+                "{extra:?}: {message}"
+            );
+        }
+    }
 }

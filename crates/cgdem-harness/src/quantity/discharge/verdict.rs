@@ -5,9 +5,9 @@
 
 use std::fmt::Write as _;
 
-use super::measurement::DischargeRate;
-use super::report::SiloRun;
+use super::SiloRun;
 use crate::code::Code;
+use crate::quantity::seeds::mean_with_block_error;
 use crate::verdict::{Criterion, KnownDifference};
 
 /// The comparison's and the criterion's names, as a `[[case.known_difference]]` gives them.
@@ -31,32 +31,20 @@ pub struct RateVerdict {
 /// standard errors on each side, or within two combined standard errors of the one
 /// reference code that ran. None without a cgdem or a reference rate.
 pub fn cgdem_verdict(runs: &[SiloRun]) -> Option<RateVerdict> {
-    let rates = |code: Code| -> Vec<&DischargeRate> {
+    // Each code's rates over its seeds, with their block errors.
+    let rates = |code: Code| -> Vec<(f64, f64)> {
         runs.iter()
             .filter(|s| s.code == code)
-            .filter_map(|s| s.rate.as_ref())
+            .filter_map(SiloRun::rate_with_error)
             .collect()
     };
-    let mean = |r: &[&DischargeRate]| -> Option<(f64, f64)> {
-        (!r.is_empty()).then(|| {
-            let n = r.len() as f64;
-            let m = r.iter().map(|x| x.rate_kg_s).sum::<f64>() / n;
-            let se = r
-                .iter()
-                .map(|x| x.std_error_kg_s.powi(2))
-                .sum::<f64>()
-                .sqrt()
-                / n;
-            (m, se)
-        })
-    };
     let cgdem_rates = rates(Code::Cgdem);
-    let (cg, cg_se) = mean(&cgdem_rates)?;
+    let (cg, cg_se) = mean_with_block_error(&cgdem_rates)?;
     let refs: Vec<(Code, f64, f64, usize)> = [Code::Liggghts, Code::Lammps]
         .iter()
         .filter_map(|&c| {
             let r = rates(c);
-            mean(&r).map(|(m, se)| (c, m, se, r.len()))
+            mean_with_block_error(&r).map(|(m, se)| (c, m, se, r.len()))
         })
         .collect();
     if refs.is_empty() {

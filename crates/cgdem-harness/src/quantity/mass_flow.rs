@@ -1,15 +1,24 @@
-//! The report section of a screw-feeder case (a scene with `[conveying]`): mass flow against
-//! screw speed for every code with its block-average standard error, beside Eq. (7) with
-//! each code's measured fill ratio (Hirose, Fig. 8), and a table of the numbers. Every code's
-//! flow is measured the same way (`analysis::conveying`: cgdem from its state, LIGGGHTS and
-//! LAMMPS from their dumps, `decks::postprocess::conveying_samples`).
+//! A screw feeder's mass flow (a scene with `[conveying]`): every code's flow is measured
+//! the same way (`analysis::conveying`: cgdem from its state, LIGGGHTS and LAMMPS from their
+//! dumps, `decks::postprocess::conveying_samples`) into each run's `summary.json`, with its
+//! block-average standard error and Eq. (7) at the run's measured fill ratio. Here: the
+//! mean over seeds at each speed, and the case's section: mass flow against screw speed for
+//! every code beside Eq. (7) (Hirose, Fig. 8), and a table of the numbers.
 
 use std::path::Path;
 
-use super::suite::{Code, SuiteCase};
-use crate::report::{write_figure, Cell, Figure, Report, Series, SeriesStyle, Table};
-use crate::runs::{output_error, Outcome, RunRecord, ValidateError};
+use super::seeds::mean_with_block_error;
+use super::{show_figure, CaseOrigin};
+use crate::code::Code;
+use crate::report::{Cell, Figure, Report, Series, SeriesStyle, Table};
+use crate::runs::{Outcome, RunRecord, ValidateError};
 use cgdem_core::scene::Scene;
+
+/// A run's conveying measurement `key` (`mass_flow_kg_s`, `eq7_mass_flow_kg_s`, ...) from
+/// its `summary.json`, when finite.
+pub fn conveying_value(summary: &serde_json::Value, key: &str) -> Option<f64> {
+    summary["conveying"][key].as_f64().filter(|v| v.is_finite())
+}
 
 /// One code's points at one speed: the mean over seeds of the flow, its standard error
 /// (the block errors combined, `sqrt(sum se^2) / n`) and Eq. (7).
@@ -39,22 +48,23 @@ pub fn points_by_code(runs: &[RunRecord]) -> Vec<(Code, Vec<SpeedPoint>)> {
                 .filter(|r| r.code == code && r.rpm == Some(rpm) && r.status == Outcome::Ok)
                 .filter(|r| r.mass_flow_kg_s.is_some())
                 .collect();
-            if at.is_empty() {
-                continue;
-            }
-            let n = at.len() as f64;
-            let mean =
-                |f: fn(&RunRecord) -> Option<f64>| at.iter().filter_map(|r| f(r)).sum::<f64>() / n;
-            let se2: f64 = at
+            // A run without its block error adds none.
+            let flows: Vec<(f64, f64)> = at
                 .iter()
-                .filter_map(|r| r.mass_flow_std_error_kg_s)
-                .map(|e| e * e)
-                .sum();
+                .filter_map(|r| {
+                    Some((r.mass_flow_kg_s?, r.mass_flow_std_error_kg_s.unwrap_or(0.0)))
+                })
+                .collect();
+            let Some((mass_flow_kg_s, std_error_kg_s)) = mean_with_block_error(&flows) else {
+                continue;
+            };
+            let n = at.len() as f64;
+            let eq7 = at.iter().filter_map(|r| r.eq7_mass_flow_kg_s).sum::<f64>() / n;
             points.push(SpeedPoint {
                 rpm,
-                mass_flow_kg_s: mean(|r| r.mass_flow_kg_s),
-                std_error_kg_s: se2.sqrt() / n,
-                eq7_mass_flow_kg_s: mean(|r| r.eq7_mass_flow_kg_s),
+                mass_flow_kg_s,
+                std_error_kg_s,
+                eq7_mass_flow_kg_s: eq7,
             });
         }
         if !points.is_empty() {
@@ -122,23 +132,23 @@ pub fn write_screw_overview(
         "The screw cases {names:?} together: each code with the screw it can run (LIGGGHTS takes mesh walls only, LAMMPS has no mesh walls and runs the screw built of particles), measured by the same rule; the numbers are in each case's section. Dashed: Eq. (7) with each run's measured fill ratio."
     ));
     let dir = out.join("figures").join("screw_overview");
-    let files =
-        write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;
-    section
-        .figure(
-            &files,
+    show_figure(
+        section,
+        &dir,
+        "mass_flow_vs_rpm",
+        &figure,
+        (
             "mass flow against screw speed, one series per code and screw case, with Eq. (7)",
             "Mass flow against screw speed for every code and screw case (mean over seeds), with Eq. (7) for each one's measured fill ratio.",
-        )
-        .map_err(|e| output_error(&files.png, e))?;
-    Ok(())
+        ),
+    )
 }
 
 /// The section: the figure (PNG, SVG and CSV under `figures/<case>/`) and the table.
 pub fn write_screw_section(
     report: &mut Report,
     scene: &Scene,
-    case: &SuiteCase,
+    case: &CaseOrigin,
     runs: &[RunRecord],
     out: &Path,
 ) -> Result<(), ValidateError> {
@@ -169,15 +179,16 @@ pub fn write_screw_section(
     );
     figure = with_speed_series(figure, runs, |code| code.name().to_string());
     if !figure.series.is_empty() {
-        let files =
-            write_figure(&dir, "mass_flow_vs_rpm", &figure).map_err(|e| output_error(&dir, e))?;
-        section
-            .figure(
-                &files,
+        show_figure(
+            section,
+            &dir,
+            "mass_flow_vs_rpm",
+            &figure,
+            (
                 "mass flow against screw speed, one series per code, with Eq. (7)",
                 "Mass flow against screw speed per code (mean over seeds), with Eq. (7) for each code's measured fill ratio.",
-            )
-            .map_err(|e| output_error(&files.png, e))?;
+            ),
+        )?;
     }
     let mut table = Table::new([
         "code",

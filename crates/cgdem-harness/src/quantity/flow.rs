@@ -1,11 +1,19 @@
 //! How a collapse unfolds, not only where it ends: the flow time series every run writes
 //! (`timeseries.csv`: front position, height at the remaining wall, kinetic energy), their
-//! mean over seeds, the characteristic time `t_half`, and the differences between two runs'
-//! series after normalising (issue: coarsening fidelity beyond the final heap).
+//! mean over seeds, the characteristic time `t_half`, the differences between two runs'
+//! series after normalising and their noise over seeds; the dynamics criteria of two groups
+//! of runs, the front-history gap to a reference run (for the accuracy sweeps) and the
+//! figures of the histories.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
+use super::seeds::{group_key, group_label, rule_of, GroupKey};
 use crate::csv_table::CsvTable;
+use crate::report::{Figure, Series, SeriesStyle};
+use crate::runs::{Outcome, RunRecord};
+use crate::verdict::{combined_standard_error, mean_sd, Criterion, KnownDifference};
+use cgdem_core::scene::Scene;
 
 /// Spacing of the common time grid on which flow histories are averaged and compared.
 pub const FLOW_GRID_S: f64 = 0.01;
@@ -54,6 +62,18 @@ impl FlowSeries {
             out.kinetic_energy_per_mass.push(energy);
         }
         (!out.time_s.is_empty()).then_some(out)
+    }
+
+    /// What the gaps are normalised by: the initial height at the wall and the peak kinetic
+    /// energy per mass; None for an empty series.
+    fn scales(&self) -> Option<(f64, f64)> {
+        let h0 = *self.wall_height_m.first()?;
+        let e_peak = self
+            .kinetic_energy_per_mass
+            .iter()
+            .copied()
+            .fold(0.0, f64::max);
+        Some((h0, e_peak))
     }
 
     pub fn duration(&self) -> f64 {
@@ -145,12 +165,7 @@ pub fn flow_difference(
     box_length: f64,
     step: f64,
 ) -> Option<FlowDifference> {
-    let h0 = *reference.wall_height_m.first()?;
-    let e_peak = reference
-        .kinetic_energy_per_mass
-        .iter()
-        .copied()
-        .fold(0.0, f64::max);
+    let (h0, e_peak) = reference.scales()?;
     if other.time_s.is_empty() || h0 <= 0.0 || e_peak <= 0.0 || box_length <= 0.0 || step <= 0.0 {
         return None;
     }
@@ -198,13 +213,7 @@ pub fn flow_noise(
     box_length: f64,
     step: f64,
 ) -> Option<FlowNoise> {
-    let reference = FlowSeries::mean(a, step)?;
-    let h0 = *reference.wall_height_m.first()?;
-    let e_peak = reference
-        .kinetic_energy_per_mass
-        .iter()
-        .copied()
-        .fold(0.0, f64::max);
+    let (h0, e_peak) = FlowSeries::mean(a, step)?.scales()?;
     if b.is_empty() || h0 <= 0.0 || e_peak <= 0.0 || box_length <= 0.0 || step <= 0.0 {
         return None;
     }
@@ -241,6 +250,214 @@ pub fn flow_noise(
         out.kinetic_energy = out.kinetic_energy.max((sa[2] + sb[2]).sqrt() / e_peak);
     }
     Some(out)
+}
+
+/// The stage whose flow a scene measures (its `[repose]` stage); None without one.
+pub fn flow_stage(scene: &Scene) -> Option<&str> {
+    scene.repose.as_ref().map(|r| r.stage.as_str())
+}
+
+/// The characteristic time of the run in `dir` of `scene` ([`FlowSeries::t_half`] of its
+/// measured stage); None without a flow or where the front never moved.
+pub fn measured_t_half(scene: &Scene, dir: &Path) -> Option<f64> {
+    FlowSeries::read(dir, flow_stage(scene)?)?.t_half()
+}
+
+/// Every successful run's flow during the measured stage, per group.
+pub fn flows_by_group(scene: &Scene, runs: &[RunRecord]) -> BTreeMap<GroupKey, Vec<FlowSeries>> {
+    let mut groups: BTreeMap<GroupKey, Vec<FlowSeries>> = BTreeMap::new();
+    let Some(stage) = flow_stage(scene) else {
+        return groups;
+    };
+    for r in runs.iter().filter(|r| r.status == Outcome::Ok) {
+        if let Some(flow) = FlowSeries::read(&r.dir, stage) {
+            groups.entry(group_key(r)).or_default().push(flow);
+        }
+    }
+    groups
+}
+
+/// The tolerances of the dynamics criteria (a suite case's `time_ratio_tolerance`,
+/// `front_tolerance`, `wall_height_tolerance`, `kinetic_energy_tolerance`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlowTolerances {
+    /// Largest |ratio - 1| of the two groups' mean t_half.
+    pub time_ratio: f64,
+    /// Largest gap of the front histories, of the box length.
+    pub front: f64,
+    /// Largest gap of the wall-height histories, of the initial height.
+    pub wall_height: f64,
+    /// Largest gap of the kinetic-energy histories, of the peak.
+    pub kinetic_energy: f64,
+}
+
+/// The dynamics of two groups of runs (`fa`, `fb`: one flow per seed), four criteria: the
+/// ratio of the seeds' mean `t_half` (judged as |ratio - 1|), and the largest gaps between
+/// the seed-mean histories of the front (of the box length), the height at the remaining
+/// wall (of its initial height) and the kinetic energy (of its peak); each against its
+/// tolerance plus `K_NOISE` times the noise the seeds show, or the band of the known
+/// difference `known(criterion)` names. With the numbers in words, the t_half ratio beside
+/// `predicted_ratio`; None when a side has no flow to compare.
+pub fn flow_criteria<'a>(
+    fa: &[FlowSeries],
+    fb: &[FlowSeries],
+    box_length: f64,
+    tolerances: &FlowTolerances,
+    known: impl Fn(&str) -> Option<&'a KnownDifference>,
+    predicted_ratio: &str,
+) -> Option<(Vec<Criterion>, String)> {
+    let ta: Vec<f64> = fa.iter().filter_map(FlowSeries::t_half).collect();
+    let tb: Vec<f64> = fb.iter().filter_map(FlowSeries::t_half).collect();
+    let step = FLOW_GRID_S;
+    let mean_a = FlowSeries::mean(fa, step)?;
+    let mean_b = FlowSeries::mean(fb, step)?;
+    let gap = flow_difference(&mean_a, &mean_b, box_length, step)?;
+    let noise = flow_noise(fa, fb, box_length, step)?;
+    let seeds = [fa.len(), fb.len()];
+    let mut criteria = Vec::new();
+    // t_half exists only where the front moved; without it on a side, the gaps still judge.
+    let t_half_text = match (mean_sd(&ta), mean_sd(&tb)) {
+        (Some((ma, sa, na)), Some((mb, sb, nb))) => {
+            let ratio = mb / ma;
+            // Standard error of the ratio from the relative standard errors of the means.
+            let ratio_noise = ratio * combined_standard_error((sa / ma, na), (sb / mb, nb));
+            criteria.push(Criterion::judge(
+                "t_half ratio",
+                "|ratio - 1|",
+                (ratio - 1.0).abs(),
+                ratio_noise,
+                [na, nb],
+                tolerances.time_ratio,
+                known("t_half ratio"),
+            ));
+            format!(
+                "t_half {ma:.3} +- {sa:.3} s vs {mb:.3} +- {sb:.3} s: ratio {ratio:.2} (predicted {predicted_ratio})"
+            )
+        }
+        _ => format!(
+            "t_half not measured (the front did not move in {} of {} and {} of {} runs)",
+            fa.len() - ta.len(),
+            fa.len(),
+            fb.len() - tb.len(),
+            fb.len()
+        ),
+    };
+    criteria.extend([
+        Criterion::judge(
+            "front gap",
+            "of the box length",
+            gap.front_max,
+            noise.front,
+            seeds,
+            tolerances.front,
+            known("front gap"),
+        ),
+        Criterion::judge(
+            "wall height gap",
+            "of the initial height",
+            gap.wall_height_max,
+            noise.wall_height,
+            seeds,
+            tolerances.wall_height,
+            known("wall height gap"),
+        ),
+        Criterion::judge(
+            "kinetic energy gap",
+            "of the peak",
+            gap.kinetic_energy_max,
+            noise.kinetic_energy,
+            seeds,
+            tolerances.kinetic_energy,
+            known("kinetic energy gap"),
+        ),
+    ]);
+    Some((
+        criteria,
+        format!(
+            "{t_half_text}; gaps, largest over time (mean): front {:.3} ({:.3}) of the box \
+             length, wall height {:.3} ({:.3}) of the initial height, kinetic energy {:.3} \
+             ({:.3}) of the peak",
+            gap.front_max,
+            gap.front_mean,
+            gap.wall_height_max,
+            gap.wall_height_mean,
+            gap.kinetic_energy_max,
+            gap.kinetic_energy_mean,
+        ),
+    ))
+}
+
+/// The flow histories (front, height at the wall, kinetic energy), mean over seeds, one
+/// line per code, level and rule.
+pub fn flow_figures(scene: &Scene, runs: &[RunRecord]) -> [Figure; 3] {
+    let flows = flows_by_group(scene, runs);
+    let time_axis = "time after the gate opens t [s]";
+    let mut front = Figure::new(
+        format!("{}: front position (mean over seeds)", scene.name),
+        time_axis,
+        "front position x_f [m]",
+    );
+    let mut height = Figure::new(
+        format!(
+            "{}: height at the remaining wall (mean over seeds)",
+            scene.name
+        ),
+        time_axis,
+        "wall height h_w [m]",
+    );
+    let mut energy = Figure::new(
+        format!("{}: kinetic energy (mean over seeds)", scene.name),
+        time_axis,
+        "kinetic energy per mass [J/kg]",
+    )
+    .log_y();
+    for (&(rule, lambda, code), series) in &flows {
+        let Some(mean) = FlowSeries::mean(series, FLOW_GRID_S) else {
+            continue;
+        };
+        let name = group_label(code, lambda, rule_of(rule));
+        let points = |v: &[f64]| {
+            mean.time_s
+                .iter()
+                .copied()
+                .zip(v.iter().copied())
+                .collect::<Vec<_>>()
+        };
+        front
+            .series
+            .push(Series::new(name.clone(), points(&mean.front_m)).style(SeriesStyle::Line));
+        height
+            .series
+            .push(Series::new(name.clone(), points(&mean.wall_height_m)).style(SeriesStyle::Line));
+        let positive = points(&mean.kinetic_energy_per_mass)
+            .into_iter()
+            .filter(|p| p.1 > 0.0)
+            .collect();
+        energy
+            .series
+            .push(Series::new(name, positive).style(SeriesStyle::Line));
+    }
+    [front, height, energy]
+}
+
+/// The front history's gap: each run's front as the fraction of its own largest advance it
+/// has covered, and the largest difference of the two fractions over the flow (on a common
+/// time grid; the run that ended first holds its last value). 0.1 means "a tenth of the
+/// run-out apart at worst". How far the fronts get is the heap's (angle, profile); this is
+/// how they get there. Each run's own advance also takes out the front's definition in
+/// particle diameters (where the deposit is two diameters deep), which puts a coarser
+/// level's front further back by about two diameters over the toe's slope. None when a
+/// front never advanced.
+pub fn front_history_gap(reference: &FlowSeries, other: &FlowSeries) -> Option<f64> {
+    let covered = |flow: &FlowSeries| -> Option<FlowSeries> {
+        let start = *flow.front_m.first()?;
+        let advance = flow.front_m.iter().map(|x| x - start).fold(0.0, f64::max);
+        (advance > 0.0).then(|| FlowSeries {
+            front_m: flow.front_m.iter().map(|x| (x - start) / advance).collect(),
+            ..flow.clone()
+        })
+    };
+    Some(flow_difference(&covered(reference)?, &covered(other)?, 1.0, FLOW_GRID_S)?.front_max)
 }
 
 #[cfg(test)]
