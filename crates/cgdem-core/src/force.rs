@@ -2,7 +2,7 @@
 //! seen from its first particle, and what acts on one particle alone (gravity, the planar
 //! walls, the bodies). Generic over the laws and inlined into the subdomains' force pass.
 
-use crate::bodies::{Body, BodyLoad, Clearance};
+use crate::bodies::{mesh_contacts, Body, BodyLoad, BodyShape, Clearance};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
@@ -162,8 +162,9 @@ pub(crate) struct Surroundings<'a, W> {
 }
 
 /// One particle's slots in the arrays its surroundings keep: the walls it may reach before
-/// the next list build, its contact histories (one per planar wall, then one per body;
-/// empty when particles do not spin) and its clearance per body.
+/// the next list build, its contact histories (one per planar wall, then
+/// `Body::history_slots` per body; empty when particles do not spin) and its clearance per
+/// body.
 pub(crate) struct AloneSlots<'s, WH> {
     pub(crate) near: WallMask,
     pub(crate) history: &'s mut [WH],
@@ -210,9 +211,24 @@ impl<W: WallLaw> Surroundings<'_, W> {
                 *force += f;
                 overlap = o;
             }
-            for (((body, clearance), load), history) in bodies.zip(body_history) {
-                let (f, t, l, o) =
-                    body_force_and_torque(body, law, particle, omega, history, clearance, dt);
+            let mut rest = body_history;
+            for ((body, clearance), load) in bodies {
+                let (history, tail) = std::mem::take(&mut rest).split_at_mut(body.history_slots());
+                rest = tail;
+                let (f, t, l, o) = match &body.shape {
+                    BodyShape::Mesh(mesh) => {
+                        mesh_contacts(body, mesh, law, particle, omega, history, clearance, dt)
+                    }
+                    _ => body_force_and_torque(
+                        body,
+                        law,
+                        particle,
+                        omega,
+                        &mut history[0],
+                        clearance,
+                        dt,
+                    ),
+                };
                 *force += f;
                 *torque += t;
                 *load += l;
@@ -223,7 +239,14 @@ impl<W: WallLaw> Surroundings<'_, W> {
             *force += f;
             overlap = o;
             for ((body, clearance), load) in bodies {
-                let (f, l, o) = body_force(body, law, particle, clearance, dt);
+                let (f, l, o) = match &body.shape {
+                    BodyShape::Mesh(mesh) => {
+                        let (f, _, l, o) =
+                            mesh_contacts(body, mesh, law, particle, omega, &mut [], clearance, dt);
+                        (f, l, o)
+                    }
+                    _ => body_force(body, law, particle, clearance, dt),
+                };
                 *force += f;
                 *load += l;
                 overlap = larger(overlap, o);

@@ -154,7 +154,7 @@ impl Body {
 
     /// Whether `p` lies within `reach` of the body's box: outside it no lookup is made.
     #[inline(always)]
-    fn within_reach(&self, p: Vec3, reach: Real) -> bool {
+    pub(super) fn within_reach(&self, p: Vec3, reach: Real) -> bool {
         let b = &self.world_bounds;
         !(p.cmplt(b.min - Vec3::splat(reach)).any() || p.cmpgt(b.max + Vec3::splat(reach)).any())
     }
@@ -225,6 +225,21 @@ impl Body {
         })
     }
 
+    /// A body-frame direction in the world frame.
+    #[inline(always)]
+    pub(super) fn rotate(&self, v: Vec3) -> Vec3 {
+        self.rotation * v
+    }
+
+    /// History slots a particle keeps for this body in its wall-history row: one, or for a
+    /// mesh body a tag and a history per contact it may have at once.
+    pub fn history_slots(&self) -> usize {
+        match self.shape {
+            BodyShape::Mesh(_) => 2 * super::MESH_CONTACTS,
+            _ => 1,
+        }
+    }
+
     /// Velocity of the body's material at world point `p`: `v + omega x (p - c)`.
     #[inline(always)]
     pub fn surface_velocity(&self, p: Vec3) -> Vec3 {
@@ -278,6 +293,21 @@ impl Clearance {
         free_squared: -1.0,
         beyond: Real::NAN,
     };
+
+    /// Whether body-frame point `q` of a particle whose contacts start below `beyond` is
+    /// inside the ball.
+    #[inline(always)]
+    pub(super) fn contains(&self, q: Vec3, beyond: Real) -> bool {
+        self.beyond == beyond && (q - self.at).length_squared() < self.free_squared
+    }
+
+    /// A ball of radius `free` (none when not positive) around `q`, for `beyond`.
+    #[inline(always)]
+    pub(super) fn set(&mut self, q: Vec3, beyond: Real, free: Real) {
+        self.at = q;
+        self.beyond = beyond;
+        self.free_squared = if free > 0.0 { free * free } else { -1.0 };
+    }
 }
 
 /// A body's signed distance at a world point, and its world normal there on demand.

@@ -1,6 +1,8 @@
 //! The shape of a body in its own frame: a signed-distance grid or an analytic SDF.
 
-use crate::geometry::{Aabb, AxisAlignedBox, Cylinder, GridSample, Sdf, SdfGrid, Sphere};
+use crate::geometry::{
+    Aabb, AxisAlignedBox, Cylinder, GridSample, MeshSurface, Sdf, SdfGrid, Sphere,
+};
 use crate::math::{Real, Vec3};
 
 /// A body's shape in the body frame. An enum rather than a trait object: the match is
@@ -12,6 +14,10 @@ pub enum BodyShape {
     Sphere(Sphere),
     Cylinder(Cylinder),
     Box(AxisAlignedBox),
+    /// The triangles themselves (`contact = "mesh"`): particles touch the closest point of a
+    /// face, an edge or a vertex (`bodies::mesh_contact`). A surface, open or closed: its
+    /// distance has no sign.
+    Mesh(Box<MeshSurface>),
     /// No surface: a body built of particles, which act through the pair law; `bounds` holds
     /// the particles' centres.
     Particles(Aabb),
@@ -53,6 +59,10 @@ impl BodyShape {
             BodyShape::Sphere(s) => Some((s.distance(p), s.normal(p))),
             BodyShape::Cylinder(c) => Some((c.distance(p), c.normal(p))),
             BodyShape::Box(b) => Some((b.distance(p), b.normal(p))),
+            BodyShape::Mesh(m) => m.nearest(p).map(|(d, c)| {
+                let normal = if d > 0.0 { (p - c) / d } else { Vec3::Z };
+                (d, normal)
+            }),
             BodyShape::Particles(_) => None,
         }
     }
@@ -102,6 +112,7 @@ impl BodyShape {
                 min: b.center - b.half_extents,
                 max: b.center + b.half_extents,
             },
+            BodyShape::Mesh(m) => m.bounds(),
             BodyShape::Particles(bounds) => *bounds,
         }
     }

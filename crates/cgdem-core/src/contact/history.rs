@@ -14,6 +14,12 @@ pub trait PairHistory:
     fn write_words(&self, out: &mut Vec<Real>);
     /// From exactly `WORDS` words.
     fn read_words(words: &[Real]) -> Self;
+    /// A history holding only `tag` (not 0) in its first word: a mesh contact keeps the
+    /// triangle it is on in a slot beside its history (`bodies::mesh_contact`). Zero-sized
+    /// histories hold no tag.
+    fn tagged(tag: Real) -> Self;
+    /// The tag of [`PairHistory::tagged`]; 0 for the default history.
+    fn tag(&self) -> Real;
 }
 
 /// The seed's model keeps no history: a zero-sized type, so its store costs nothing.
@@ -22,6 +28,10 @@ impl PairHistory for () {
     const WORDS: usize = 0;
     fn write_words(&self, _: &mut Vec<Real>) {}
     fn read_words(_: &[Real]) -> Self {}
+    fn tagged(_: Real) -> Self {}
+    fn tag(&self) -> Real {
+        0.0
+    }
 }
 
 /// A displacement of `i` relative to `j` (e.g. a tangential spring): `j` sees it negated.
@@ -35,6 +45,12 @@ impl PairHistory for Vec3 {
     }
     fn read_words(w: &[Real]) -> Self {
         Vec3::new(w[0], w[1], w[2])
+    }
+    fn tagged(tag: Real) -> Self {
+        Vec3::new(tag, 0.0, 0.0)
+    }
+    fn tag(&self) -> Real {
+        self.x
     }
 }
 
@@ -51,6 +67,20 @@ impl<A: PairHistory, B: PairHistory> PairHistory for (A, B) {
     fn read_words(w: &[Real]) -> Self {
         (A::read_words(&w[..A::WORDS]), B::read_words(&w[A::WORDS..]))
     }
+    fn tagged(tag: Real) -> Self {
+        if A::WORDS > 0 {
+            (A::tagged(tag), B::default())
+        } else {
+            (A::default(), B::tagged(tag))
+        }
+    }
+    fn tag(&self) -> Real {
+        if A::WORDS > 0 {
+            self.0.tag()
+        } else {
+            self.1.tag()
+        }
+    }
 }
 
 /// A magnitude (e.g. accumulated slip length): the same from either side.
@@ -64,5 +94,11 @@ impl PairHistory for Real {
     }
     fn read_words(w: &[Real]) -> Self {
         w[0]
+    }
+    fn tagged(tag: Real) -> Self {
+        tag
+    }
+    fn tag(&self) -> Real {
+        *self
     }
 }

@@ -134,6 +134,39 @@ impl Bvh {
         self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds)
     }
 
+    /// Calls `f` with the source index of every triangle whose bounding box lies within
+    /// `reach` of `p` (in tree order; a superset of those within `reach`).
+    pub fn for_each_near(&self, p: Vec3, reach: Real, mut f: impl FnMut(u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let reach2 = reach * reach;
+        let mut stack = [0u32; STACK_DEPTH];
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let node = &self.nodes[stack[len] as usize];
+            if node.bounds.distance_squared(p) > reach2 {
+                continue;
+            }
+            if node.is_leaf() {
+                for k in node.first..node.first + node.count {
+                    let [a, b, c] = self.triangles[k as usize];
+                    let lo = a.min(b).min(c);
+                    let hi = a.max(b).max(c);
+                    let d = (lo - p).max(p - hi).max(Vec3::ZERO);
+                    if d.length_squared() <= reach2 {
+                        f(self.triangle_ids[k as usize]);
+                    }
+                }
+                continue;
+            }
+            stack[len] = node.first;
+            stack[len + 1] = node.first + 1;
+            len += 2;
+        }
+    }
+
     /// Closest triangle to `p`, or `None` for an empty mesh.
     pub fn nearest(&self, p: Vec3) -> Option<Nearest> {
         self.nearest_within(p, Real::INFINITY)

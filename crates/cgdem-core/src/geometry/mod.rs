@@ -8,6 +8,7 @@ pub mod bvh;
 mod finite_plane;
 pub mod mesh;
 mod mesh_builder;
+pub mod mesh_surface;
 pub mod screw_feeder;
 pub mod sdf_grid;
 pub mod silo;
@@ -23,6 +24,7 @@ pub use analytic::{
 pub use bvh::{Bvh, Nearest};
 pub use finite_plane::FinitePlane;
 pub use mesh::{EdgeDefect, TopologyReport, TriMesh};
+pub use mesh_surface::{MeshSurface, TriangleHit};
 pub use sdf_grid::{GridSample, SdfGrid, SdfGridError};
 pub use stl::{read_stl, read_stl_unchecked, write_stl_ascii, write_stl_binary, StlError};
 pub use triangle_distance::{closest_point_on_triangle, TriangleFeature};

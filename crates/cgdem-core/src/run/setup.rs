@@ -3,11 +3,11 @@
 
 use crate::bodies::{fcc_sites_inside, Body, BodyShape, KinematicParticles, Motion};
 use crate::contact::PairLaw;
-use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, SdfGrid};
+use crate::geometry::{Aabb, Bvh, FastWindingNumber, FinitePlane, MeshSurface, SdfGrid};
 use crate::insertion::{insert_random_where, lattice_sites};
 use crate::math::{Real, Vec3};
 use crate::particles::Particles;
-use crate::scene::{InsertAmount, Scene};
+use crate::scene::{BodyContact, InsertAmount, MeshSource, Scene};
 use crate::timestep::LinearContact;
 use crate::walls::{Wall, WallLaw, WallSet};
 
@@ -257,7 +257,7 @@ pub fn build_bodies<W: WallLaw>(
             field: format!("body[{k}]"),
             message,
         };
-        let mesh = b.mesh.load().map_err(error)?;
+        let mesh = b.load_mesh().map_err(error)?;
         let motion = Motion::rotation_rpm(b.axis, b.point, b.rpm).with_velocity(b.velocity);
         if b.particles.is_some() {
             // Shape set below, once the SDF bodies exist.
@@ -267,6 +267,26 @@ pub fn build_bodies<W: WallLaw>(
                 max: b.point,
             };
             let mut body = Body::new(b.name.clone(), BodyShape::Particles(empty), motion);
+            if b.start_stage.is_none() {
+                body.start(0.0);
+            }
+            bodies.push(body);
+            continue;
+        }
+        if b.contact == BodyContact::Mesh {
+            let surface = MeshSurface::new(&mesh).map_err(|e| {
+                let file = match &b.mesh {
+                    MeshSource::Stl(path) => format!("{}: ", path.display()),
+                    _ => String::new(),
+                };
+                RunError::Geometry {
+                    file: scene.source.display().to_string(),
+                    field: format!("body[{k}].mesh"),
+                    message: format!("{file}{e}"),
+                }
+            })?;
+            let mut body = Body::new(b.name.clone(), BodyShape::Mesh(Box::new(surface)), motion);
+            body.material = b.material;
             if b.start_stage.is_none() {
                 body.start(0.0);
             }

@@ -468,6 +468,35 @@ pub struct BodySettings {
     /// The surface's material (an SDF body), as `WallSettings::material`.
     #[serde(default)]
     pub material: usize,
+    /// How particles meet the mesh: its SDF grid or its triangles.
+    #[serde(default)]
+    pub contact: BodyContact,
+}
+
+/// How particles meet a body's mesh (`[[body]] contact`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BodyContact {
+    /// A signed-distance grid of `cell_size` built from the closed mesh.
+    #[default]
+    Grid,
+    /// The triangles themselves, as LIGGGHTS's mesh walls: exact, open meshes allowed.
+    Mesh,
+}
+
+impl BodySettings {
+    /// The body's mesh: a closed, outward-oriented surface for a grid, any surface (open
+    /// or closed, as given) for mesh contact.
+    pub fn load_mesh(&self) -> Result<crate::geometry::TriMesh, String> {
+        match (self.contact, &self.mesh) {
+            (BodyContact::Mesh, MeshSource::Stl(path)) => {
+                crate::geometry::stl::read_stl_unchecked(path)
+                    .map(|(mesh, _)| mesh)
+                    .map_err(|e| format!("{}: {e}", path.display()))
+            }
+            _ => self.mesh.load(),
+        }
+    }
 }
 
 /// The derived text of the fields as before, `material` only when not the default.
@@ -485,6 +514,7 @@ impl std::fmt::Debug for BodySettings {
             .field("velocity", &self.velocity)
             .field("start_stage", &self.start_stage);
         optional_field(&mut s, "material", &self.material);
+        optional_field(&mut s, "contact", &self.contact);
         s.finish()
     }
 }
@@ -902,6 +932,7 @@ mod tests {
             velocity: Vec3::ZERO,
             start_stage: None,
             material: 0,
+            contact: BodyContact::Grid,
         };
         assert_eq!(
             format!("{body:?}"),

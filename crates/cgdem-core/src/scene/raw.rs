@@ -91,6 +91,8 @@ pub struct RawBody {
     pub start_stage: Option<String>,
     /// A `[[wall_material]]` name; default: `[wall_contact]`'s material.
     pub material: Option<String>,
+    /// `"grid"` (default) or `"mesh"`.
+    pub contact: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]

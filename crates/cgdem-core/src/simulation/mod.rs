@@ -676,10 +676,10 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
     }
 }
 
-/// History entries per particle for walls and bodies: one per planar wall, then one per
-/// body (at least one, so chunks exist).
+/// History entries per particle for walls and bodies: one per planar wall, then
+/// `Body::history_slots` per body (at least one, so chunks exist).
 fn wall_slots(walls: &WallSet, bodies: &[Body]) -> usize {
-    (walls.walls.len() + bodies.len()).max(1)
+    (walls.walls.len() + bodies.iter().map(Body::history_slots).sum::<usize>()).max(1)
 }
 
 /// The distances a grid must respect.

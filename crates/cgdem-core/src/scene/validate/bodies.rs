@@ -51,14 +51,44 @@ pub(super) fn bodies(
             None => None,
             Some(bp) => Some(body_particles(c, k, b, bp, species)?),
         };
+        let contact = match b.contact.as_deref() {
+            None | Some("grid") => BodyContact::Grid,
+            Some("mesh") => BodyContact::Mesh,
+            Some(other) => {
+                return Err(c.invalid(
+                    format!("body[{k}].contact"),
+                    other,
+                    "\"grid\" (the default: a signed-distance grid of cell_size) or \"mesh\" (the triangles themselves, as LIGGGHTS's mesh walls)",
+                ))
+            }
+        };
+        if contact == BodyContact::Mesh {
+            let field = if particles.is_some() {
+                Some("particles")
+            } else if b.cell_size.is_some() {
+                Some("cell_size")
+            } else if b.padding.is_some() {
+                Some("padding")
+            } else {
+                None
+            };
+            if let Some(field) = field {
+                return Err(c.invalid(
+                    format!("body[{k}].{field}"),
+                    "given with contact = \"mesh\"",
+                    "nothing: a body with contact = \"mesh\" is met on its triangles, it has no grid and is not built of particles",
+                ));
+            }
+        }
         let cell_size = match (&particles, b.cell_size) {
             (Some(_), _) => 0.0,
+            (None, _) if contact == BodyContact::Mesh => 0.0,
             (None, Some(cell)) => c.positive(&format!("body[{k}].cell_size"), cell)?,
             (None, None) => {
                 return Err(c.invalid(
                     format!("body[{k}].cell_size"),
                     "missing",
-                    "the SDF grid spacing, m (or particles = { species = ..., lattice = \"fcc\" } for a body built of particles)",
+                    "the SDF grid spacing, m (or contact = \"mesh\" to meet the triangles themselves, or particles = { species = ..., lattice = \"fcc\" } for a body built of particles)",
                 ))
             }
         };
@@ -77,6 +107,7 @@ pub(super) fn bodies(
             super::materials::material_index(c, &material_field, b.material.as_deref(), materials)?;
         bodies.push(BodySettings {
             material,
+            contact,
             name: b.name.clone(),
             mesh: mesh_source(c, &format!("body[{k}].mesh"), &b.mesh)?,
             cell_size,

@@ -315,15 +315,14 @@ fn mesh_lines(scene: &Scene, types: &AtomTypes, rolling: &str) -> Result<MeshLin
                 b.name
             )));
         }
-        if b.velocity.length() > 0.0 {
+        if b.velocity.length() > 0.0 && b.rpm != 0.0 {
             return Err(unsupported(format!(
-                "body[{k}] `{}` translates; LIGGGHTS decks rotate bodies only",
+                "body[{k}] `{}` both turns and translates; LIGGGHTS decks take one motion per body",
                 b.name
             )));
         }
         let mesh = b
-            .mesh
-            .load()
+            .load_mesh()
             .map_err(|e| unsupported(format!("body[{k}].mesh: {e}")))?;
         // One mesh fix per separate solid of the body (see `TriMesh::components`).
         for (j, piece) in mesh.components().into_iter().enumerate() {
@@ -341,7 +340,8 @@ fn mesh_lines(scene: &Scene, types: &AtomTypes, rolling: &str) -> Result<MeshLin
             out.files.push((file.clone(), text.into_bytes()));
             let _ = writeln!(
                 out.setup,
-                "fix             b_{name} all mesh/surface file {file} type {wall_type} curvature 1e-5"
+                "fix             b_{name} all mesh/surface file {file} type {wall_type} curvature {:e}",
+                cgdem_core::geometry::mesh_surface::CURVATURE_DEG
             );
             names.push(format!("b_{name}"));
             pieces.push(name);
@@ -392,10 +392,24 @@ fn run_lines(scene: &Scene, n: u64) -> String {
 
 /// `fix move/mesh ... rotate` for each piece of a turning body: LIGGGHTS turns
 /// counter-clockwise about `axis` once per `period`; a negative rpm turns about the reversed
-/// axis.
+/// axis. `fix move/mesh ... linear` for each piece of a translating one.
 fn move_lines(b: &cgdem_core::scene::BodySettings, pieces: &[String]) -> String {
     if b.rpm == 0.0 {
-        return String::new();
+        if b.velocity.length() == 0.0 {
+            return String::new();
+        }
+        let v = b.velocity;
+        return pieces
+            .iter()
+            .map(|name| {
+                format!(
+                    "fix             move_{name} all move/mesh mesh b_{name} linear {} {} {}\n",
+                    g(v.x),
+                    g(v.y),
+                    g(v.z)
+                )
+            })
+            .collect();
     }
     let axis = if b.rpm < 0.0 { -b.axis } else { b.axis };
     let mut d = String::new();

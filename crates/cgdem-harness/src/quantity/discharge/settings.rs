@@ -177,7 +177,7 @@ pub fn opening(scene: &Scene) -> Option<Opening> {
                 if down == cgdem_core::math::Vec3::ZERO {
                     continue;
                 }
-                let Ok(mesh) = body.mesh.load() else { continue };
+                let Ok(mesh) = body.load_mesh() else { continue };
                 let b = mesh.bounding_box();
                 let centre = 0.5 * (b.min + b.max);
                 let radius = mesh
