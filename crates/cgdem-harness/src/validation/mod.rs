@@ -107,6 +107,23 @@ pub fn validate_suite(
     Ok(summary)
 }
 
+/// A screw case's mass-flow verdicts as the suite's comparisons (one per reference code and
+/// speed), counted in the status as every other.
+fn screw_comparisons(case: &str, verdicts: mass_flow::FlowVerdicts) -> Vec<Comparison> {
+    (verdicts.judged.into_iter())
+        .map(|v| {
+            Comparison::judged(
+                case,
+                "codes",
+                mass_flow::PART,
+                &v.what,
+                v.detail,
+                vec![v.criterion],
+            )
+        })
+        .collect()
+}
+
 /// Each reference code the suite runs, as found: its release (or that it is missing) in the
 /// provenance; a release the decks were not verified against is warned about on the console
 /// and returned for the report's first screen.
@@ -228,12 +245,30 @@ fn run_cases(
             comparisons.extend(verdict);
             continue;
         }
-        if scene.conveying.is_some() {
-            // A screw case is judged by its mass flow against Eq. (7), code by code.
+        if let Some(conveying) = &scene.conveying {
+            // A screw case: cgdem's mass flow judged against each reference code's, speed
+            // by speed; shown beside Eq. (7), code by code.
+            let own_rpm = (scene.bodies.iter())
+                .find(|b| b.name == conveying.body)
+                .map(|b| b.rpm.abs());
+            let verdicts = mass_flow::flow_verdicts(
+                &case_runs,
+                own_rpm,
+                conveying.blocks,
+                &case.known_differences,
+            );
             let origin = case.origin();
-            mass_flow::write_screw_section(report, &scene, &origin, &case_runs, &options.out)?;
+            mass_flow::write_screw_section(
+                report,
+                &scene,
+                &origin,
+                &case_runs,
+                &verdicts,
+                &options.out,
+            )?;
             write_code_notes(report, &case_runs);
             runs.extend(case_runs);
+            comparisons.extend(screw_comparisons(&scene.name, verdicts));
             continue;
         }
         let case_comparisons = compare(&scene, &case, &case_runs);
