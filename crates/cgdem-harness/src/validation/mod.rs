@@ -26,6 +26,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use crate::faults::{self, Faults};
 use crate::quantity::{discharge, mass_flow};
 use crate::report::Report;
 use crate::runs::output_error;
@@ -68,6 +69,7 @@ pub fn validate_suite(
     suite: &Suite,
     options: &ValidateOptions,
 ) -> Result<ValidationSummary, ValidateError> {
+    check_faults(suite, options)?;
     std::fs::create_dir_all(&options.out).map_err(|e| output_error(&options.out, e))?;
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
     let mut provenance = provenance(suite, options);
@@ -122,6 +124,27 @@ fn screw_comparisons(case: &str, verdicts: mass_flow::FlowVerdicts) -> Vec<Compa
             )
         })
         .collect()
+}
+
+/// The planted faults, parsed before any run is made; the screw's speed fault needs a case
+/// with a screw (a scene with `[conveying]`), or it would change nothing and say so nowhere.
+fn check_faults(suite: &Suite, options: &ValidateOptions) -> Result<(), ValidateError> {
+    let error = |message: String| ValidateError::Case {
+        file: suite.source.clone(),
+        message,
+    };
+    let faults = Faults::parse(&options.cgdem_faults).map_err(|e| error(e.to_string()))?;
+    if faults.rpm_factor.is_some() {
+        let conveys = |case: &SuiteCase| case.load_scene().is_ok_and(|s| s.conveying.is_some());
+        if !suite.cases.iter().any(conveys) {
+            return Err(error(format!(
+                "--fault {}: no case of suite `{}` has a screw (a scene with [conveying]) to turn",
+                faults::RPM_FACTOR,
+                suite.name
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Each reference code the suite runs, as found: its release (or that it is missing) in the
