@@ -94,7 +94,7 @@ pub fn flow_verdicts(
                 let at = |code: Code| -> Vec<&RunRecord> {
                     runs.iter()
                         .filter(in_group)
-                        .filter(|r| r.code == code && speed(*r) == Some(rpm))
+                        .filter(|r| r.code == code && speed(r) == Some(rpm))
                         .collect()
                 };
                 let (cgdem_runs, reference_runs) = (at(Code::Cgdem), at(reference));
