@@ -70,8 +70,9 @@ pub(super) struct ValidateArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..))]
     jobs: u16,
     /// Plant a fault in cgdem's runs only: a scene override (`contact.friction=0.3`)
-    /// applied after the case's own, the scene keeping its name, so its comparisons with
-    /// the reference codes show that the verdicts can fail (repeatable;
+    /// applied after the case's own, or `rpm_factor=F` (the screw of a conveying case
+    /// turning F times as fast as the case says), the scene keeping its name, so its
+    /// comparisons with the reference codes show that the verdicts can fail (repeatable;
     /// scripts/planted-faults.sh). Marked on the report's first screen.
     #[arg(long = "fault", value_name = "KEY=VALUE")]
     fault: Vec<String>,

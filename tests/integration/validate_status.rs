@@ -109,3 +109,31 @@ fn an_unreadable_suite_or_scene_is_exit_status_two() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("missing_scene.toml"));
 }
+
+/// The screw's speed fault is refused before any run: with a factor that is not one, and on a
+/// scene without a screw, where it would change nothing (exit status 2, no report written).
+#[test]
+fn a_screw_speed_fault_without_a_screw_or_with_a_bad_factor_is_exit_status_two() {
+    let dir = scratch("screw-fault");
+    let scene = Path::new(ROOT).join("tests/data/tiny_drop.toml");
+    for (fault, says) in [
+        ("rpm_factor=0.8", "has a screw"),
+        ("rpm_factor=0", "a factor > 0"),
+    ] {
+        let args = [scene.to_str().unwrap(), "--codes", "cgdem", "--seeds", "1"];
+        let out = validate(
+            &dir,
+            &[&args[..], &["--out", "faulted", "--fault", fault]].concat(),
+        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{fault}: {stderr}");
+        assert!(
+            stderr.contains("rpm_factor") && stderr.contains(says),
+            "{stderr}"
+        );
+        assert!(
+            !dir.join("faulted").exists(),
+            "{fault}: no report without a run"
+        );
+    }
+}

@@ -22,7 +22,8 @@
 //!   its figures, which the suite kinds and [`advise`] combine.
 //! - **Building blocks**: [`suite`] and [`suite_entry`] (suite files), [`runs`] (one run of
 //!   any code, reuse, concurrency), [`decks`] (the reference codes: a LAMMPS and a LIGGGHTS
-//!   dialect, runner, dump parser, post-processing), [`ranks`] (cgdem as MPI ranks),
+//!   dialect, runner, dump parser, post-processing), [`faults`] (`--fault`, planted in
+//!   cgdem's runs only), [`ranks`] (cgdem as MPI ranks),
 //!   [`verdict`], [`report`] (figures and HTML), [`csv_table`], [`code`].
 
 // Commands.
@@ -41,6 +42,7 @@ pub mod quantity;
 pub mod code;
 pub mod csv_table;
 pub mod decks;
+pub mod faults;
 pub mod ranks;
 pub mod report;
 pub mod runs;

@@ -225,9 +225,10 @@ pub struct ValidateOptions {
     /// Raised on SIGINT/SIGTERM: runs in progress stop (cgdem at the end of a step, reference
     /// codes with their process tree) and record why; no further run starts.
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-    /// Planted faults (`--fault KEY=VALUE`): scene overrides applied to cgdem's runs only,
-    /// after the case's own, the scene keeping its name, so that its comparisons with the
-    /// reference codes show whether the verdicts can fail (scripts/planted-faults.sh).
+    /// Planted faults (`--fault KEY=VALUE`, `crate::faults`): scene overrides, or the
+    /// screw's speed scaled, applied to cgdem's runs only, the scene keeping its name, so
+    /// that its comparisons with the reference codes show whether the verdicts can fail
+    /// (scripts/planted-faults.sh).
     pub cgdem_faults: Vec<String>,
     /// A nightly history directory (`history.json`, `cgdem history`): the report's first
     /// screen says what moved since the last night recorded there.

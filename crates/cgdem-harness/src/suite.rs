@@ -154,13 +154,14 @@ struct RawKnownDifference {
 }
 
 /// The criteria a comparison is judged by (`verdict::Criterion::name`).
-pub const CRITERIA: [&str; 6] = [
+pub const CRITERIA: [&str; 7] = [
     crate::quantity::repose::CRITERION,
     "t_half ratio",
     "front gap",
     "wall height gap",
     "kinetic energy gap",
     crate::quantity::discharge::CRITERION,
+    crate::quantity::mass_flow::CRITERION,
 ];
 
 impl Suite {
@@ -399,7 +400,7 @@ fn parse_known_difference(
         return Err(invalid(
             field("criterion"),
             format!("\"{}\"", kd.criterion),
-            "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\", \"discharge rate\" (a silo case)",
+            "one of \"repose angle\", \"t_half ratio\", \"front gap\", \"wall height gap\", \"kinetic energy gap\", \"discharge rate\" (a silo case), \"mass flow\" (a screw case)",
         ));
     }
     if !(kd.band[0].is_finite() && kd.band[1].is_finite() && kd.band[0] <= kd.band[1]) {

@@ -12,6 +12,11 @@
 //! few seeds scatters around it as much as around a tolerance): inside, "known difference";
 //! outside, "fail". The row's verdict is its worst criterion's, and the
 //! row names the criterion that decided it.
+//!
+//! Rates measured over blocks of a steady window (a silo's discharge rate, a screw's mass
+//! flow) carry a standard error even from one seed; their criteria have no physical
+//! tolerance and pass when the two sides, each widened by `K_NOISE` of its own standard
+//! errors, meet. Such a criterion says how its noise was estimated (`noise_rule`).
 
 use serde::Serialize;
 
@@ -103,6 +108,10 @@ pub struct Criterion {
     pub verdict: Verdict,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub known_difference: Option<KnownDifference>,
+    /// How the noise was estimated, when not from the seeds' spread alone (e.g. from the
+    /// runs' block-average standard errors): said instead of the seeds' note.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_rule: Option<String>,
 }
 
 impl Criterion {
@@ -134,7 +143,14 @@ impl Criterion {
             threshold,
             verdict,
             known_difference: known.cloned(),
+            noise_rule: None,
         }
+    }
+
+    /// The criterion with `rule` saying how its noise was estimated.
+    pub fn with_noise_rule(mut self, rule: impl Into<String>) -> Criterion {
+        self.noise_rule = Some(rule.into());
+        self
     }
 
     /// How close the value is to deciding against it: value / threshold (band edge for a
@@ -150,7 +166,12 @@ impl Criterion {
 
     /// "value 0.061 > threshold 0.050 + 2 x 0.004 = 0.058" in words, for tables.
     pub fn describe(&self) -> String {
-        let seeds = if self.seeds.iter().any(|&n| n < 2) {
+        let seeds = if let Some(rule) = &self.noise_rule {
+            format!(
+                " (seeds {}+{}; noise: {rule})",
+                self.seeds[0], self.seeds[1]
+            )
+        } else if self.seeds.iter().any(|&n| n < 2) {
             format!(
                 " (seeds {}+{}: a side with one seed has no noise estimate)",
                 self.seeds[0], self.seeds[1]

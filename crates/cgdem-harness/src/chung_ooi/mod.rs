@@ -80,11 +80,10 @@ pub fn run_chung_ooi(
     if laws.is_empty() {
         return Ok(Vec::new());
     }
-    let faults = options
-        .cgdem_faults
-        .iter()
-        .map(|f| Override::parse(f, std::path::Path::new("--fault")).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()?;
+    // The screw's speed fault has no screw to act on here.
+    let faults = crate::faults::Faults::parse(&options.cgdem_faults)
+        .map_err(|e| e.to_string())?
+        .overrides;
     let mut results = Vec::new();
     let mut verdicts = Vec::new();
     for law in laws {

@@ -56,6 +56,18 @@ pub fn mean_with_block_error(measurements: &[(f64, f64)]) -> Option<(f64, f64)> 
     Some((mean, se))
 }
 
+/// The mean over seeds of block-averaged measurements `(value, se)` and the noise of that
+/// mean: the block errors combined ([`mean_with_block_error`]), or, with two or more seeds,
+/// the standard error of the seeds' spread when that is larger. Both estimate the same noise;
+/// the larger is taken so that a few blocks or a few seeds that happen to agree do not
+/// narrow a verdict's band. None without a measurement.
+pub fn mean_with_noise(measurements: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let (mean, block_se) = mean_with_block_error(measurements)?;
+    let values: Vec<f64> = measurements.iter().map(|m| m.0).collect();
+    let seeds_se = mean_se(&values).1.unwrap_or(0.0);
+    Some((mean, block_se.max(seeds_se)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -67,6 +79,23 @@ mod tests {
         assert_eq!(mean, 1.5);
         assert!((se - 0.25).abs() < 1e-15, "{se}");
         assert_eq!(mean_with_block_error(&[]), None);
+    }
+
+    #[test]
+    fn the_noise_of_a_mean_is_the_larger_of_its_block_and_seed_errors() {
+        // One seed: its block error alone.
+        assert_eq!(mean_with_noise(&[(4.0, 0.05)]), Some((4.0, 0.05)));
+        // Seeds 4.0 and 4.2 (standard error of the spread 0.1) with block errors 0.03 and
+        // 0.04 (combined 0.025): the spread's.
+        let (mean, se) = mean_with_noise(&[(4.0, 0.03), (4.2, 0.04)]).unwrap();
+        assert!(
+            (mean - 4.1).abs() < 1e-12 && (se - 0.1).abs() < 1e-12,
+            "{se}"
+        );
+        // Seeds that agree to the last digit keep their block errors: sqrt(0.3^2 + 0.4^2) / 2.
+        let (_, se) = mean_with_noise(&[(4.0, 0.3), (4.0, 0.4)]).unwrap();
+        assert!((se - 0.25).abs() < 1e-12, "{se}");
+        assert_eq!(mean_with_noise(&[]), None);
     }
 
     #[test]

@@ -26,6 +26,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use crate::faults::{self, Faults};
 use crate::quantity::{discharge, mass_flow};
 use crate::report::Report;
 use crate::runs::output_error;
@@ -68,6 +69,7 @@ pub fn validate_suite(
     suite: &Suite,
     options: &ValidateOptions,
 ) -> Result<ValidationSummary, ValidateError> {
+    check_faults(suite, options)?;
     std::fs::create_dir_all(&options.out).map_err(|e| output_error(&options.out, e))?;
     let mut report = Report::new(format!("cgdem validation: suite `{}`", suite.name));
     let mut provenance = provenance(suite, options);
@@ -105,6 +107,44 @@ pub fn validate_suite(
         .write(&html_path)
         .map_err(|e| output_error(&html_path, e))?;
     Ok(summary)
+}
+
+/// A screw case's mass-flow verdicts as the suite's comparisons (one per reference code and
+/// speed), counted in the status as every other.
+fn screw_comparisons(case: &str, verdicts: mass_flow::FlowVerdicts) -> Vec<Comparison> {
+    (verdicts.judged.into_iter())
+        .map(|v| {
+            Comparison::judged(
+                case,
+                "codes",
+                mass_flow::PART,
+                &v.what,
+                v.detail,
+                vec![v.criterion],
+            )
+        })
+        .collect()
+}
+
+/// The planted faults, parsed before any run is made; the screw's speed fault needs a case
+/// with a screw (a scene with `[conveying]`), or it would change nothing and say so nowhere.
+fn check_faults(suite: &Suite, options: &ValidateOptions) -> Result<(), ValidateError> {
+    let error = |message: String| ValidateError::Case {
+        file: suite.source.clone(),
+        message,
+    };
+    let faults = Faults::parse(&options.cgdem_faults).map_err(|e| error(e.to_string()))?;
+    if faults.rpm_factor.is_some() {
+        let conveys = |case: &SuiteCase| case.load_scene().is_ok_and(|s| s.conveying.is_some());
+        if !suite.cases.iter().any(conveys) {
+            return Err(error(format!(
+                "--fault {}: no case of suite `{}` has a screw (a scene with [conveying]) to turn",
+                faults::RPM_FACTOR,
+                suite.name
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Each reference code the suite runs, as found: its release (or that it is missing) in the
@@ -228,12 +268,30 @@ fn run_cases(
             comparisons.extend(verdict);
             continue;
         }
-        if scene.conveying.is_some() {
-            // A screw case is judged by its mass flow against Eq. (7), code by code.
+        if let Some(conveying) = &scene.conveying {
+            // A screw case: cgdem's mass flow judged against each reference code's, speed
+            // by speed; shown beside Eq. (7), code by code.
+            let own_rpm = (scene.bodies.iter())
+                .find(|b| b.name == conveying.body)
+                .map(|b| b.rpm.abs());
+            let verdicts = mass_flow::flow_verdicts(
+                &case_runs,
+                own_rpm,
+                conveying.blocks,
+                &case.known_differences,
+            );
             let origin = case.origin();
-            mass_flow::write_screw_section(report, &scene, &origin, &case_runs, &options.out)?;
+            mass_flow::write_screw_section(
+                report,
+                &scene,
+                &origin,
+                &case_runs,
+                &verdicts,
+                &options.out,
+            )?;
             write_code_notes(report, &case_runs);
             runs.extend(case_runs);
+            comparisons.extend(screw_comparisons(&scene.name, verdicts));
             continue;
         }
         let case_comparisons = compare(&scene, &case, &case_runs);

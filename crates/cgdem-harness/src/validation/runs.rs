@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::faults::Faults;
 use crate::runs::{run_concurrently, run_one, RunRecord, ValidateError, ValidateOptions};
 use crate::suite::{Code, SuiteCase};
 use cgdem_core::coarse_graining::CoarseGrainRule;
@@ -35,20 +36,18 @@ pub(super) fn run_case(
     };
     // Planted faults change cgdem's scene only; it keeps its name, so its runs are compared
     // with the reference codes' runs of the unchanged case.
-    let faulted = if options.cgdem_faults.is_empty() {
+    let case_error = |message: String| ValidateError::Case {
+        file: case.file.clone(),
+        message,
+    };
+    let faults = Faults::parse(&options.cgdem_faults).map_err(|e| case_error(e.to_string()))?;
+    let faulted = if faults.overrides.is_empty() {
         None
     } else {
-        let case_error = |message: String| ValidateError::Case {
-            file: case.file.clone(),
-            message,
-        };
-        let mut overrides = case.overrides.clone();
-        for f in &options.cgdem_faults {
-            overrides.push(
-                cgdem_core::scene::Override::parse(f, Path::new("--fault"))
-                    .map_err(|e| case_error(e.to_string()))?,
-            );
-        }
+        let overrides: Vec<_> = (case.overrides.iter())
+            .chain(&faults.overrides)
+            .cloned()
+            .collect();
         let mut s = crate::suite::load_variant(&case.file, &overrides, case.variant.as_deref())
             .map_err(|e| case_error(e.to_string()))?;
         s.name = scene.name.clone();
@@ -88,6 +87,12 @@ pub(super) fn run_case(
                 }
                 _ => scene,
             };
+            // The screw's speed fault acts on the speed the run is made at.
+            let at_faulty_speed = match code {
+                Code::Cgdem => faults.at_faulty_speed(scene),
+                _ => None,
+            };
+            let scene = at_faulty_speed.as_ref().unwrap_or(scene);
             let options = &ValidateOptions {
                 keep_going: options.keep_going || case.keep_going,
                 ..options.clone()

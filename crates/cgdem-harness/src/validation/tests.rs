@@ -124,3 +124,64 @@ fn a_declared_difference_is_amber_in_its_band_and_red_outside() {
         Verdict::Fail
     );
 }
+
+#[test]
+fn a_screw_flow_outside_its_band_turns_the_status_red_and_one_inside_green() {
+    use crate::quantity::mass_flow::flow_verdicts;
+    // One seed per code at 140 rpm (reports/screw_three_codes/NOTE.md: cgdem 5.938 +- 0.086,
+    // LIGGGHTS 5.896 +- 0.146 kg/s), and cgdem's flow as a screw turning 0.8 times as fast.
+    let screw_run = |code: Code, flow: f64, se: f64| {
+        let mut r = RunRecord::ok(
+            "screw_feeder_hertz".into(),
+            code,
+            1,
+            CoarseGrainRule::RelativeOverlap,
+            1,
+            std::path::PathBuf::from("unused"),
+        );
+        r.rpm = Some(140.0);
+        r.mass_flow_kg_s = Some(flow);
+        r.mass_flow_std_error_kg_s = Some(se);
+        r
+    };
+    let night = |cgdem_flow: f64| {
+        let runs = vec![
+            screw_run(Code::Cgdem, cgdem_flow, 0.086),
+            screw_run(Code::Liggghts, 5.896, 0.146),
+        ];
+        let verdicts = flow_verdicts(&runs, None, 2, &[]);
+        let mut summary = ValidationSummary {
+            suite: "screw".into(),
+            status: Status::Green,
+            provenance: BTreeMap::new(),
+            comparisons: screw_comparisons("screw_feeder_hertz", verdicts),
+            runs,
+            accuracy: None,
+            stability: Vec::new(),
+            chung_ooi: Vec::new(),
+        };
+        summary.status = Status::of(&summary);
+        summary
+    };
+    let unchanged = night(5.938);
+    assert_eq!(
+        unchanged.status,
+        Status::Green,
+        "{:?}",
+        unchanged.comparisons
+    );
+    let slowed = night(0.8 * 5.938);
+    assert_eq!(slowed.status, Status::Red);
+    assert_eq!(slowed.status.exit_code(), 1);
+    // summary.json says which comparison and criterion, as for every other case.
+    let json = serde_json::to_value(&slowed).unwrap();
+    let c = &json["comparisons"][0];
+    assert_eq!(c["what"], "cgdem vs liggghts, lambda = 1, 140 rpm", "{c}");
+    assert_eq!(c["part"], "steady flow");
+    assert_eq!(c["verdict"], "fail");
+    assert_eq!(c["decided_by"], "mass flow");
+    assert!(c["criteria"][0]["noise_rule"]
+        .as_str()
+        .unwrap()
+        .contains("one seed per code"));
+}

@@ -2,16 +2,22 @@
 //! the same way (`analysis::conveying`: cgdem from its state, LIGGGHTS and LAMMPS from their
 //! dumps, `decks::postprocess::conveying_samples`) into each run's `summary.json`, with its
 //! block-average standard error and Eq. (7) at the run's measured fill ratio. Here: the
-//! mean over seeds at each speed, and the case's section: mass flow against screw speed for
-//! every code beside Eq. (7) (Hirose, Fig. 8), and a table of the numbers.
+//! mean over seeds at each speed; cgdem's flow judged against each reference code's at each
+//! speed (`verdict`); and the case's section: the verdicts, mass flow against screw speed
+//! for every code beside Eq. (7) (Hirose, Fig. 8), and a table of the numbers.
+
+mod verdict;
+
+pub use verdict::{flow_verdicts, FlowSide, FlowVerdict, FlowVerdicts, CRITERION, PART};
 
 use std::path::Path;
 
 use super::seeds::mean_with_block_error;
 use super::{show_figure, CaseOrigin};
 use crate::code::Code;
-use crate::report::{Cell, Figure, Report, Series, SeriesStyle, Table};
+use crate::report::{Cell, Figure, Report, Section, Series, SeriesStyle, Status, Table};
 use crate::runs::{Outcome, RunRecord, ValidateError};
+use crate::verdict::{Verdict, K_NOISE};
 use cgdem_core::scene::Scene;
 
 /// A run's conveying measurement `key` (`mass_flow_kg_s`, `eq7_mass_flow_kg_s`, ...) from
@@ -144,12 +150,14 @@ pub fn write_screw_overview(
     )
 }
 
-/// The section: the figure (PNG, SVG and CSV under `figures/<case>/`) and the table.
+/// The section: the verdicts, the figure (PNG, SVG and CSV under `figures/<case>/`) and
+/// the table.
 pub fn write_screw_section(
     report: &mut Report,
     scene: &Scene,
     case: &CaseOrigin,
     runs: &[RunRecord],
+    verdicts: &FlowVerdicts,
     out: &Path,
 ) -> Result<(), ValidateError> {
     let dir = out.join("figures").join(&scene.name);
@@ -169,6 +177,7 @@ pub fn write_screw_section(
         case.rpms,
         case.seeds
     ));
+    write_verdicts(section, verdicts);
     if case.keep_going {
         section.paragraph("cgdem's guards only warn in this case (suite entry `keep_going = true`): grains wedge between the flight's tip and the casing, a clearance narrower than a grain, deeper than the overlap guard allows; the warnings and the deepest overlap are in each run's summary.json.");
     }
@@ -232,4 +241,128 @@ pub fn write_screw_section(
     }
     section.table(table);
     Ok(())
+}
+
+/// The verdicts of a screw case: a banner with the worst, the rule, and a row per speed
+/// (the speeds not compared too, with why).
+fn write_verdicts(section: &mut Section, verdicts: &FlowVerdicts) {
+    if verdicts.judged.is_empty() && verdicts.not_compared.is_empty() {
+        return;
+    }
+    let worst = verdicts.judged.iter().map(|v| v.criterion.verdict).max();
+    let counted = |verdict: Verdict| {
+        verdicts
+            .judged
+            .iter()
+            .filter(|v| v.criterion.verdict == verdict)
+            .count()
+    };
+    let (status, word) = match worst {
+        Some(Verdict::Fail) => (Status::Fail, "red"),
+        Some(Verdict::KnownDifference) => (Status::Known, "amber"),
+        Some(Verdict::Pass) => (Status::Pass, "green"),
+        None => (Status::Skipped, ""),
+    };
+    let banner = if verdicts.judged.is_empty() {
+        format!(
+            "Mass flow, cgdem against the reference codes: not judged ({} comparisons not \
+             made, listed below).",
+            verdicts.not_compared.len()
+        )
+    } else {
+        format!(
+            "Mass flow, cgdem against the reference codes: {word} ({} speeds within the band, \
+             {} known differences inside their bands, {} outside; {} not compared).",
+            counted(Verdict::Pass),
+            counted(Verdict::KnownDifference),
+            counted(Verdict::Fail),
+            verdicts.not_compared.len()
+        )
+    };
+    section.banner(status, banner);
+    let one_seed = verdicts
+        .judged
+        .iter()
+        .any(|v| v.cgdem.seeds == 1 || v.reference.seeds == 1);
+    let mut rule = format!(
+        "Verdict, speed by speed: cgdem's mass flow against each reference code's that ran \
+         the same screw, |cgdem - reference| over the reference code's flow. It passes when \
+         the two flows, each widened by {K_NOISE} of its standard errors, meet (the silo's \
+         discharge-rate rule): threshold = {K_NOISE} x (SE_cgdem + SE_reference) / reference. \
+         No physical tolerance is added: the codes run the same grains, screw, feed and \
+         window, so a difference beyond the noise is a finding, or a declared known \
+         difference (amber inside its band). A side's standard error is its runs' \
+         block-average errors combined, or, with several seeds, the standard error of the \
+         seeds' spread when that is larger."
+    );
+    if one_seed {
+        rule += &format!(
+            " Where a code has one seed, the band rests on that one run: its standard error \
+             is the block-average standard error of its own window ({} blocks, so the band \
+             is itself uncertain); more seeds steady it.",
+            verdicts.blocks
+        );
+    }
+    section.paragraph(rule);
+    let mut table = Table::new([
+        "comparison",
+        "cgdem (kg/s)",
+        "reference (kg/s)",
+        "difference",
+        "threshold",
+        "seeds",
+        "verdict",
+    ])
+    .caption("Mass flow verdicts: cgdem against each reference code, speed by speed");
+    let side = |s: &FlowSide| format!("{:.3} +- {:.3}", s.mass_flow_kg_s, s.std_error_kg_s);
+    for v in &verdicts.judged {
+        let c = &v.criterion;
+        let threshold = match &c.known_difference {
+            Some(k) => format!(
+                "band [{:.1}%, {:.1}%] +- {K_NOISE} x {:.1}%",
+                100.0 * k.band[0],
+                100.0 * k.band[1],
+                100.0 * c.noise
+            ),
+            None => format!("{:.1}%", 100.0 * c.threshold),
+        };
+        let verdict = match (&c.known_difference, c.verdict) {
+            (_, Verdict::Pass) => Cell::pass("pass"),
+            (Some(k), Verdict::KnownDifference) => Cell::text(format!(
+                "known difference: {} (evidence: {})",
+                k.reason, k.evidence
+            ))
+            .status(Status::Known),
+            (_, verdict) => Cell::fail(verdict.name()),
+        };
+        table.row([
+            Cell::text(&v.what),
+            Cell::num(side(&v.cgdem)),
+            Cell::num(format!(
+                "{} {}",
+                v.reference.code.label(),
+                side(&v.reference)
+            )),
+            Cell::num(format!(
+                "{:+.1}%",
+                100.0 * (v.cgdem.mass_flow_kg_s - v.reference.mass_flow_kg_s)
+                    / v.reference.mass_flow_kg_s
+            )),
+            Cell::num(threshold),
+            Cell::num(format!("{}+{}", v.cgdem.seeds, v.reference.seeds)),
+            verdict,
+        ]);
+    }
+    for (what, why) in &verdicts.not_compared {
+        table.row([
+            Cell::text(what),
+            Cell::text("-"),
+            Cell::text("-"),
+            Cell::text("-"),
+            Cell::text("-"),
+            Cell::text("-"),
+            Cell::skipped(format!("not compared: {why}")),
+        ]);
+    }
+    section.table(table);
 }
