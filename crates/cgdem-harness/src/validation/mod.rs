@@ -268,30 +268,12 @@ fn run_cases(
             comparisons.extend(verdict);
             continue;
         }
-        if let Some(conveying) = &scene.conveying {
-            // A screw case: cgdem's mass flow judged against each reference code's, speed
-            // by speed; shown beside Eq. (7), code by code.
-            let own_rpm = (scene.bodies.iter())
-                .find(|b| b.name == conveying.body)
-                .map(|b| b.rpm.abs());
-            let verdicts = mass_flow::flow_verdicts(
-                &case_runs,
-                own_rpm,
-                conveying.blocks,
-                &case.known_differences,
-            );
-            let origin = case.origin();
-            mass_flow::write_screw_section(
-                report,
-                &scene,
-                &origin,
-                &case_runs,
-                &verdicts,
-                &options.out,
-            )?;
+        if scene.conveying.is_some() {
+            comparisons.extend(judge_screw_case(
+                report, &scene, &case, &case_runs, options,
+            )?);
             write_code_notes(report, &case_runs);
             runs.extend(case_runs);
-            comparisons.extend(screw_comparisons(&scene.name, verdicts));
             continue;
         }
         let case_comparisons = compare(&scene, &case, &case_runs);
@@ -308,4 +290,36 @@ fn run_cases(
         comparisons.extend(case_comparisons);
     }
     Ok((runs, comparisons))
+}
+
+/// A screw case: cgdem's mass flow judged against each reference code's, speed by speed,
+/// and its section (shown beside Eq. (7), code by code); returns its comparisons.
+fn judge_screw_case(
+    report: &mut Report,
+    scene: &Scene,
+    case: &SuiteCase,
+    case_runs: &[RunRecord],
+    options: &ValidateOptions,
+) -> Result<Vec<Comparison>, ValidateError> {
+    let Some(conveying) = &scene.conveying else {
+        return Ok(Vec::new());
+    };
+    let own_rpm = (scene.bodies.iter())
+        .find(|b| b.name == conveying.body)
+        .map(|b| b.rpm.abs());
+    let verdicts = mass_flow::flow_verdicts(
+        case_runs,
+        own_rpm,
+        conveying.blocks,
+        &case.known_differences,
+    );
+    mass_flow::write_screw_section(
+        report,
+        scene,
+        &case.origin(),
+        case_runs,
+        &verdicts,
+        &options.out,
+    )?;
+    Ok(screw_comparisons(&scene.name, verdicts))
 }

@@ -249,6 +249,14 @@ fn write_verdicts(section: &mut Section, verdicts: &FlowVerdicts) {
     if verdicts.judged.is_empty() && verdicts.not_compared.is_empty() {
         return;
     }
+    let (status, banner) = verdict_banner(verdicts);
+    section.banner(status, banner);
+    section.paragraph(verdict_rule(verdicts));
+    section.table(verdict_table(verdicts));
+}
+
+/// The screw case's verdict in one line: the worst comparison's status and the counts.
+fn verdict_banner(verdicts: &FlowVerdicts) -> (Status, String) {
     let worst = verdicts.judged.iter().map(|v| v.criterion.verdict).max();
     let counted = |verdict: Verdict| {
         verdicts
@@ -279,7 +287,11 @@ fn write_verdicts(section: &mut Section, verdicts: &FlowVerdicts) {
             verdicts.not_compared.len()
         )
     };
-    section.banner(status, banner);
+    (status, banner)
+}
+
+/// How the screw's verdict is made, in words (and what a one-seed band rests on).
+fn verdict_rule(verdicts: &FlowVerdicts) -> String {
     let one_seed = verdicts
         .judged
         .iter()
@@ -303,7 +315,11 @@ fn write_verdicts(section: &mut Section, verdicts: &FlowVerdicts) {
             verdicts.blocks
         );
     }
-    section.paragraph(rule);
+    rule
+}
+
+/// A row per judged speed, then a row per speed not compared, with why.
+fn verdict_table(verdicts: &FlowVerdicts) -> Table {
     let mut table = Table::new([
         "comparison",
         "cgdem (kg/s)",
@@ -364,5 +380,5 @@ fn write_verdicts(section: &mut Section, verdicts: &FlowVerdicts) {
             Cell::skipped(format!("not compared: {why}")),
         ]);
     }
-    section.table(table);
+    table
 }
