@@ -30,8 +30,12 @@ use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use cgdem_harness::code::Code;
 use cgdem_harness::decks::{self, lammps, liggghts, Deck, RunStatus, RunnerOptions};
 
+#[path = "support/bead_scene.rs"]
+mod bead_scene;
 #[path = "support/golden.rs"]
 mod golden;
+
+use bead_scene::{every_step, BEAD_CONTACT, BEAD_WALL_CONTACT};
 
 const GOLDEN_FILE: &str = "hertz_collisions.csv";
 
@@ -55,35 +59,9 @@ periodic = [false, false, false]
 name = "bead"
 diameter = {DIAMETER}
 density = 2500.0
-[contact]
-model = "hertz"
-youngs_modulus = 5.0e6
-poisson_ratio = 0.3
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-damping = "hertz"
-tangential = "history"
-rolling = "epsd2"
-cohesion = "none"
-characteristic_velocity = 1.0
-[wall_contact]
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-[time]
-dt_fraction = 0.05
-[neighbor]
-skin_fraction = 0.1
-resort_every = 0
-[[stage]]
-name = "collide"
-duration = {duration}
-[output]
-timeseries_interval = {DT}
-{walls}
+{BEAD_CONTACT}{BEAD_WALL_CONTACT}{run}{walls}
 "#,
-        duration = STEPS as Real * DT
+        run = every_step(STEPS as Real * DT, DT)
     );
     Scene::parse(&text, Path::new("hertz_golden.toml")).expect("golden scene")
 }
@@ -452,19 +430,7 @@ diameter = 1.5e-3
 density = 1200.0
 youngs_modulus = 5.0e7
 poisson_ratio = 0.2
-[contact]
-model = "hertz"
-youngs_modulus = 5.0e6
-poisson_ratio = 0.3
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-damping = "hertz"
-tangential = "history"
-rolling = "epsd2"
-cohesion = "none"
-characteristic_velocity = 1.0
-[[contact.pair]]
+{BEAD_CONTACT}[[contact.pair]]
 species = ["grain", "bead"]
 restitution = 0.35
 friction = 0.3
@@ -478,29 +444,15 @@ rolling_friction = 0.02
 name = "plate"
 youngs_modulus = 1.0e8
 poisson_ratio = 0.25
-[wall_contact]
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-[[wall_contact.pair]]
+{BEAD_WALL_CONTACT}[[wall_contact.pair]]
 species = "grain"
 material = "plate"
 restitution = 0.6
 friction = 0.4
 rolling_friction = 0.03
-[time]
-dt_fraction = 0.05
-[neighbor]
-skin_fraction = 0.1
-resort_every = 0
-[[stage]]
-name = "collide"
-duration = {duration}
-[output]
-timeseries_interval = {DT}
-{walls}
+{run}{walls}
 "#,
-        duration = STEPS as Real * DT
+        run = every_step(STEPS as Real * DT, DT)
     );
     Scene::parse(&text, Path::new("hertz_golden_unlike.toml")).expect("golden scene")
 }

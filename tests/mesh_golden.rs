@@ -32,8 +32,12 @@ use cgdem_core::scene::{ContactSettings, Scene};
 use cgdem_core::simulation::{Decompose, NeighborSettings, World, WorldSetup};
 use cgdem_harness::decks::{self, liggghts, RunStatus, RunnerOptions};
 
+#[path = "support/bead_scene.rs"]
+mod bead_scene;
 #[path = "support/golden.rs"]
 mod golden;
+
+use bead_scene::{every_step, BEAD_CONTACT, BEAD_WALL_CONTACT};
 
 const GOLDEN_FILE: &str = "mesh_collisions.csv";
 const CODE: &str = "LIGGGHTS";
@@ -137,40 +141,14 @@ periodic = [false, false, false]
 name = "bead"
 diameter = {diameter}
 density = 2500.0
-[contact]
-model = "hertz"
-youngs_modulus = 5.0e6
-poisson_ratio = 0.3
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-damping = "hertz"
-tangential = "history"
-rolling = "epsd2"
-cohesion = "none"
-characteristic_velocity = 1.0
-[wall_contact]
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-[time]
-dt_fraction = 0.05
-[neighbor]
-skin_fraction = 0.1
-resort_every = 0
-[[stage]]
-name = "collide"
-duration = {duration}
-[output]
-timeseries_interval = {DT}
-[[body]]
+{BEAD_CONTACT}{BEAD_WALL_CONTACT}{run}[[body]]
 name = "mesh"
 mesh = "mesh.stl"
 contact = "mesh"
 {motion}
 "#,
         diameter = 2.0 * RADIUS,
-        duration = STEPS as Real * DT
+        run = every_step(STEPS as Real * DT, DT)
     );
     Scene::parse(&text, &dir.join("scene.toml")).expect("golden scene")
 }

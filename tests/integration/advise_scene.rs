@@ -7,9 +7,13 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::bead_scene::{BEAD_CONTACT, BEAD_WALL_CONTACT};
+
 /// A small Hertz collapse (320 beads of 10 mm behind a gate, then 0.2 s of spreading): a
 /// case no suite names.
-const HEAP: &str = r#"
+fn heap() -> String {
+    format!(
+        r#"
 name = "my_heap"
 
 [domain]
@@ -22,24 +26,8 @@ name = "bead"
 diameter = 1.0e-2
 density = 2500.0
 
-[contact]
-model = "hertz"
-youngs_modulus = 5.0e6
-poisson_ratio = 0.3
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-damping = "hertz"
-tangential = "history"
-rolling = "epsd2"
-cohesion = "none"
-characteristic_velocity = 1.0
-
-[wall_contact]
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.1
-
+{BEAD_CONTACT}
+{BEAD_WALL_CONTACT}
 [[wall]]
 name = "floor"
 point = [0.0, 0.0, 0.0]
@@ -94,14 +82,16 @@ at_stage_end = true
 bin_width_diameters = 1.0
 exclude_wall_fraction = 0.15
 exclude_toe_fraction = 0.15
-"#;
+"#
+    )
+}
 
 /// A fresh working directory outside the repository, holding the scene.
 fn workdir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("cgdem-advise-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("heap.toml"), HEAP).unwrap();
+    std::fs::write(dir.join("heap.toml"), heap()).unwrap();
     dir
 }
 

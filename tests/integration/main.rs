@@ -3,6 +3,8 @@
 //! the multi-stage Hertz decks in LIGGGHTS and LAMMPS.
 
 mod advise_scene;
+#[path = "../support/bead_scene.rs"]
+mod bead_scene;
 mod bodies;
 mod cli;
 mod cli_reference;
