@@ -500,3 +500,61 @@ fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
     assert!(!matrix.join("runs/tiny_hertz_collapse-short").exists());
     let _ = std::fs::remove_dir_all(&matrix);
 }
+
+/// An open surface (a plate of two triangles, as a CAD export of a sheet gives it) cannot be
+/// an SDF grid: the run is refused naming the scene, the body and the STL file once, and
+/// pointing to `contact = "mesh"`, under which the same file runs.
+#[test]
+fn an_open_stl_is_refused_as_a_grid_and_met_on_its_triangles_as_a_mesh() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("open_stl_body");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("plate.stl"),
+        "solid plate\n\
+         facet normal 0 0 1\nouter loop\nvertex -0.05 -0.05 0\nvertex 0.05 -0.05 0\nvertex 0.05 0.05 0\nendloop\nendfacet\n\
+         facet normal 0 0 1\nouter loop\nvertex -0.05 -0.05 0\nvertex 0.05 0.05 0\nvertex -0.05 0.05 0\nendloop\nendfacet\n\
+         endsolid plate\n",
+    )
+    .unwrap();
+    let scene = std::fs::read_to_string("tests/data/tiny_hertz_collapse.toml").unwrap();
+    let run = |name: &str, body: &str| {
+        let file = dir.join(format!("{name}.toml"));
+        std::fs::write(
+            &file,
+            format!("{scene}\n[[body]]\nname = \"plate\"\nmesh = \"plate.stl\"\n{body}\n"),
+        )
+        .unwrap();
+        cgdem()
+            .arg("run")
+            .arg(&file)
+            .args([
+                "--quiet",
+                "--threads",
+                "1",
+                "--set",
+                "stage[0].max_duration=0.001",
+            ])
+            .args(["--set", "stage[0].min_duration=0.001", "--out"])
+            .arg(dir.join(name))
+            .output()
+            .unwrap()
+    };
+    let out = run("grid", "cell_size = 0.005");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("grid.toml")
+            && stderr.contains("body[0]")
+            && stderr.matches("plate.stl").count() == 1
+            && stderr.contains("not closed")
+            && stderr.contains("contact = \"mesh\""),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let out = run("mesh", "contact = \"mesh\"");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -427,10 +427,16 @@ pub enum SiloPart {
 impl MeshSource {
     pub fn load(&self) -> Result<crate::geometry::TriMesh, String> {
         use crate::geometry::screw_feeder as sf;
+        use crate::geometry::stl::StlError;
         match self {
-            MeshSource::Stl(path) => {
-                crate::geometry::read_stl(path).map_err(|e| format!("{}: {e}", path.display()))
-            }
+            // The STL errors name the file.
+            MeshSource::Stl(path) => crate::geometry::read_stl(path).map_err(|e| match e {
+                StlError::OpenEdges { .. } | StlError::BadOrientation { .. } => format!(
+                    "{e}\n  an SDF grid needs a closed, consistently oriented surface; \
+                     contact = \"mesh\" meets an open one on its triangles"
+                ),
+                e => e.to_string(),
+            }),
             MeshSource::ScrewFeeder(part) => {
                 let spec = sf::ScrewFeederSpec::default();
                 Ok(match part.as_str() {
@@ -492,7 +498,7 @@ impl BodySettings {
             (BodyContact::Mesh, MeshSource::Stl(path)) => {
                 crate::geometry::stl::read_stl_unchecked(path)
                     .map(|(mesh, _)| mesh)
-                    .map_err(|e| format!("{}: {e}", path.display()))
+                    .map_err(|e| e.to_string())
             }
             _ => self.mesh.load(),
         }
