@@ -2,7 +2,7 @@
 //! seen from its first particle, and what acts on one particle alone (gravity, the planar
 //! walls, the bodies). Generic over the laws and inlined into the subdomains' force pass.
 
-use crate::bodies::{mesh_contacts, Body, BodyLoad, BodyShape, Clearance};
+use crate::bodies::{mesh_contacts, Body, BodyLoad, BodyShape, Clearance, NearTriangles};
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
@@ -169,6 +169,8 @@ pub(crate) struct AloneSlots<'s, WH> {
     pub(crate) near: WallMask,
     pub(crate) history: &'s mut [WH],
     pub(crate) clearances: &'s mut [Clearance],
+    /// One list per body met on its triangles, in body order.
+    pub(crate) near_triangles: &'s mut [NearTriangles],
 }
 
 impl<W: WallLaw> Surroundings<'_, W> {
@@ -192,6 +194,7 @@ impl<W: WallLaw> Surroundings<'_, W> {
         *force += particle.mass * self.gravity;
         let mut overlap;
         let bodies = self.bodies.iter().zip(slots.clearances).zip(loads);
+        let mut lists = slots.near_triangles.iter_mut();
         if rotates {
             let (wall_history, body_history) = slots.history.split_at_mut(self.walls.walls.len());
             if W::NEEDS_ROTATION {
@@ -217,7 +220,10 @@ impl<W: WallLaw> Surroundings<'_, W> {
                 rest = tail;
                 let (f, t, l, o) = match &body.shape {
                     BodyShape::Mesh(mesh) => {
-                        mesh_contacts(body, mesh, law, particle, omega, history, clearance, dt)
+                        let near = lists.next().expect("a list per mesh body");
+                        mesh_contacts(
+                            body, mesh, law, particle, omega, history, clearance, near, dt,
+                        )
                     }
                     _ => body_force_and_torque(
                         body,
@@ -241,8 +247,18 @@ impl<W: WallLaw> Surroundings<'_, W> {
             for ((body, clearance), load) in bodies {
                 let (f, l, o) = match &body.shape {
                     BodyShape::Mesh(mesh) => {
-                        let (f, _, l, o) =
-                            mesh_contacts(body, mesh, law, particle, omega, &mut [], clearance, dt);
+                        let near = lists.next().expect("a list per mesh body");
+                        let (f, _, l, o) = mesh_contacts(
+                            body,
+                            mesh,
+                            law,
+                            particle,
+                            omega,
+                            &mut [],
+                            clearance,
+                            near,
+                            dt,
+                        );
                         (f, l, o)
                     }
                     _ => body_force(body, law, particle, clearance, dt),

@@ -160,13 +160,21 @@ impl Body {
     }
 
     /// Signed distance and world normal at world point `p`, if `p` lies within `reach` of the
-    /// body's box and the shape has data there.
+    /// body's box and the shape has data there. A body met on its triangles is searched no
+    /// farther than `reach` (the whole mesh otherwise): `None` where no triangle is that near.
     #[inline(always)]
     pub fn query(&self, p: Vec3, reach: Real) -> Option<(Real, Vec3)> {
         if !self.within_reach(p, reach) {
             return None;
         }
-        let (distance, normal) = self.shape.query(self.to_body(p))?;
+        let q = self.to_body(p);
+        let (distance, normal) = match &self.shape {
+            BodyShape::Mesh(mesh) => mesh.nearest_within(q, reach).map(|(d, c)| {
+                let normal = if d > 0.0 { (q - c) / d } else { Vec3::Z };
+                (d, normal)
+            })?,
+            shape => shape.query(q)?,
+        };
         Some((distance, self.rotation * normal))
     }
 
@@ -223,6 +231,11 @@ impl Body {
             shape,
             rotation: &self.rotation,
         })
+    }
+
+    /// Whether the body is met on its triangles (`contact = "mesh"`).
+    pub fn is_mesh(&self) -> bool {
+        matches!(self.shape, BodyShape::Mesh(_))
     }
 
     /// A body-frame direction in the world frame.

@@ -13,7 +13,9 @@
 //! A particle keeps [`MESH_CONTACTS`] contacts per mesh body, each in two slots of its
 //! wall-history row: the triangle (as a tag, [`PairHistory::tagged`]) and the history. The
 //! triangles are found through the surface's BVH when the particle's clearance (as for grid
-//! bodies, a ball free of the surface) does not already rule them out.
+//! bodies, a ball free of the surface) does not already rule them out, and kept in the
+//! particle's [`NearTriangles`] (LIGGGHTS's per-particle triangle list): while its point stays
+//! within the skin of where they were searched, it visits them without searching again.
 
 use std::cell::RefCell;
 
@@ -28,19 +30,76 @@ use crate::walls::{WallContact, WallLaw, WallParticle};
 /// triangles in its list). A further contact acts without history.
 pub const MESH_CONTACTS: usize = 4;
 
-/// How far beyond its reach a particle's triangle search looks, in reaches: the clearance
-/// ball then lets the particle move that far before the next search.
-const SEARCH_REACH: Real = 2.0;
+/// How far a particle's triangle search looks, in reaches: the clearance ball and the list of
+/// triangles then let the particle move half a reach (the list's skin) before the next
+/// search. A wider skin searches less often but lists more triangles, each tested every step.
+const SEARCH_REACH: Real = 1.5;
 
 thread_local! {
     /// The triangles near the particle of the moment (the search's scratch).
     static NEAR: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
 }
 
+/// Triangles a particle's list holds at most; a search that finds more is not kept (the
+/// particle searches again at its next step, as it would without a list).
+const NEAR_CAPACITY: usize = 48;
+
+/// The triangles of one mesh body within the search radius of a body-frame point `at`: a
+/// particle's list, as LIGGGHTS keeps one per particle and mesh. For any point within
+/// `skin` of `at`, every triangle nearer than `beyond` is in it, so the contacts found from it
+/// are those a new search would give, in the same (index) order: the outputs do not change.
+/// Like [`Clearance`], it states a fact about the body, not about a particle, so a slot
+/// handed to another particle after a re-sort is still right for it.
+#[derive(Clone, Copy, Debug)]
+pub struct NearTriangles {
+    at: Vec3,
+    /// Squared radius of the ball of points the list serves; negative: none.
+    skin_squared: Real,
+    /// The distance below which the list holds every triangle (a particle's reach or radius).
+    beyond: Real,
+    count: u32,
+    triangles: [u32; NEAR_CAPACITY],
+}
+
+impl NearTriangles {
+    pub const NONE: NearTriangles = NearTriangles {
+        at: Vec3::ZERO,
+        skin_squared: -1.0,
+        beyond: Real::NAN,
+        count: 0,
+        triangles: [0; NEAR_CAPACITY],
+    };
+
+    /// How far `q` is from where the list was searched, if it serves `q` for `beyond`.
+    #[inline(always)]
+    fn serves(&self, q: Vec3, beyond: Real) -> Option<Real> {
+        let moved_squared = (q - self.at).length_squared();
+        (self.beyond == beyond && moved_squared < self.skin_squared).then(|| moved_squared.sqrt())
+    }
+
+    /// Keeps `triangles` (every one within `beyond + skin` of `at`), if they fit.
+    fn keep(&mut self, at: Vec3, beyond: Real, skin: Real, triangles: &[u32]) {
+        if triangles.len() > NEAR_CAPACITY {
+            *self = NearTriangles::NONE;
+            return;
+        }
+        self.at = at;
+        self.beyond = beyond;
+        self.skin_squared = skin * skin;
+        self.count = triangles.len() as u32;
+        self.triangles[..triangles.len()].copy_from_slice(triangles);
+    }
+
+    fn triangles(&self) -> &[u32] {
+        &self.triangles[..self.count as usize]
+    }
+}
+
 /// Force and torque of a mesh body on one particle, the particle's load on the body and its
 /// deepest overlap with a triangle as a fraction of its radius. `slots`: the particle's
 /// `2 * MESH_CONTACTS` history slots for this body (tags, then histories); empty when
-/// particles do not spin (then contacts keep no history and give no torque).
+/// particles do not spin (then contacts keep no history and give no torque). `clearance`
+/// and `near`: the particle's ball free of the surface and its list of triangles.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mesh_contacts<W: WallLaw>(
     body: &Body,
@@ -50,6 +109,7 @@ pub(crate) fn mesh_contacts<W: WallLaw>(
     omega: Vec3,
     slots: &mut [W::History],
     clearance: &mut Clearance,
+    near: &mut NearTriangles,
     dt: Real,
 ) -> (Vec3, Vec3, BodyLoad, Real) {
     let reach = law.reach(particle.species, particle.radius);
@@ -65,10 +125,26 @@ pub(crate) fn mesh_contacts<W: WallLaw>(
     let mut keep = [false; MESH_CONTACTS];
     // Without history: the triangles counted at this step, for the one-patch rule.
     let mut counted = [u32::MAX; MESH_CONTACTS];
+    // No triangle outside the ones visited is nearer than this.
     let mut nearest = search;
-    NEAR.with_borrow_mut(|near| {
-        mesh.triangles_near(q, search, near);
-        for &t in near.iter() {
+    NEAR.with_borrow_mut(|found| {
+        let listed = match near.serves(q, beyond) {
+            Some(moved) => {
+                nearest = search - moved;
+                near.triangles()
+            }
+            None => {
+                mesh.triangles_near(q, search, found);
+                near.keep(q, beyond, search - beyond, found);
+                found.as_slice()
+            }
+        };
+        for &t in listed {
+            let at_least = mesh.distance_at_least(t as usize, q);
+            if at_least >= beyond {
+                nearest = nearest.min(at_least);
+                continue;
+            }
             let Some(hit) = mesh.resolve(t as usize, q) else {
                 continue;
             };

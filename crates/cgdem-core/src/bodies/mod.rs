@@ -9,7 +9,7 @@ mod shape;
 
 pub use body::{Body, BodyLoad, BodySample, BodyState, Clearance};
 pub(crate) use mesh_contact::mesh_contacts;
-pub use mesh_contact::MESH_CONTACTS;
+pub use mesh_contact::{NearTriangles, MESH_CONTACTS};
 pub use motion::Motion;
 pub use particle_body::{fcc_sites_inside, KinematicParticles};
 pub use shape::{BodyShape, ShapeSample};

@@ -104,6 +104,8 @@ pub struct Subdomain<H, WH> {
     /// Per owned particle, per body: where it needs no SDF lookup (as the world's; not
     /// stored in restart files).
     pub body_clearances: Vec<crate::bodies::Clearance>,
+    /// Per owned particle and body met on its triangles: the triangles near it.
+    pub near_triangles: Vec<crate::bodies::NearTriangles>,
     /// Per owned particle, the walls it may reach before the next list build; made by the
     /// first force pass after a build (not stored in restart files: any pass makes them
     /// right, they only spare looking at walls out of reach).
@@ -128,6 +130,7 @@ impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
             receives: Vec::new(),
             list: PairList::default(),
             body_clearances: Vec::new(),
+            near_triangles: Vec::new(),
             near_walls: Vec::new(),
             within_reach: Vec::new(),
         }

@@ -13,7 +13,7 @@ use super::removal::{RemovalRule, Removals};
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
-use crate::bodies::{Body, BodyLoad, Clearance, KinematicParticles};
+use crate::bodies::{Body, BodyLoad, Clearance, KinematicParticles, NearTriangles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::Domain;
@@ -589,6 +589,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             m.particle_bytes += sub.particles.array_bytes()
                 + bytes(&sub.wall_history)
                 + bytes(&sub.body_clearances)
+                + bytes(&sub.near_triangles)
                 + bytes(&sub.list.reference)
                 + sub.sends.iter().map(|l| bytes(&l.indices)).sum::<usize>()
                 + bytes(&sub.receives);
@@ -855,6 +856,15 @@ fn forces<L: PairLaw, W: WallLaw>(
     if sub.body_clearances.len() != n * n_bodies {
         sub.body_clearances = vec![Clearance::NONE; n * n_bodies];
     }
+    let n_meshes = physics
+        .surroundings
+        .bodies
+        .iter()
+        .filter(|b| b.is_mesh())
+        .count();
+    if sub.near_triangles.len() != n * n_meshes {
+        sub.near_triangles = vec![NearTriangles::NONE; n * n_meshes];
+    }
     let slots = if rotates { physics.wall_slots } else { 0 };
     let particle = |i: usize| WallParticle {
         species: state.species[i] as usize,
@@ -887,6 +897,7 @@ fn forces<L: PairLaw, W: WallLaw>(
             near: sub.near_walls[i],
             history: &mut sub.wall_history[i * slots..(i + 1) * slots],
             clearances: &mut sub.body_clearances[i * n_bodies..(i + 1) * n_bodies],
+            near_triangles: &mut sub.near_triangles[i * n_meshes..(i + 1) * n_meshes],
         };
         let omega = state.omega.map_or(Vec3::ZERO, |w| w[i]);
         let mut unused = Vec3::ZERO;

@@ -61,6 +61,9 @@ pub struct MeshSurface {
     tolerance: Vec<Real>,
     /// The corner with an obtuse angle, 3 for none.
     obtuse: Vec<u8>,
+    /// Centroid and the largest centroid-to-corner distance: a bound that spares the exact
+    /// test for triangles out of reach.
+    spheres: Vec<(Vec3, Real)>,
     edge_active: Vec<[bool; 3]>,
     corner_active: Vec<[bool; 3]>,
     /// Triangles of the same patch sharing a vertex: `coplanar[start[t]..start[t + 1]]`.
@@ -87,6 +90,7 @@ impl MeshSurface {
             normals: Vec::with_capacity(n),
             tolerance: Vec::with_capacity(n),
             obtuse: Vec::with_capacity(n),
+            spheres: Vec::with_capacity(n),
             edge_active: vec![[true; 3]; n],
             corner_active: vec![[true; 3]; n],
             coplanar_start: Vec::with_capacity(n + 1),
@@ -129,6 +133,7 @@ impl MeshSurface {
             // normal comes out exact.
             s.normals.push(normal / normal.length());
             s.tolerance.push(PRECISION / (2.0 * r_bound));
+            s.spheres.push((center, r_bound));
             s.obtuse.push(obtuse);
         }
         let by_vertex = triangles_by_vertex(mesh);
@@ -249,6 +254,14 @@ impl MeshSurface {
             + std::mem::size_of_val(self.bvh.triangle_ids())
     }
 
+    /// A distance from `p` that triangle `t` is not nearer than (from its bounding sphere;
+    /// at most the exact distance).
+    #[inline]
+    pub fn distance_at_least(&self, t: usize, p: Vec3) -> Real {
+        let (center, radius) = self.spheres[t];
+        (p - center).length() - radius
+    }
+
     /// Whether triangles `a` and `b` share a vertex and lie in one smooth patch.
     #[inline]
     pub fn coplanar(&self, a: u32, b: u32) -> bool {
@@ -262,6 +275,13 @@ impl MeshSurface {
         out.clear();
         self.bvh.for_each_near(p, reach, |t| out.push(t));
         out.sort_unstable();
+    }
+
+    /// As [`MeshSurface::nearest`], searched no farther than `distance`.
+    pub fn nearest_within(&self, p: Vec3, distance: Real) -> Option<(Real, Vec3)> {
+        self.bvh
+            .nearest_within(p, distance)
+            .map(|n| (n.distance(), n.point))
     }
 
     /// Exact distance from `p` to the surface, with the closest point (any triangle's).

@@ -18,6 +18,8 @@ const PAIRS_PER_PARTICLE: Real = 6.0;
 const CELL_BYTES_PER_PARTICLE: Real = 16.0 * 8.0;
 /// Per particle and body: its clearance (`bodies::Clearance`), not in the figures above.
 const CLEARANCE_BYTES: Real = std::mem::size_of::<crate::bodies::Clearance>() as Real;
+/// Per particle and body met on its triangles: its list of them (`bodies::NearTriangles`).
+const NEAR_TRIANGLES_BYTES: Real = std::mem::size_of::<crate::bodies::NearTriangles>() as Real;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct MemoryEstimate {
@@ -113,12 +115,17 @@ fn sdf_bytes(scene: &Scene) -> Real {
 /// The estimate for `scene`, or for `particles` when the run starts from a given state.
 pub fn estimate(scene: &Scene, particles: Option<usize>) -> MemoryEstimate {
     let particles = particles.map_or_else(|| particle_count(scene), |n| n as Real);
+    let meshes = scene
+        .bodies
+        .iter()
+        .filter(|b| b.contact == BodyContact::Mesh && b.particles.is_none());
     MemoryEstimate {
         particles,
         particle_bytes: particles
             * (PARTICLE_BYTES
                 + CELL_BYTES_PER_PARTICLE
-                + scene.bodies.len() as Real * CLEARANCE_BYTES),
+                + scene.bodies.len() as Real * CLEARANCE_BYTES
+                + meshes.count() as Real * NEAR_TRIANGLES_BYTES),
         pair_bytes: particles * PAIRS_PER_PARTICLE * PAIR_BYTES,
         sdf_bytes: sdf_bytes(scene),
     }
