@@ -24,15 +24,20 @@ import os
 import struct
 
 
+def cross(a, b, c):
+    """(b - a) x (c - a): the triangle's normal times twice its area."""
+    u = [b[i] - a[i] for i in range(3)]
+    v = [c[i] - a[i] for i in range(3)]
+    return [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+
+
 def write_stl(path, triangles, name):
     """Binary STL: an 80-byte header, the count, then per triangle a normal and 3 corners."""
     with open(path, "wb") as f:
         f.write(name.encode()[:80].ljust(80, b" "))
         f.write(struct.pack("<I", len(triangles)))
         for a, b, c in triangles:
-            u = [b[i] - a[i] for i in range(3)]
-            v = [c[i] - a[i] for i in range(3)]
-            n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+            n = cross(a, b, c)
             length = math.sqrt(sum(x * x for x in n)) or 1.0
             f.write(struct.pack("<3f", *(x / length for x in n)))
             for p in (a, b, c):
@@ -41,13 +46,7 @@ def write_stl(path, triangles, name):
 
 
 def area(triangles):
-    total = 0.0
-    for a, b, c in triangles:
-        u = [b[i] - a[i] for i in range(3)]
-        v = [c[i] - a[i] for i in range(3)]
-        n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
-        total += 0.5 * math.sqrt(sum(x * x for x in n))
-    return total
+    return sum(0.5 * math.sqrt(sum(x * x for x in cross(*t))) for t in triangles)
 
 
 def grid(rows, cols, point):
