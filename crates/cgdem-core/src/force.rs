@@ -9,7 +9,7 @@ use crate::math::{Real, Vec3};
 use crate::particles::Particles;
 use crate::walls::{WallContact, WallLaw, WallMask, WallParticle, WallSet};
 
-/// The particle arrays the owner pass reads.
+/// The particle arrays a force pass reads.
 #[derive(Clone, Copy)]
 pub(crate) struct ParticleState<'a> {
     pub(crate) position: &'a [Vec3],
@@ -76,9 +76,9 @@ impl<'a> ParticleState<'a> {
     }
 }
 
-/// What a pair needs of its owner `i`, read once for all of `i`'s pairs.
+/// What a pair needs of its first particle `i` (the lower id; owned or a ghost), read once.
 #[derive(Clone, Copy)]
-pub(crate) struct Owner {
+pub(crate) struct FirstParticle {
     pub(crate) position: Vec3,
     pub(crate) velocity: Vec3,
     pub(crate) omega: Vec3,
@@ -88,23 +88,38 @@ pub(crate) struct Owner {
     pub(crate) species_row: usize,
 }
 
-/// The force of the pair `(i, j)` seen from `i` (the `owner`), with `j` at `position_j` (its
+impl FirstParticle {
+    /// Particle `i` of `p` (no spin when `p` has none).
+    #[inline(always)]
+    pub(crate) fn at(p: &ParticleState, i: usize, n_species: usize) -> Self {
+        FirstParticle {
+            position: p.position[i],
+            velocity: p.velocity[i],
+            omega: p.omega.map_or(Vec3::ZERO, |w| w[i]),
+            radius: p.radius[i],
+            inv_mass: p.inv_mass[i],
+            species_row: p.species[i] as usize * n_species,
+        }
+    }
+}
+
+/// The force of the pair `(i, j)` seen from `i` (`first`), with `j` at `position_j` (its
 /// position, or a periodic image of it); zero (and history reset) when out of range. Also
 /// returns the overlap and the smaller radius, for the guard.
 #[inline(always)]
 pub(crate) fn pair_force<L: PairLaw>(
     law: &L,
     p: &ParticleState,
-    owner: &Owner,
+    first: &FirstParticle,
     j: usize,
     position_j: Vec3,
     history: &mut L::History,
     dt: Real,
 ) -> (PairResult, Real, Real) {
-    let d = owner.position - position_j;
+    let d = first.position - position_j;
     let distance_sq = d.length_squared();
-    let (radius_i, radius_j) = (owner.radius, p.radius[j]);
-    let species_pair = owner.species_row + p.species[j] as usize;
+    let (radius_i, radius_j) = (first.radius, p.radius[j]);
+    let species_pair = first.species_row + p.species[j] as usize;
     let cutoff = law.cutoff(species_pair, radius_i, radius_j);
     if distance_sq >= cutoff * cutoff {
         *history = L::History::default();
@@ -114,11 +129,11 @@ pub(crate) fn pair_force<L: PairLaw>(
     // One division, as LIGGGHTS's `rinv`.
     let normal = d * (1.0 / distance);
     let overlap = radius_i + radius_j - distance;
-    let mut relative_velocity = owner.velocity - p.velocity[j];
+    let mut relative_velocity = first.velocity - p.velocity[j];
     let mut spins = (Vec3::ZERO, Vec3::ZERO);
     if L::NEEDS_ROTATION {
         if let Some(omega) = p.omega {
-            spins = (owner.omega, omega[j]);
+            spins = (first.omega, omega[j]);
             // Contact point on the line of centres, inside each sphere by half the overlap.
             let arm_i = -normal * (radius_i - 0.5 * overlap);
             let arm_j = normal * (radius_j - 0.5 * overlap);
@@ -126,7 +141,7 @@ pub(crate) fn pair_force<L: PairLaw>(
         }
     }
     let normal_speed = relative_velocity.dot(normal);
-    let (inv_mass_i, inv_mass_j) = (owner.inv_mass, p.inv_mass[j]);
+    let (inv_mass_i, inv_mass_j) = (first.inv_mass, p.inv_mass[j]);
     let contact = Contact {
         species_pair,
         normal,

@@ -1,7 +1,8 @@
 //! Spatial domain decomposition (LAMMPS `Comm`, comm_brick.cpp): the box is cut into a grid
 //! of subdomains, each owning the particles inside it in its own arrays, plus a layer of
 //! ghost copies of its neighbours' particles, `width` = largest diameter + contact reach +
-//! skin thick. Four phases, one file each:
+//! skin thick. The cut, then the three phases that move data between subdomains (LAMMPS's
+//! fourth, `reverse_comm`, is not needed: see below), one file each:
 //!
 //! - [`grid`]: the subdomain grid and its cut planes (by particle count);
 //! - [`balance`] and [`rebalance`]: at a list rebuild, the cut planes move by count when
@@ -13,17 +14,21 @@
 //!   (periodic faces through shifted images);
 //! - [`forward`]: every step, the ghosts' positions, velocities and spins.
 //!
-//! Pairs that cross a boundary are evaluated by both owners (newton off, as LIGGGHTS's
-//! granular pair styles), so no forces travel back; each pair is evaluated with the particle
-//! of lower id first, so both sides compute the same numbers and keep the same history.
-//! Each phase packs what travels into buffers and unpacks them on the other side: threads in
-//! one process read them in place, MPI ranks send the same buffers ([`transport`]). The
-//! threads of a process form a [`team`] that gives each subdomain to the same thread, unless
-//! another is free first.
+//! The step itself is [`step`] (what the world asks for) and `force_pass` (the forces of one
+//! subdomain). Pairs that cross a boundary are evaluated by both owners (newton off, as
+//! LIGGGHTS's granular pair styles), so no forces travel back; each pair is evaluated with
+//! the particle of lower id first, so both sides compute the same numbers and keep the same
+//! history, except across a periodic face cut into subdomains: there each side sees the
+//! other particle through its image, whose position is rounded once more (`x + L`), so the
+//! two copies agree to that rounding only (see `step_tests`). Each phase packs what travels
+//! into buffers and unpacks them on the other side: threads in one process read them in
+//! place, MPI ranks send the same buffers ([`transport`]). The threads of a process form a
+//! [`team`] that gives each subdomain to the same thread, unless another is free first.
 
 pub mod balance;
 pub mod borders;
 pub mod exchange;
+mod force_pass;
 pub mod forward;
 pub mod grid;
 pub mod placement;
@@ -31,6 +36,8 @@ pub mod rebalance;
 pub mod removal;
 pub mod state;
 pub mod step;
+#[cfg(test)]
+mod step_tests;
 pub mod team;
 pub mod transport;
 
@@ -110,9 +117,9 @@ pub struct Subdomain<H, WH> {
     /// first force pass after a build (not stored in restart files: any pass makes them
     /// right, they only spare looking at walls out of reach).
     pub near_walls: Vec<crate::walls::WallMask>,
-    /// Scratch of the force pass: the listed (direct) pairs within reach this step, by
-    /// index, sized as the list.
-    pub within_reach: Vec<u32>,
+    /// Scratch of the force pass: the listed (direct) pairs by index, those within reach
+    /// this step first, sized as the list (laws with history only).
+    pub pairs_by_reach: Vec<u32>,
 }
 
 impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
@@ -132,7 +139,7 @@ impl<H: PairHistory, WH: PairHistory> Subdomain<H, WH> {
             body_clearances: Vec::new(),
             near_triangles: Vec::new(),
             near_walls: Vec::new(),
-            within_reach: Vec::new(),
+            pairs_by_reach: Vec::new(),
         }
     }
 

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::balance::Balance;
 use super::borders::SendList;
-use super::forward::States;
+use super::forward::Forward;
 use super::step::Decomposition;
 use super::{Comm, Grid, HistoryRows, Subdomain};
 use crate::contact::PairHistory;
@@ -125,9 +125,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 }
                 subdomain_arrays!(sub, record, as_ref);
                 capacities.extend(sub.sends.iter().map(|l| l.indices.capacity()));
-                let buffers = self.buffers.get(s).map_or(Vec::new(), |b| {
-                    b.iter().map(|States(v)| v.capacity()).collect()
-                });
+                let buffers = self.forward.capacities(s);
                 let state = SubdomainOut {
                     particles: &sub.particles,
                     n_owned: sub.n_owned,
@@ -174,7 +172,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
         let mut subdomains: Vec<Subdomain<H, WH>> = (0..count)
             .map(|s| Subdomain::new(s, &grid, rotation))
             .collect();
-        let mut buffers: Vec<Vec<States>> = vec![Vec::new(); count];
+        let mut buffers: Vec<Vec<usize>> = vec![Vec::new(); count];
         let mut total = 0;
         for (s, bytes) in state.subdomains.iter().enumerate() {
             let stored: SubdomainState<H, WH> = bincode::deserialize(bytes)
@@ -205,11 +203,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             for list in &mut sub.sends {
                 reserve!(list.indices);
             }
-            buffers[s] = stored
-                .buffers
-                .iter()
-                .map(|&c| States(Vec::with_capacity(c)))
-                .collect();
+            buffers[s] = stored.buffers;
         }
         let mut balance = state.balance;
         balance.threshold = threshold;
@@ -225,8 +219,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             total,
             bytes_sent,
             balance,
-            buffers,
-            forward_counts: None,
+            forward: Forward::with_capacities(buffers),
         })
     }
 

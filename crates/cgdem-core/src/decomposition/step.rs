@@ -1,31 +1,34 @@
 //! The step of the subdomains: each stepped on the thread (or rank) that owns it, with the
-//! four phases of communication between them. The world asks for the three parts of a step
-//! in turn: `Decomposition::advance` (the first half of the integrator), a
-//! `Decomposition::rebuild` when a particle moved past half the skin, and
-//! `Decomposition::forces` (then the second half). The owned particles of all subdomains
-//! side by side are what the outputs read (`Decomposition::gathered`).
+//! three phases of communication between them (`exchange` and `borders` at a rebuild, the
+//! `forward` every step). The world asks for the three parts of a step in turn:
+//! `Decomposition::advance` (the first half of the integrator, the ghosts' new states
+//! packed), a `Decomposition::rebuild` when a particle moved past half the skin, and
+//! `Decomposition::forces` (the ghosts' states unpacked, the force pass of `force_pass`,
+//! then the second half). The owned particles of all subdomains side
+//! by side are what the outputs read (`Decomposition::gathered`).
 
 use super::balance::{imbalance, Balance};
 use super::borders::borders;
 use super::exchange::exchange;
-use super::forward::{pack, unpack, States};
+use super::force_pass;
+use super::forward::Forward;
 use super::removal::{RemovalRule, Removals};
 use super::transport::{read_histories, write_histories};
 use super::transport::{Comm, Wire};
 use super::{Grid, HistoryRows, Subdomain};
-use crate::bodies::{Body, BodyLoad, Clearance, KinematicParticles, NearTriangles};
+use crate::bodies::{Body, BodyLoad, KinematicParticles};
 use crate::contact::PairHistory;
 use crate::contact::PairLaw;
 use crate::domain::Domain;
-use crate::force::{larger, pair_force, AloneSlots, ForceView, Owner, ParticleState, Surroundings};
+use crate::force::{larger, Surroundings};
 use crate::geometry::aabb::in_delete_region;
 use crate::geometry::Aabb;
-use crate::integrate::{closing_kick, drift_kick, kick, pcvv, Integrator};
+use crate::integrate::{closing_kick, kick, kick_then_drift, pcvv, Integrator};
 use crate::math::{Real, Vec3};
 use crate::memory_use::MemoryUse;
 use crate::neighbor::{CellGrid, PairList};
 use crate::particles::Particles;
-use crate::walls::{WallLaw, WallParticle};
+use crate::walls::WallLaw;
 
 /// The laws and what acts on a particle alone, for one force pass.
 pub(crate) struct Physics<'a, L, W> {
@@ -128,9 +131,8 @@ pub struct Decomposition<H, WH> {
     pub bytes_sent: u64,
     /// Whether and how the cut planes follow the particles, and what it saw.
     pub balance: Balance,
-    pub(super) buffers: Vec<Vec<States>>,
-    /// Words each rank sends here in a forward, fixed between rebuilds.
-    pub(super) forward_counts: Option<Vec<usize>>,
+    /// The ghosts' update of every step between rebuilds.
+    pub(super) forward: Forward,
 }
 
 impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
@@ -180,8 +182,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             comm,
             total: particles.len(),
             bytes_sent: 0,
-            buffers: Vec::new(),
-            forward_counts: None,
+            forward: Forward::default(),
         };
         d.borders_and_lists(false);
         d
@@ -195,7 +196,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 .each_owned(&mut self.subdomains, |sub| resort_by_cell(sub, width));
         }
         self.bytes_sent += borders(&mut self.subdomains, &self.grid, width, &self.comm);
-        self.forward_counts = None;
+        self.forward.ghosts_rebuilt();
         let (extra, list_box) = (self.extra, self.grid.list_box());
         self.comm.each_owned(&mut self.subdomains, |sub| {
             let p = &sub.particles;
@@ -395,19 +396,18 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     /// The first half of a step of `integrator` for the owned particles (velocity
     /// Verlet's half kick and drift, or PCVV's predictor), then the particles of bodies
     /// built of particles moved to their bodies' pose, and the new states packed for the
-    /// ghosts, in one pass per subdomain. Whether a rebuild is due, on any rank: a particle
-    /// moved past half the skin, or entered one of the delete regions (the rebuild removes
-    /// it); then the packed states are not used.
+    /// ghosts ([`Forward`]), in one pass per subdomain. Whether a rebuild is due, on any
+    /// rank: a particle moved past half the skin, or entered one of the delete regions (the
+    /// rebuild removes it, and drops the packed states).
     pub(crate) fn advance(&mut self, dt: Real, integrator: Integrator, drive: &Drive<'_>) -> bool {
         let limit_sq = 0.25 * self.skin * self.skin;
         let regions = drive.delete_regions;
-        self.buffers.resize_with(self.subdomains.len(), Vec::new);
-        let mut with_buffers: Vec<_> = self.subdomains.iter_mut().zip(&mut self.buffers).collect();
+        let mut packing = self.forward.start_packing(&mut self.subdomains);
         let due = self
             .comm
-            .each_owned(&mut with_buffers, |(sub, out)| {
+            .each_owned(&mut packing, |(sub, out)| {
                 let moved = first_half(sub, dt, integrator, drive, limit_sq);
-                pack(sub, out);
+                Forward::pack(sub, out);
                 let p = &sub.particles.position[..sub.n_owned];
                 moved || (!regions.is_empty() && p.iter().any(|&x| in_delete_region(regions, x)))
             })
@@ -418,43 +418,34 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
     }
 
     /// Forces on the owned particles, then the second half of a step of `closing` if
-    /// given (velocity Verlet's closing half kick, or PCVV's corrector). With `forwarded`
-    /// the ghosts first take the states `advance` packed (`forward`: no rebuild this
-    /// step). The world's arrays are not touched: `gathered` brings the owned particles
-    /// when they are read. Returns the deepest overlaps, finiteness and body loads over all
-    /// subdomains of all ranks.
+    /// given (velocity Verlet's closing half kick, or PCVV's corrector). The ghosts first
+    /// take the states `advance` packed, unless a rebuild since gave them fresh copies
+    /// ([`Forward`]). The world's arrays are not touched: `gathered` brings the owned
+    /// particles when they are read. Returns the deepest overlaps, finiteness and body
+    /// loads over all subdomains of all ranks.
     pub(crate) fn forces<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         closing: Option<Integrator>,
-        forwarded: bool,
     ) -> ForceSums {
-        if forwarded {
-            let subs = &self.subdomains;
-            self.bytes_sent += self.comm.route(
-                &mut self.buffers,
-                |from, list, _| subs[from].sends[list].to,
-                &mut self.forward_counts,
-            );
-        }
-        self.pass(physics, closing, forwarded)
+        self.bytes_sent += self.forward.route(&self.subdomains, &self.comm);
+        let sums = self.pass(physics, closing);
+        self.forward.unpacked();
+        sums
     }
 
-    /// One pass per owned subdomain: unpack the ghosts' states (if `unpack_ghosts`),
-    /// forces, the second half of the step (if `closing`); the guard's values and the body
-    /// loads over all ranks, summed in subdomain order.
+    /// One pass per owned subdomain: the ghosts' states unpacked (if packed), forces, the
+    /// second half of the step (if `closing`); the guard's values and the body loads over
+    /// all ranks, summed in subdomain order.
     fn pass<L: PairLaw<History = H>, W: WallLaw<History = WH>>(
         &mut self,
         physics: &Physics<'_, L, W>,
         closing: Option<Integrator>,
-        unpack_ghosts: bool,
     ) -> ForceSums {
         let count = self.subdomains.len();
-        let (comm, buffers, skin) = (&self.comm, &self.buffers, self.skin);
+        let (comm, forward, skin) = (&self.comm, &self.forward, self.skin);
         let mine: Vec<Option<ForceSums>> = comm.each_owned(&mut self.subdomains, |sub| {
-            if unpack_ghosts {
-                unpack(sub, buffers);
-            }
+            forward.unpack(sub);
             forces_and_closing(sub, physics, closing, skin)
         });
         let in_order = |all: Vec<ForceSums>| {
@@ -602,19 +593,14 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
                 // The force pass's scratch for laws with history, as it will be sized
                 // (counted from the list, so a resumed run reports what the
                 // uninterrupted one does).
-                + if compacts_touching_pairs::<H>() {
+                + if force_pass::compacts_touching_pairs::<H>() {
                     l.pairs.len() * std::mem::size_of::<u32>()
                 } else {
                     0
                 };
             m.history_entries += l.len();
         }
-        m.particle_bytes += self
-            .buffers
-            .iter()
-            .flatten()
-            .map(|States(b)| bytes(b))
-            .sum::<usize>();
+        m.particle_bytes += self.forward.bytes();
         m
     }
 
@@ -670,7 +656,7 @@ fn first_half<H: PairHistory, WH: PairHistory>(
     let reference = &sub.list.reference;
     let (position, velocity) = (&mut p.position[..n], &mut p.velocity[..n]);
     let mut moved = match integrator {
-        Integrator::VelocityVerlet => drift_kick(
+        Integrator::VelocityVerlet => kick_then_drift(
             position,
             velocity,
             &p.force,
@@ -724,7 +710,7 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
         let torque = p.angular.as_ref().map(|a| a.torque[..n].to_vec());
         (p.force[..n].to_vec(), torque)
     });
-    let mut sums = forces(sub, physics, skin);
+    let mut sums = force_pass::forces(sub, physics, skin);
     let (p, gravity) = (&sub.particles, physics.surroundings.gravity);
     sums.kinematic_loads = physics
         .kinematic
@@ -734,19 +720,34 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
             group.load(p, n, gravity, center)
         })
         .collect();
-    let dt = physics.surroundings.dt;
-    let p = &mut sub.particles;
-    let spins = p.angular.as_mut().filter(|_| physics.rotates);
     sums.finite = match closing {
         None => true,
-        Some(Integrator::VelocityVerlet) => {
+        Some(integrator) => second_half(sub, physics, integrator, old),
+    };
+    sums
+}
+
+/// The second half of a step of `integrator` for `sub`'s owned particles, from the forces
+/// just evaluated (`old`: PCVV's forces and torques of the step before); whether every
+/// velocity and spin stayed finite.
+fn second_half<L: PairLaw, W: WallLaw>(
+    sub: &mut Subdomain<L::History, W::History>,
+    physics: &Physics<'_, L, W>,
+    integrator: Integrator,
+    old: Option<OldLoads>,
+) -> bool {
+    let (n, dt) = (sub.n_owned, physics.surroundings.dt);
+    let p = &mut sub.particles;
+    let spins = p.angular.as_mut().filter(|_| physics.rotates);
+    match integrator {
+        Integrator::VelocityVerlet => {
             let mut finite = closing_kick(&mut p.velocity[..n], &p.force, &p.inv_mass, dt);
             if let Some(a) = spins {
                 finite &= closing_kick(&mut a.omega[..n], &a.torque, &a.inv_inertia, dt);
             }
             finite
         }
-        Some(Integrator::Pcvv) => {
+        Integrator::Pcvv => {
             let (force, torque) = old.expect("kept for PCVV");
             let mut finite = pcvv::correct(
                 &mut p.velocity[..n],
@@ -761,213 +762,8 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
             }
             finite
         }
-    };
-    sums
-}
-
-/// Forces (and torques) on `sub`'s owned particles: every listed pair evaluated with the
-/// lower id first and added to whichever of its particles are owned here (both for an owned
-/// pair: a half list without stored reactions), then what acts on each particle alone
-/// (gravity, the planar walls and the bodies, with their histories). Returns the deepest
-/// pair and wall (or body) overlaps and the bodies' loads summed over the owned particles in
-/// order.
-fn forces<L: PairLaw, W: WallLaw>(
-    sub: &mut Subdomain<L::History, W::History>,
-    physics: &Physics<'_, L, W>,
-    skin: Real,
-) -> ForceSums {
-    let n = sub.n_owned;
-    let ForceView {
-        state,
-        force,
-        torque,
-        ..
-    } = ParticleState::split(&mut sub.particles);
-    let rotates = physics.rotates;
-    let dt = physics.surroundings.dt;
-    force[..n].fill(Vec3::ZERO);
-    if rotates {
-        torque[..n].fill(Vec3::ZERO);
-    }
-    let mut deepest_pair: Real = 0.0;
-    // One pair, `b` seen at `position_b`: its force added to whichever of the two are owned
-    // (a macro, written once for the direct pairs and those through an image, so that each
-    // loop keeps its sums in registers).
-    macro_rules! pair {
-        ($a:expr, $b:expr, $position_b:expr, $history:expr) => {{
-            let (a, b): (usize, usize) = ($a, $b);
-            let owner = Owner {
-                position: state.position[a],
-                velocity: state.velocity[a],
-                omega: state.omega.map_or(Vec3::ZERO, |w| w[a]),
-                radius: state.radius[a],
-                inv_mass: state.inv_mass[a],
-                species_row: state.species[a] as usize * physics.n_species,
-            };
-            let (result, overlap, smaller_radius) =
-                pair_force(physics.law, &state, &owner, b, $position_b, $history, dt);
-            if overlap > deepest_pair * smaller_radius {
-                deepest_pair = overlap / smaller_radius;
-            }
-            if a < n {
-                force[a] += result.force_on_i;
-                if rotates {
-                    torque[a] += result.torque_on_i;
-                }
-            }
-            if b < n {
-                force[b] -= result.force_on_i;
-                if rotates {
-                    torque[b] += result.torque_on_j;
-                }
-            }
-        }};
-    }
-    let list = &mut sub.list;
-    if !compacts_touching_pairs::<L::History>() {
-        // A law without contact history (the seed model) is cheap per pair: a filter first
-        // would cost more than it spares (the main job 11% slower, reports/PERFORMANCE.md).
-        for (&[a, b], history) in list.pairs.iter().zip(&mut list.history) {
-            let b = b as usize;
-            pair!(a as usize, b, state.position[b], history);
-        }
-    } else {
-        let count = within_reach(list, &mut sub.within_reach, &state, physics);
-        for &k in &sub.within_reach[..count] {
-            let k = k as usize;
-            let [a, b] = list.pairs[k];
-            let b = b as usize;
-            pair!(a as usize, b, state.position[b], &mut list.history[k]);
-        }
-    }
-    for (image, history) in list.image_pairs.iter().zip(&mut list.image_history) {
-        let b = image.pair[1] as usize;
-        pair!(
-            image.pair[0] as usize,
-            b,
-            state.position[b] + image.shift,
-            history
-        );
-    }
-    let mut deepest_wall: Real = 0.0;
-    let n_bodies = physics.surroundings.bodies.len();
-    let mut body_loads = vec![BodyLoad::default(); n_bodies];
-    // Sized exactly (the reported memory must not depend on the run's history).
-    if sub.body_clearances.len() != n * n_bodies {
-        sub.body_clearances = vec![Clearance::NONE; n * n_bodies];
-    }
-    let n_meshes = physics
-        .surroundings
-        .bodies
-        .iter()
-        .filter(|b| b.is_mesh())
-        .count();
-    if sub.near_triangles.len() != n * n_meshes {
-        sub.near_triangles = vec![NearTriangles::NONE; n * n_meshes];
-    }
-    let slots = if rotates { physics.wall_slots } else { 0 };
-    let particle = |i: usize| WallParticle {
-        species: state.species[i] as usize,
-        position: state.position[i],
-        velocity: state.velocity[i],
-        radius: state.radius[i],
-        mass: state.mass[i],
-    };
-    if sub.near_walls.len() != n {
-        // After a list build: the walls each particle may reach before the next one; the
-        // histories of the others are at rest (a pass over all walls would reset them now).
-        let walls = physics.surroundings.walls;
-        sub.near_walls = (0..n)
-            .map(|i| walls.near(physics.surroundings.wall_law, &particle(i), skin))
-            .collect();
-        if rotates {
-            for (i, near) in sub.near_walls.iter().enumerate() {
-                let history = &mut sub.wall_history[i * slots..][..walls.walls.len()];
-                for (k, h) in history.iter_mut().enumerate() {
-                    if !near.has(k) {
-                        *h = Default::default();
-                    }
-                }
-            }
-        }
-    }
-    for i in 0..n {
-        let particle = particle(i);
-        let alone = AloneSlots {
-            near: sub.near_walls[i],
-            history: &mut sub.wall_history[i * slots..(i + 1) * slots],
-            clearances: &mut sub.body_clearances[i * n_bodies..(i + 1) * n_bodies],
-            near_triangles: &mut sub.near_triangles[i * n_meshes..(i + 1) * n_meshes],
-        };
-        let omega = state.omega.map_or(Vec3::ZERO, |w| w[i]);
-        let mut unused = Vec3::ZERO;
-        let spin = if rotates { &mut torque[i] } else { &mut unused };
-        let overlap = physics.surroundings.act_on(
-            &particle,
-            omega,
-            rotates,
-            alone,
-            &mut body_loads,
-            &mut force[i],
-            spin,
-        );
-        deepest_wall = larger(deepest_wall, overlap);
-    }
-    ForceSums {
-        deepest_pair,
-        deepest_wall,
-        finite: true,
-        body_loads,
-        kinematic_loads: Vec::new(),
     }
 }
 
-/// Whether the force pass compacts the touching pairs: for laws with contact history only
-/// (the seed model's law is cheaper than the filter; reports/PERFORMANCE.md).
-fn compacts_touching_pairs<H>() -> bool {
-    std::mem::size_of::<H>() > 0
-}
-
-/// Touching pairs compacted, for laws with contact history: a cheap distance filter over the
-/// listed pairs writes those within reach to the front of `within` and the others to its
-/// back, with no branch, and the others lose their history, as the law would reset it. The
-/// law then runs over the pairs within reach only, in list order (every particle's sum is
-/// the same), with no branch that half of them take: a settled bed lists about two pairs
-/// for each one that touches. Returns how many are within reach.
-fn within_reach<L: PairLaw, W: WallLaw>(
-    list: &mut PairList<L::History>,
-    within: &mut Vec<u32>,
-    state: &ParticleState<'_>,
-    physics: &Physics<'_, L, W>,
-) -> usize {
-    let listed = list.pairs.len();
-    if within.len() != listed {
-        // Sized exactly, not grown (the reported memory must not depend on the run's
-        // history: a resumed run reports what the uninterrupted one does).
-        *within = vec![0; listed];
-    }
-    let (mut count, mut back) = (0, listed);
-    for (k, &[a, b]) in list.pairs.iter().enumerate() {
-        let (a, b) = (a as usize, b as usize);
-        let species_pair =
-            state.species[a] as usize * physics.n_species + state.species[b] as usize;
-        let cutoff = physics
-            .law
-            .cutoff(species_pair, state.radius[a], state.radius[b]);
-        // The same test as `pair_force`'s (a NaN distance is within reach, so the guard
-        // sees it).
-        let out_of_reach =
-            (state.position[a] - state.position[b]).length_squared() >= cutoff * cutoff;
-        let at = if out_of_reach { back - 1 } else { count };
-        within[at] = k as u32;
-        count += usize::from(!out_of_reach);
-        back -= usize::from(out_of_reach);
-    }
-    for &k in &within[count..] {
-        let history = &mut list.history[k as usize];
-        if *history != Default::default() {
-            *history = Default::default();
-        }
-    }
-    count
-}
+/// PCVV's forces and torques (none without spin) of the step before, per owned particle.
+type OldLoads = (Vec<Vec3>, Option<Vec<Vec3>>);

@@ -3,7 +3,7 @@
 pub mod pcvv;
 mod velocity_verlet;
 
-pub use velocity_verlet::{closing_kick, drift_kick, kick};
+pub use velocity_verlet::{closing_kick, kick, kick_then_drift};
 
 /// The scheme a world steps with, chosen once per scene (`[time] integrator`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

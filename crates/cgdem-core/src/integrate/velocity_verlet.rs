@@ -1,5 +1,5 @@
 //! Velocity Verlet, split around the force evaluation: `v += dt/2 F/m; x += dt v`
-//! ([`drift_kick`]), forces at the new positions and half-step velocities, then
+//! ([`kick_then_drift`]), forces at the new positions and half-step velocities, then
 //! `v += dt/2 F/m` ([`closing_kick`]); spins the same with torque and inverse inertia
 //! ([`kick`]). Kernels over slices (a subdomain's owned particles): every particle is
 //! updated on its own, so the result does not depend on who steps which slice.
@@ -9,7 +9,7 @@ use crate::math::{Real, Vec3};
 /// Half kick then drift of each particle; whether one moved farther than
 /// `sqrt(limit_sq)` from its `reference` position (the pair list's rebuild test, at no
 /// extra pass).
-pub fn drift_kick(
+pub fn kick_then_drift(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
     force: &[Vec3],
@@ -56,7 +56,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn drift_kick_moves_and_reports_the_displacement_test() {
+    fn kick_then_drift_moves_and_reports_the_displacement_test() {
         let n = 7;
         let mut x: Vec<Vec3> = (0..n).map(|k| Vec3::new(k as Real, 0.0, 0.0)).collect();
         let reference = x.clone();
@@ -65,7 +65,7 @@ mod tests {
         let inv_m = vec![0.5; n];
         v[n - 1] = Vec3::new(10.0, 0.0, 0.0);
         // dt = 0.1: the last particle moves 1 (beyond 0.5), the others 0.01.
-        assert!(drift_kick(
+        assert!(kick_then_drift(
             &mut x, &mut v, &f, &inv_m, &reference, 0.25, 0.1
         ));
         assert!((v[0].z - -0.1).abs() < 1e-15);
@@ -73,7 +73,7 @@ mod tests {
         assert!((x[n - 1].x - (n as Real - 1.0 + 1.0)).abs() < 1e-9);
         let mut slow = reference.clone();
         let mut w = vec![Vec3::ZERO; n];
-        assert!(!drift_kick(
+        assert!(!kick_then_drift(
             &mut slow, &mut w, &f, &inv_m, &reference, 0.25, 0.1
         ));
     }

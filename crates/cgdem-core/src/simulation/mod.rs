@@ -222,7 +222,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             subdomains,
             grid_reason,
         };
-        world.evaluate_forces(None, false);
+        world.evaluate_forces(None);
         world.sync_particles();
         world.guard.initial_overlap = Some(world.max_overlap_fraction());
         world.reset_energy_reference();
@@ -353,7 +353,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         d.builds += old.builds;
         d.bytes_sent += old.bytes_sent;
         self.subdomains = d;
-        self.evaluate_forces(None, false);
+        self.evaluate_forces(None);
         self.sync_particles();
         self.reset_energy_reference();
     }
@@ -406,7 +406,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         if rebuild {
             self.rebuild();
         }
-        self.evaluate_forces(Some(self.integrator), !rebuild);
+        self.evaluate_forces(Some(self.integrator));
         self.time += dt;
         self.steps += 1;
         self.check_guards();
@@ -443,10 +443,9 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
         self.guard.removed_non_finite.extend(removals.non_finite);
     }
 
-    /// Forces from the current ghosts (`forwarded`: after they take the states the first
-    /// half packed), then the second half of a step of `closing`, if given; the guard's
-    /// overlaps and finiteness, the bodies' loads.
-    fn evaluate_forces(&mut self, closing: Option<Integrator>, forwarded: bool) {
+    /// Forces (the ghosts brought up to date first), then the second half of a step of
+    /// `closing`, if given; the guard's overlaps and finiteness, the bodies' loads.
+    fn evaluate_forces(&mut self, closing: Option<Integrator>) {
         let physics = Physics {
             law: &self.law,
             surroundings: Surroundings {
@@ -461,7 +460,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             wall_slots: wall_slots(&self.walls, &self.bodies),
             rotates: Self::ROTATES,
         };
-        let sums = self.subdomains.forces(&physics, closing, forwarded);
+        let sums = self.subdomains.forces(&physics, closing);
         self.take(sums, closing.is_some());
     }
 

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::World;
 use crate::contact::PairLaw;
-use crate::force::{pair_force, Owner, ParticleState};
+use crate::force::{pair_force, FirstParticle, ParticleState};
 use crate::math::{Real, Vec3};
 use crate::neighbor::pairs_within;
 use crate::walls::WallLaw;
@@ -60,20 +60,13 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
             .with_min_len(4096)
             .filter_map(|&pair| {
                 let (i, j) = (pair.i as usize, pair.j as usize);
-                let owner = Owner {
-                    position: p.position[i],
-                    velocity: p.velocity[i],
-                    omega: p.angular.as_ref().map_or(Vec3::ZERO, |a| a.omega[i]),
-                    radius: p.radius[i],
-                    inv_mass: p.inv_mass[i],
-                    species_row: p.species[i] as usize * self.n_species,
-                };
+                let first = FirstParticle::at(&state, i, self.n_species);
                 let shift = self.domain.image_shift(pair.image);
                 let mut history = L::History::default();
                 let (result, overlap, _) = pair_force(
                     &self.law,
                     &state,
-                    &owner,
+                    &first,
                     j,
                     p.position[j] + shift,
                     &mut history,
@@ -82,7 +75,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                 let d = p.position[i] - (p.position[j] + shift);
                 let within = d.length()
                     < self.law.cutoff(
-                        owner.species_row + p.species[j] as usize,
+                        first.species_row + p.species[j] as usize,
                         p.radius[i],
                         p.radius[j],
                     );
