@@ -2,13 +2,13 @@
 
 use crate::math::{Real, Vec3};
 
-/// Per-pair contact history (e.g. a tangential spring). Stored once per pair, kept across
-/// list rebuilds, mirrored when a re-sort swaps which particle of the pair comes first.
+/// Contact history of a particle pair or of a particle and a wall (e.g. a tangential
+/// spring). A pair's is stored once per listed pair and kept across list rebuilds, always
+/// seen from the particle of lower id: a re-sort, which changes the particles' indices but
+/// not their ids, leaves it as it is (it is never mirrored).
 pub trait PairHistory:
     Copy + Default + Send + Sync + PartialEq + serde::Serialize + serde::de::DeserializeOwned
 {
-    /// The same history seen from the other particle.
-    fn mirrored(self) -> Self;
     /// `f64` words of one history, for the MPI transport of the decomposed step.
     const WORDS: usize;
     fn write_words(&self, out: &mut Vec<Real>);
@@ -24,7 +24,6 @@ pub trait PairHistory:
 
 /// The seed's model keeps no history: a zero-sized type, so its store costs nothing.
 impl PairHistory for () {
-    fn mirrored(self) -> Self {}
     const WORDS: usize = 0;
     fn write_words(&self, _: &mut Vec<Real>) {}
     fn read_words(_: &[Real]) -> Self {}
@@ -36,9 +35,6 @@ impl PairHistory for () {
 
 /// A displacement of `i` relative to `j` (e.g. a tangential spring): `j` sees it negated.
 impl PairHistory for Vec3 {
-    fn mirrored(self) -> Self {
-        -self
-    }
     const WORDS: usize = 3;
     fn write_words(&self, out: &mut Vec<Real>) {
         out.extend_from_slice(&self.to_array());
@@ -56,9 +52,6 @@ impl PairHistory for Vec3 {
 
 /// Two histories side by side (e.g. tangential and rolling).
 impl<A: PairHistory, B: PairHistory> PairHistory for (A, B) {
-    fn mirrored(self) -> Self {
-        (self.0.mirrored(), self.1.mirrored())
-    }
     const WORDS: usize = A::WORDS + B::WORDS;
     fn write_words(&self, out: &mut Vec<Real>) {
         self.0.write_words(out);
@@ -85,9 +78,6 @@ impl<A: PairHistory, B: PairHistory> PairHistory for (A, B) {
 
 /// A magnitude (e.g. accumulated slip length): the same from either side.
 impl PairHistory for Real {
-    fn mirrored(self) -> Self {
-        self
-    }
     const WORDS: usize = 1;
     fn write_words(&self, out: &mut Vec<Real>) {
         out.push(*self);
