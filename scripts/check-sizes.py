@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""The size limits of issue 39, so that the house stays walkable: every file of the core
-(crates/cgdem-core/src) under 1,000 lines; in the harness (crates/cgdem-harness/src) no file
-over 800 lines and no function over 120; in the command (src/) no function over 80.
+"""The size limits of issues 39 and 55, so that the house stays walkable: every file of the
+core (crates/cgdem-core/src) under 1,000 lines and no function over 150; in the harness
+(crates/cgdem-harness/src) no file over 800 lines and no function over 120; in the command
+(src/) no function over 80.
 
 A function's length counts from its `fn` line to its closing brace. Braces inside string
 and character literals and comments do not count. Tests count like any other code.
@@ -13,7 +14,7 @@ from pathlib import Path
 
 # (folder, longest file in lines or None, longest function in lines or None)
 LIMITS = [
-    ("crates/cgdem-core/src", 999, None),
+    ("crates/cgdem-core/src", 999, 150),
     ("crates/cgdem-harness/src", 800, 120),
     ("src", None, 80),
 ]
@@ -107,7 +108,7 @@ def main():
     for p in problems:
         print(p)
     if problems:
-        print(f"check-sizes: {len(problems)} limit(s) passed (issue 39: a file or function this long is split)")
+        print(f"check-sizes: {len(problems)} limit(s) passed (issues 39 and 55: a file or function this long is split)")
         return 1
     print("check-sizes: every file and function within the limits")
     return 0

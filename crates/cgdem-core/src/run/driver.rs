@@ -66,96 +66,114 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
     let grid = options
         .grid
         .or(stored.as_ref().map(|s| GridSpec::Given(s.grid())));
-    let (mut world, mut n_inserted, mut n_body_particles) =
+    let (mut world, n_inserted, n_body_particles) =
         build_world(scene, law, wall_law, dt, &scales, options, grid)?;
-    // A scene large enough for more subdomains than the default grid gives, on more
-    // threads than it has: say how to use them.
-    let subdomains: usize = world.grid().iter().product();
-    let workers = rayon::current_num_threads() * options.comm.size();
-    if grid.is_none() && subdomains == MAX_SUBDOMAINS && workers > subdomains {
-        warnings.push(format!(
-            "the grid chosen from the scene has {subdomains} subdomains (the most it chooses), fewer than the {workers} threads, which take whole subdomains: give --grid {workers} (or more) to keep them all busy"
-        ));
+    if grid.is_none() {
+        warn_of_idle_workers(&world, options, &mut warnings);
     }
     // Under MPI only rank 0 writes into the run's directory: the others' outputs (in a
     // scratch directory) start afresh.
     let root = options.comm.is_root();
     let mut observers = observers(scene, out, resume.is_some() && root)?;
-    let checkpoint = match (&options.checkpoint, resume) {
+    let checkpoint = checkpoint_options(options, resume);
+    if checkpoint.is_some() && resume.is_none() {
+        restart::remove(out).map_err(|e| output_error(&out.join(restart::RESTART_FILE), e))?;
+    }
+    let checkpointer = checkpoint.map(|c| Checkpointer {
+        next: c.every,
+        options: c,
+        digest: scene.digest(),
+        laws,
+        out: out.clone(),
+        n_inserted,
+        n_body_particles,
+    });
+    let mut driver = Driver::new(scene, dt, options, checkpointer)?;
+    let counts = Counts {
+        inserted: n_inserted,
+        body_particles: n_body_particles,
+    };
+    let stored = resume.zip(stored);
+    let (resume_at, counts) = driver.start(
+        &mut world,
+        &mut observers,
+        &mut warnings,
+        stored,
+        options,
+        counts,
+    )?;
+    driver.started = Instant::now();
+    let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings, resume_at)?;
+    driver.progress.finish();
+    // Under MPI rank 0 gathers the final state and writes it.
+    world.sync_particles_for_output();
+    let ran = Ran {
+        counts,
+        steps: (dt, &scales),
+        stopped_by,
+    };
+    conclude(
+        scene,
+        &world,
+        &mut driver,
+        &mut observers,
+        warnings,
+        ran,
+        options,
+    )
+}
+
+/// A scene large enough for more subdomains than the default grid gives, on more threads
+/// than it has: say how to use them.
+fn warn_of_idle_workers<L: PairLaw, W: WallLaw>(
+    world: &World<L, W>,
+    options: &RunOptions,
+    warnings: &mut Warnings,
+) {
+    let subdomains: usize = world.grid().iter().product();
+    let workers = rayon::current_num_threads() * options.comm.size();
+    if subdomains == MAX_SUBDOMAINS && workers > subdomains {
+        warnings.push(format!(
+            "the grid chosen from the scene has {subdomains} subdomains (the most it chooses), fewer than the {workers} threads, which take whole subdomains: give --grid {workers} (or more) to keep them all busy"
+        ));
+    }
+}
+
+/// The restart files' settings: as given, or as the resumed run had them.
+fn checkpoint_options(
+    options: &RunOptions,
+    resume: Option<&restart::RestartLoaded>,
+) -> Option<CheckpointOptions> {
+    match (&options.checkpoint, resume) {
         (Some(c), _) => Some(c.clone()),
         (None, Some(r)) => Some(CheckpointOptions {
             every: r.restart.checkpoint_every,
             invocation: r.restart.invocation.clone(),
         }),
         (None, None) => None,
-    };
-    if checkpoint.is_some() && resume.is_none() {
-        restart::remove(out).map_err(|e| output_error(&out.join(restart::RESTART_FILE), e))?;
     }
-    let mut driver = Driver {
-        scene,
-        dt,
-        progress: match &options.progress {
-            Some(Progress(reporter)) => reporter.start(total_steps(scene, dt)),
-            None => Box::new(progress::Silent),
-        },
-        keep_going: options.keep_going,
-        refill_regions: scene
-            .insertions
-            .iter()
-            .enumerate()
-            .filter(|(_, ins)| ins.refill.is_some())
-            .map(|(k, ins)| RefillRegion::new(scene, k, ins).map(|r| (k, r)))
-            .collect::<Result<_, _>>()?,
-        refilled: 0,
-        particle_steps: 0,
-        stages: Vec::new(),
-        guard_counts: Vec::new(),
-        stop: options.stop.clone(),
-        interrupted: false,
-        checkpoint: checkpoint.map(|c| Checkpointer {
-            next: c.every,
-            options: c,
-            digest: scene.digest(),
-            laws,
-            out: out.clone(),
-            n_inserted,
-            n_body_particles,
-        }),
-        wall_before: 0.0,
-        started: Instant::now(),
-    };
-    let resume_at = match (resume, stored) {
-        (Some(loaded), Some(state)) => {
-            let (at, counts) = driver.resume_from(
-                &mut world,
-                &mut observers,
-                &mut warnings,
-                loaded,
-                state,
-                options.grid,
-            )?;
-            (n_inserted, n_body_particles) = counts;
-            at
-        }
-        _ => {
-            let start = Position {
-                stage: 0,
-                within: None,
-            };
-            driver.save_checkpoint(&world, &mut observers, &warnings, start, &[])?;
-            Resume {
-                at: start,
-                observers: None,
-                refills: Vec::new(),
-            }
-        }
-    };
-    driver.started = Instant::now();
-    let stopped_by = driver.run_stages(&mut world, &mut observers, &mut warnings, resume_at)?;
-    driver.progress.finish();
-    // Under MPI rank 0 gathers the final state and writes it.
-    world.sync_particles_for_output();
+}
+
+/// How a run's stepping ended: its particle counts, time step and time scales, and the
+/// guard trip that stopped it, if one did.
+struct Ran<'a> {
+    counts: Counts,
+    steps: (Real, &'a Timescales),
+    stopped_by: Option<GuardTrip>,
+}
+
+/// After the last step: the run's warnings, its summary with what the observers measured
+/// (written to summary.json), and the result: the summary, or why the run stopped early.
+fn conclude<L: PairLaw, W: WallLaw>(
+    scene: &Scene,
+    world: &World<L, W>,
+    driver: &mut Driver,
+    observers: &mut [Scheduled<'_, L, W>],
+    mut warnings: Warnings,
+    ran: Ran<'_>,
+    options: &RunOptions,
+) -> Result<RunSummary, RunError> {
+    let out = &options.out_dir;
     // A resumed run counts the wall time its earlier processes spent up to its checkpoint.
     let wall_s = driver.wall_s();
     for (kind, count) in driver.guard_counts.iter().filter(|(_, count)| *count > 1) {
@@ -170,22 +188,20 @@ pub(crate) fn execute<L: PairLaw, W: WallLaw>(
             world.lost
         ));
     }
+    let stopped_by = ran.stopped_by;
     let mut summary = base_summary(
         scene,
-        &world,
-        &mut driver,
-        Counts {
-            inserted: n_inserted,
-            body_particles: n_body_particles,
-        },
-        (dt, &scales),
+        world,
+        driver,
+        ran.counts,
+        ran.steps,
         wall_s,
         stopped_by.clone(),
         options,
     );
-    for o in &mut observers {
+    for o in observers.iter_mut() {
         o.observer()
-            .finish(&world, stopped_by.is_some(), &mut summary, &mut warnings)?;
+            .finish(world, stopped_by.is_some(), &mut summary, &mut warnings)?;
     }
     summary.warnings = warnings.0;
     write_summary(out, &summary)?;
@@ -482,7 +498,78 @@ fn check_resumable(
 /// top-ups so far).
 type Refill<'r> = (usize, &'r RefillRegion, usize, u64);
 
-impl Driver<'_> {
+impl<'s> Driver<'s> {
+    /// The driver of `scene`'s stages, at its start.
+    fn new(
+        scene: &'s Scene,
+        dt: Real,
+        options: &RunOptions,
+        checkpoint: Option<Checkpointer>,
+    ) -> Result<Self, RunError> {
+        Ok(Driver {
+            scene,
+            dt,
+            progress: match &options.progress {
+                Some(Progress(reporter)) => reporter.start(total_steps(scene, dt)),
+                None => Box::new(progress::Silent),
+            },
+            keep_going: options.keep_going,
+            refill_regions: scene
+                .insertions
+                .iter()
+                .enumerate()
+                .filter(|(_, ins)| ins.refill.is_some())
+                .map(|(k, ins)| RefillRegion::new(scene, k, ins).map(|r| (k, r)))
+                .collect::<Result<_, _>>()?,
+            refilled: 0,
+            particle_steps: 0,
+            stages: Vec::new(),
+            guard_counts: Vec::new(),
+            stop: options.stop.clone(),
+            interrupted: false,
+            checkpoint,
+            wall_before: 0.0,
+            started: Instant::now(),
+        })
+    }
+
+    /// Where the stage loop starts: a stored run taken over (`stored`: the restart file and
+    /// its world's state; the particle counts become the stored run's), or the first stage,
+    /// whose start is saved as a checkpoint.
+    fn start<'r, L: PairLaw, W: WallLaw>(
+        &mut self,
+        world: &mut World<L, W>,
+        observers: &mut [Scheduled<'_, L, W>],
+        warnings: &mut Warnings,
+        stored: Option<(
+            &'r restart::RestartLoaded,
+            WorldState<L::History, W::History>,
+        )>,
+        options: &RunOptions,
+        counts: Counts,
+    ) -> Result<(Resume<'r>, Counts), RunError> {
+        if let Some((loaded, state)) = stored {
+            let (at, (inserted, body_particles)) =
+                self.resume_from(world, observers, warnings, loaded, state, options.grid)?;
+            let counts = Counts {
+                inserted,
+                body_particles,
+            };
+            return Ok((at, counts));
+        }
+        let start = Position {
+            stage: 0,
+            within: None,
+        };
+        self.save_checkpoint(world, observers, warnings, start, &[])?;
+        let at = Resume {
+            at: start,
+            observers: None,
+            refills: Vec::new(),
+        };
+        Ok((at, counts))
+    }
+
     /// Wall seconds of stepping so far, over every process of the run.
     fn wall_s(&self) -> Real {
         self.wall_before + self.started.elapsed().as_secs_f64()
