@@ -450,6 +450,9 @@ struct Checkpointer {
     n_body_particles: usize,
 }
 
+/// A stored run to take over: its restart file and its world's state.
+type Stored<'r, H, WH> = (&'r restart::RestartLoaded, WorldState<H, WH>);
+
 /// Where a resumed run starts: the position, and the observers' and top-ups' states to
 /// put back once the stage has begun again (when resuming within a stage).
 struct Resume<'r> {
@@ -541,10 +544,7 @@ impl<'s> Driver<'s> {
         world: &mut World<L, W>,
         observers: &mut [Scheduled<'_, L, W>],
         warnings: &mut Warnings,
-        stored: Option<(
-            &'r restart::RestartLoaded,
-            WorldState<L::History, W::History>,
-        )>,
+        stored: Option<Stored<'r, L::History, W::History>>,
         options: &RunOptions,
         counts: Counts,
     ) -> Result<(Resume<'r>, Counts), RunError> {
