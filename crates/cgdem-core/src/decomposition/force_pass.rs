@@ -3,6 +3,11 @@
 //! particle may reach, then what acts on each particle alone (gravity, the planar walls,
 //! the bodies). Every sum runs in list, then particle, order: the same bits on any number
 //! of threads or ranks.
+//!
+//! The helpers take the particle arrays (`ParticleState`, a few slices) by value: passed by
+//! reference to a helper the compiler does not inline, their address escapes, and the pair
+//! loop then reloads every slice's pointer after each force it stores (the heap bench ran
+//! 26% slower so).
 
 use super::step::{ForceSums, Physics};
 use super::Subdomain;
@@ -37,7 +42,7 @@ pub(super) fn forces<L: PairLaw, W: WallLaw>(
     let deepest_pair = pair_sums(
         &mut sub.list,
         &mut sub.pairs_by_reach,
-        &state,
+        state,
         force,
         torque,
         n,
@@ -45,7 +50,7 @@ pub(super) fn forces<L: PairLaw, W: WallLaw>(
     );
     if sub.near_walls.len() != n {
         // After a list build: the walls each particle may reach before the next one.
-        sub.near_walls = near_walls(&state, n, physics, skin);
+        sub.near_walls = near_walls(state, n, physics, skin);
         forget_far_wall_histories(&sub.near_walls, &mut sub.wall_history, physics);
     }
     let (n_bodies, n_meshes) = (physics.surroundings.bodies.len(), mesh_bodies(physics));
@@ -63,7 +68,7 @@ pub(super) fn forces<L: PairLaw, W: WallLaw>(
         clearances: &mut sub.body_clearances,
         near_triangles: &mut sub.near_triangles,
     };
-    let deepest_wall = alone_sums(alone, &state, force, torque, &mut body_loads, physics);
+    let deepest_wall = alone_sums(alone, state, force, torque, &mut body_loads, physics);
     ForceSums {
         deepest_pair,
         deepest_wall,
@@ -78,7 +83,7 @@ pub(super) fn forces<L: PairLaw, W: WallLaw>(
 fn pair_sums<L: PairLaw, W: WallLaw>(
     list: &mut PairList<L::History>,
     pairs_by_reach: &mut Vec<u32>,
-    state: &ParticleState<'_>,
+    state: ParticleState<'_>,
     force: &mut [Vec3],
     torque: &mut [Vec3],
     n: usize,
@@ -92,9 +97,9 @@ fn pair_sums<L: PairLaw, W: WallLaw>(
     macro_rules! pair {
         ($a:expr, $b:expr, $position_b:expr, $history:expr) => {{
             let (a, b): (usize, usize) = ($a, $b);
-            let first = FirstParticle::at(state, a, physics.n_species);
+            let first = FirstParticle::at(&state, a, physics.n_species);
             let (result, overlap, smaller_radius) =
-                pair_force(physics.law, state, &first, b, $position_b, $history, dt);
+                pair_force(physics.law, &state, &first, b, $position_b, $history, dt);
             if overlap > deepest_pair * smaller_radius {
                 deepest_pair = overlap / smaller_radius;
             }
@@ -156,7 +161,7 @@ pub(super) fn compacts_touching_pairs<H>() -> bool {
 fn sort_by_reach<L: PairLaw, W: WallLaw>(
     list: &PairList<L::History>,
     order: &mut Vec<u32>,
-    state: &ParticleState<'_>,
+    state: ParticleState<'_>,
     physics: &Physics<'_, L, W>,
 ) -> usize {
     let listed = list.pairs.len();
@@ -197,7 +202,8 @@ fn forget_out_of_reach<H: PairHistory>(list: &mut PairList<H>, out_of_reach: &[u
 }
 
 /// What the wall law reads of owned particle `i`.
-fn wall_particle(state: &ParticleState<'_>, i: usize) -> WallParticle {
+#[inline(always)]
+fn wall_particle(state: ParticleState<'_>, i: usize) -> WallParticle {
     WallParticle {
         species: state.species[i] as usize,
         position: state.position[i],
@@ -209,7 +215,7 @@ fn wall_particle(state: &ParticleState<'_>, i: usize) -> WallParticle {
 
 /// Per owned particle (the first `n`), the walls it may reach before the next list build.
 fn near_walls<L: PairLaw, W: WallLaw>(
-    state: &ParticleState<'_>,
+    state: ParticleState<'_>,
     n: usize,
     physics: &Physics<'_, L, W>,
     skin: Real,
@@ -266,7 +272,7 @@ fn mesh_bodies<L, W>(physics: &Physics<'_, L, W>) -> usize {
 /// as a fraction of the radius.
 fn alone_sums<L: PairLaw, W: WallLaw>(
     arrays: AloneArrays<'_, W::History>,
-    state: &ParticleState<'_>,
+    state: ParticleState<'_>,
     force: &mut [Vec3],
     torque: &mut [Vec3],
     body_loads: &mut [BodyLoad],
