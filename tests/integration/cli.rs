@@ -503,7 +503,8 @@ fn advise_run_makes_the_missing_points_of_one_case_and_answers_from_them() {
 
 /// An open surface (a plate of two triangles, as a CAD export of a sheet gives it) cannot be
 /// an SDF grid: the run is refused naming the scene, the body and the STL file once, and
-/// pointing to `contact = "mesh"`, under which the same file runs.
+/// pointing to `contact = "mesh"`, under which the same file runs, as it does with neither
+/// `contact` nor `cell_size` (a body given no grid spacing is met on its triangles).
 #[test]
 fn an_open_stl_is_refused_as_a_grid_and_met_on_its_triangles_as_a_mesh() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("open_stl_body");
@@ -551,10 +552,13 @@ fn an_open_stl_is_refused_as_a_grid_and_met_on_its_triangles_as_a_mesh() {
         "{stderr}"
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
-    let out = run("mesh", "contact = \"mesh\"");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    // Named, or by default for a body given no grid spacing.
+    for (name, body) in [("mesh", "contact = \"mesh\""), ("default", "")] {
+        let out = run(name, body);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }

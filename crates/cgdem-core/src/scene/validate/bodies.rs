@@ -4,7 +4,8 @@ use super::super::raw::*;
 use super::super::*;
 use super::{mesh_source, names, Checker};
 
-/// `[[body]]`: a moving rigid body, by an SDF grid (`cell_size`) or built of particles.
+/// `[[body]]`: a moving rigid body, met on its triangles, on an SDF grid (`cell_size`) or
+/// built of particles.
 pub(super) fn bodies(
     c: &Checker,
     raw: &RawScene,
@@ -51,14 +52,22 @@ pub(super) fn bodies(
             None => None,
             Some(bp) => Some(body_particles(c, k, b, bp, species)?),
         };
+        // Without `contact`, a body given a grid spacing (or built of particles) keeps its grid
+        // and one given none is met on its triangles: exact, in memory with its surface, and
+        // the cheaper where grains are small against the triangles (the silo), while a grid
+        // pays where they are large (the screw: reports/exact_walls/NOTE.md).
         let contact = match b.contact.as_deref() {
-            None | Some("grid") => BodyContact::Grid,
+            Some("grid") => BodyContact::Grid,
             Some("mesh") => BodyContact::Mesh,
+            None if b.cell_size.is_some() || b.padding.is_some() || particles.is_some() => {
+                BodyContact::Grid
+            }
+            None => BodyContact::Mesh,
             Some(other) => {
                 return Err(c.invalid(
                     format!("body[{k}].contact"),
                     other,
-                    "\"grid\" (the default: a signed-distance grid of cell_size) or \"mesh\" (the triangles themselves, as LIGGGHTS's mesh walls)",
+                    "\"grid\" (a signed-distance grid of cell_size; the default with cell_size) or \"mesh\" (the triangles themselves, as LIGGGHTS's mesh walls; the default without)",
                 ))
             }
         };
@@ -88,7 +97,7 @@ pub(super) fn bodies(
                 return Err(c.invalid(
                     format!("body[{k}].cell_size"),
                     "missing",
-                    "the SDF grid spacing, m (or contact = \"mesh\" to meet the triangles themselves, or particles = { species = ..., lattice = \"fcc\" } for a body built of particles)",
+                    "the SDF grid spacing, m, with contact = \"grid\" (without both, the body is met on its triangles)",
                 ))
             }
         };
