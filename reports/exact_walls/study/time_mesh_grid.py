@@ -23,6 +23,9 @@ import subprocess
 import sys
 import time
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the report's scripts
+from mesh_cases import with_mesh_contact  # noqa: E402  (beside this file)
+
 here = os.path.dirname(os.path.abspath(__file__))
 repo = os.path.normpath(os.path.join(here, "..", "..", ".."))
 cases = os.path.join(repo, "validation", "cases")
@@ -42,11 +45,6 @@ def run(cgdem, scene, out, sets):
         sys.exit(f"{' '.join(args)} failed (wait status {status})")
     stepping = json.load(open(os.path.join(out, "summary.json")))["wall_s"]
     return whole, stepping, usage.ru_maxrss / 1024
-
-
-def with_mesh_contact(text):
-    """The screw's text with every body met on its triangles (as mesh_cases.py writes it)."""
-    return re.sub(r"cell_size = [0-9.e-]+[^\n]*\n(?:[ ]+#[^\n]*\n)*", 'contact = "mesh"\n', text)
 
 
 def discharge_from_fill(text, fill):
