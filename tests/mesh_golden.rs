@@ -396,8 +396,8 @@ fn sphere_against_a_moving_plate() {
 /// The paddle at 600 rpm agrees to 2.4e-11 of its scale in the spin about z, not to 1e-12;
 /// the other quantities agree to 5e-13. The case amplifies round-off, so it is held to 1e-10.
 /// - By step 3346 of 4000 the two trajectories differ by 1e-16 m in position, 1e-13 of the
-///   radius. There the rolling torque reaches its cap, and from then on it is
-///   `mu_r r |F_n|`.
+///   radius. There a capped regime begins, the rolling torque at `mu_r r |F_n|` (by
+///   elimination: the tangential force stays below its cap until step 3480).
 /// - `F_n` is by then the elastic force less the damping, a ninth of the elastic force. So the
 ///   overlap's relative difference, 6e-12, reaches the spin about nine times over.
 /// - cgdem alone shows the same sensitivity: a start moved by one ulp in y (2e-19 m) moves
