@@ -24,6 +24,7 @@ use crate::walls::{WallLaw, WallMask, WallParticle};
 /// (gravity, the planar walls and the bodies, with their histories). Returns the deepest
 /// pair and wall (or body) overlaps and the bodies' loads summed over the owned particles in
 /// order.
+#[inline(always)]
 pub(super) fn forces<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
@@ -80,6 +81,7 @@ pub(super) fn forces<L: PairLaw, W: WallLaw>(
 
 /// Every listed pair's force (and torques) added to whichever of its two particles are owned
 /// (the first `n`); returns the deepest overlap as a fraction of the smaller radius.
+#[inline(always)]
 fn pair_sums<L: PairLaw, W: WallLaw>(
     list: &mut PairList<L::History>,
     pairs_by_reach: &mut Vec<u32>,
@@ -158,6 +160,7 @@ pub(super) fn compacts_touching_pairs<H>() -> bool {
 /// runs over the front only, in list order (every particle's sum is the same as over the
 /// whole list), with no branch that half of them take: a settled bed lists about two pairs
 /// for each one that touches. Returns how many are within reach.
+#[inline(always)]
 fn sort_by_reach<L: PairLaw, W: WallLaw>(
     list: &PairList<L::History>,
     order: &mut Vec<u32>,
@@ -192,6 +195,7 @@ fn sort_by_reach<L: PairLaw, W: WallLaw>(
 
 /// The pairs `out_of_reach` (by index) lose their history, as the law would reset it had it
 /// seen them; written only where it is set.
+#[inline(always)]
 fn forget_out_of_reach<H: PairHistory>(list: &mut PairList<H>, out_of_reach: &[u32]) {
     for &k in out_of_reach {
         let history = &mut list.history[k as usize];
@@ -270,6 +274,7 @@ fn mesh_bodies<L, W>(physics: &Physics<'_, L, W>) -> usize {
 /// walls it may reach and the bodies, with its histories, clearances and lists of near
 /// triangles; each body's load into `body_loads`. Returns the deepest wall or body overlap
 /// as a fraction of the radius.
+#[inline(always)]
 fn alone_sums<L: PairLaw, W: WallLaw>(
     arrays: AloneArrays<'_, W::History>,
     state: ParticleState<'_>,

@@ -29,6 +29,7 @@ use crate::memory_use::MemoryUse;
 use crate::neighbor::{CellGrid, PairList};
 use crate::particles::Particles;
 use crate::walls::WallLaw;
+use multiversion::multiversion;
 
 /// The laws and what acts on a particle alone, for one force pass.
 pub(crate) struct Physics<'a, L, W> {
@@ -640,10 +641,23 @@ fn resort_by_cell<H: PairHistory, WH: PairHistory>(sub: &mut Subdomain<H, WH>, c
     }
 }
 
+// The two halves of a subdomain's step below are where the step's time goes: each is
+// compiled three times, for AVX-512 (x86-64-v4), AVX2 (x86-64-v3) and any x86-64, and the
+// first call picks the best the CPU has. The build needs no `target-cpu`, so one binary runs
+// on every node of a cluster and is as fast as one built for the CPU at hand. Everything
+// they call on the hot path (force pass, laws, integrator kernels) is `#[inline(always)]`:
+// a function not inlined into them is compiled for plain x86-64 only. These are the only
+// dispatch points: one per half and subdomain per step; a dispatch boundary lower down
+// (around the pair loop) costs the inlining across it (the heap bench 7% slower).
+
 /// The first half of a step of `integrator` for `sub`'s owned particles (velocity Verlet's
 /// half kick and drift, or PCVV's predictor), then the particles of bodies built of
 /// particles moved to their bodies' pose; whether one moved farther than
 /// `sqrt(limit_sq)` from its position at the last build.
+#[multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl+avx2+fma+bmi1+bmi2+f16c+lzcnt+movbe+popcnt",
+    "x86_64+avx2+fma+bmi1+bmi2+f16c+lzcnt+movbe+popcnt",
+))]
 fn first_half<H: PairHistory, WH: PairHistory>(
     sub: &mut Subdomain<H, WH>,
     dt: Real,
@@ -696,6 +710,10 @@ fn first_half<H: PairHistory, WH: PairHistory>(
 /// Forces on `sub`'s owned particles, the load on the particles of bodies built of
 /// particles, then the second half of a step of `closing` (velocity Verlet's closing half
 /// kick, or PCVV's corrector from the forces before this step's).
+#[multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl+avx2+fma+bmi1+bmi2+f16c+lzcnt+movbe+popcnt",
+    "x86_64+avx2+fma+bmi1+bmi2+f16c+lzcnt+movbe+popcnt",
+))]
 fn forces_and_closing<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,
@@ -730,6 +748,7 @@ fn forces_and_closing<L: PairLaw, W: WallLaw>(
 /// The second half of a step of `integrator` for `sub`'s owned particles, from the forces
 /// just evaluated (`old`: PCVV's forces and torques of the step before); whether every
 /// velocity and spin stayed finite.
+#[inline(always)]
 fn second_half<L: PairLaw, W: WallLaw>(
     sub: &mut Subdomain<L::History, W::History>,
     physics: &Physics<'_, L, W>,

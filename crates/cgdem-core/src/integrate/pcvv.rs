@@ -10,6 +10,7 @@
 use crate::math::{Real, Vec3};
 
 /// The predictor for positions and velocities.
+#[inline(always)]
 pub fn predict(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
@@ -29,6 +30,7 @@ pub fn predict(
 }
 
 /// The predictor for spins (or any rate): `w += dt T/I`.
+#[inline(always)]
 pub fn predict_rate(rate: &mut [Vec3], torque: &[Vec3], inv_inertia: &[Real], dt: Real) {
     for (w, (t, inv_i)) in rate.iter_mut().zip(torque.iter().zip(inv_inertia)) {
         *w += dt * *inv_i * *t;
@@ -36,6 +38,7 @@ pub fn predict_rate(rate: &mut [Vec3], torque: &[Vec3], inv_inertia: &[Real], dt
 }
 
 /// The corrector: `v += dt/(2m) (F1 - F0)`. Returns whether every updated value is finite.
+#[inline(always)]
 pub fn correct(
     velocity: &mut [Vec3],
     force: &[Vec3],

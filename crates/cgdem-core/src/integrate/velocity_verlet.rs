@@ -9,6 +9,7 @@ use crate::math::{Real, Vec3};
 /// Half kick then drift of each particle; whether one moved farther than
 /// `sqrt(limit_sq)` from its `reference` position (the pair list's rebuild test, at no
 /// extra pass).
+#[inline(always)]
 pub fn kick_then_drift(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
@@ -36,6 +37,7 @@ pub fn kick_then_drift(
 }
 
 /// `v += half F/m` (or `w += half T/I`): a half kick; whether every result is finite.
+#[inline(always)]
 pub fn kick(rate: &mut [Vec3], load: &[Vec3], inv_inertia: &[Real], half: Real) -> bool {
     let mut finite = true;
     for ((v, f), inv_m) in rate.iter_mut().zip(load).zip(inv_inertia) {
@@ -47,6 +49,7 @@ pub fn kick(rate: &mut [Vec3], load: &[Vec3], inv_inertia: &[Real], half: Real) 
 
 /// The closing half kick `v += dt/2 F/m`; whether every result is finite (the non-finite
 /// guard, at no extra pass).
+#[inline(always)]
 pub fn closing_kick(velocity: &mut [Vec3], force: &[Vec3], inv_mass: &[Real], dt: Real) -> bool {
     kick(velocity, force, inv_mass, 0.5 * dt)
 }
