@@ -73,6 +73,7 @@ enum Command {
     Advise(advise::AdviseArgs),
     /// Run a scene in a reference code (deck written from the scene, run, post-processed
     /// with cgdem's analysis into the same outputs).
+    #[command(after_help = reference::EXIT_STATUS)]
     Reference {
         #[command(subcommand)]
         code: reference::ReferenceCommand,

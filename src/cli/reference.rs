@@ -12,12 +12,21 @@ use cgdem_harness::decks::{
     run_reference, ReferenceOptions, ReferenceRun, RunStatus, RunnerOptions,
 };
 
+/// The exit statuses of `cgdem reference`, shown under its help and its codes' help.
+pub(super) const EXIT_STATUS: &str = "Exit status: 0 the code ran and its outputs were post-processed; 1 the scene could not be written as a deck, or the code failed or timed out (its log's tail is printed); 3 the code is not installed (the deck is written in the output directory, to be run where it is); 130 interrupted by SIGINT (Ctrl-C), 143 by SIGTERM.";
+
+/// The exit status of a run the code was not there for: a script that asked for a reference
+/// run must not read it as done (`cgdem validate` calls such a suite incomplete, also 3).
+const NOT_INSTALLED: u8 = 3;
+
 #[derive(Subcommand)]
 pub(super) enum ReferenceCommand {
     /// LAMMPS (`lmp` on PATH or $CGDEM_LMP): the WCA model of Hirose
     /// (reference/lammps/SEED_MODEL.md) and Hertz scenes (reference/MAPPING.md).
+    #[command(after_help = EXIT_STATUS)]
     Lammps(ReferenceArgs),
     /// LIGGGHTS (`liggghts` on PATH or $CGDEM_LIGGGHTS): Hertz scenes with LIGGGHTS's keywords.
+    #[command(after_help = EXIT_STATUS)]
     Liggghts(ReferenceArgs),
 }
 
@@ -139,8 +148,11 @@ fn report(code: Code, run: ReferenceRun, out: &std::path::Path) -> Result<ExitCo
             reason,
             install_hint,
         } => {
-            println!("skipped: {reason}; install with `{install_hint}`");
-            Ok(ExitCode::SUCCESS)
+            eprintln!(
+                "error: {name} is not installed, so it did not run: {reason}; install with `{install_hint}`. The deck is in {}",
+                out.display()
+            );
+            Ok(ExitCode::from(NOT_INSTALLED))
         }
         RunStatus::Failed {
             exit_code,

@@ -24,6 +24,32 @@ fn a_missing_scene_file_is_an_error_naming_it() {
     assert!(!stderr.contains("panicked"));
 }
 
+/// A reference run asked for by name whose code is not installed is not reported as done:
+/// exit status 3, the reason on stderr, and the deck left in the output directory.
+#[test]
+fn a_reference_run_without_its_code_exits_3_and_keeps_the_deck() {
+    let out_dir = std::env::temp_dir().join(format!("cgdem-ref-missing-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let case = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/validation/cases/aor_hertz_smoke.toml"
+    );
+    let out = cgdem()
+        .args(["reference", "liggghts", case, "--out"])
+        .arg(&out_dir)
+        .env("CGDEM_LIGGGHTS", "/no/such/liggghts")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("not installed") && stderr.contains("/no/such/liggghts"),
+        "{stderr}"
+    );
+    assert!(out_dir.join("deck.in").is_file(), "the deck is kept");
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
+
 /// A sweep's runs are not decomposed: `--grid` with `--sweep` is refused rather than ignored.
 #[test]
 fn grid_with_a_sweep_is_refused_not_ignored() {
