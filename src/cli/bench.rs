@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 
+use cgdem_harness::bench::builds::BuildSpec;
 use cgdem_harness::bench::{bench, format_report, BenchOptions};
 use cgdem_harness::suite::Code;
 
@@ -53,6 +54,15 @@ pub(super) struct BenchArgs {
     /// target/release/cgdem of a `cargo build --release --features mpi`.
     #[arg(long, value_name = "PATH", requires = "np")]
     cgdem_bin: Option<PathBuf>,
+    /// A build of a reference code to time, as CODE=LABEL:PATH (repeat the option for
+    /// several), e.g. `--build lammps=native:/opt/lammps/build/lmp`. Each build runs in the
+    /// same alternation, with rows of its own; at more than one worker a LAMMPS build with
+    /// the OPENMP package also runs as one process of that many OpenMP threads. The `mpirun`
+    /// beside the binary starts its ranks if there is one (a Python environment's MPI), else
+    /// the one on PATH. A code given no build runs the one found as usual ($CGDEM_LMP or
+    /// `lmp` on PATH; $CGDEM_LIGGGHTS or `liggghts`), labelled by its release.
+    #[arg(long = "build", value_name = "CODE=LABEL:PATH")]
+    builds: Vec<BuildSpec>,
 }
 
 pub(super) fn execute(args: BenchArgs) -> ExitCode {
@@ -85,6 +95,7 @@ pub(super) fn execute(args: BenchArgs) -> ExitCode {
         grid: args.grid,
         np: args.np,
         cgdem_bin: args.cgdem_bin,
+        builds: args.builds,
         cases: args.cases,
         out: args.out,
         codes,

@@ -18,12 +18,19 @@
 //! tree under `mpirun`, `cgdem run` on the case file with the timed scene's overrides, the
 //! prepared state from a state file and `--grid`, its figures from rank 0's summary.json.
 //! Their outcome is not run again: the ranks write bitwise the threaded grid's outputs.
+//!
+//! Each reference code may be timed in several builds (`--build lammps=LABEL:PATH`), each in
+//! the same alternation, with rows of its own; at more than one worker a LAMMPS build with
+//! the OPENMP package also runs as one process of OpenMP threads. The report names the
+//! fastest build of each code at each worker count, with cgdem's ratio to it.
 
 //!
-//! Its phases, one file each: `suite` (the cases prepared to time), `runs` (every code,
-//! case and worker count in alternation, and the outcome runs), `measurement` (medians and
-//! ratios) and `report` (`bench.json`, the CSV, the figure and the printed text).
+//! Its phases, one file each: `suite` (the cases prepared to time), `builds` (the reference
+//! builds found and probed), `runs` (every code, build, case and worker count in
+//! alternation, and the outcome runs), `measurement` (medians and ratios) and `report`
+//! (`bench.json`, the CSV, the figure and the printed text).
 
+pub mod builds;
 mod measurement;
 mod report;
 mod runs;
@@ -40,13 +47,14 @@ use std::time::Duration;
 use serde::Serialize;
 
 use crate::suite::Code;
+use builds::{Build, BuildSpec};
 use cgdem_core::analysis::conical_heap::ConicalHeap;
 use cgdem_core::decomposition::GridSpec;
 use cgdem_core::math::Real;
-use measurement::{medians, rank_ratios, ratios};
+use measurement::{fastest, medians, rank_ratios, ratios};
 use report::write_report;
-use runs::{check_ranks, outcome_run, ranks_run, run_order, timed_run};
-use suite::prepare;
+use runs::{check_ranks, outcome_run, ranks_run, run_dir, run_order, timed_run, Runner};
+use suite::{prepare, PreparedCase};
 
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
@@ -77,6 +85,9 @@ pub struct BenchOptions {
     pub np: Vec<usize>,
     /// The cgdem the ranks run: a build with `--features mpi`.
     pub cgdem_bin: Option<PathBuf>,
+    /// The reference builds to time (`--build`); a code none is given for runs its default
+    /// build.
+    pub builds: Vec<BuildSpec>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -87,6 +98,8 @@ pub enum BenchError {
     Output { path: PathBuf, message: String },
     #[error("--np: {0}")]
     Ranks(String),
+    #[error("{0}")]
+    Build(String),
 }
 
 /// One timed run.
@@ -94,11 +107,15 @@ pub enum BenchError {
 pub struct BenchRun {
     pub case: String,
     pub code: Code,
+    /// The reference code's build (its label); none for cgdem.
+    pub build: Option<String>,
     /// Workers: cgdem's threads, or the MPI ranks of a reference code or of cgdem (`--np`).
     pub threads: usize,
     /// MPI ranks when the run was started by `mpirun` (the reference codes beyond one
     /// worker, cgdem under `--np`); none for one process.
     pub ranks: Option<usize>,
+    /// OpenMP threads of a reference run as one process (`-sf omp`).
+    pub openmp_threads: Option<usize>,
     pub repetition: usize,
     /// `completed`, `skipped`, `failed` or `timed out`.
     pub status: String,
@@ -118,8 +135,10 @@ pub struct BenchRun {
 pub struct BenchMedian {
     pub case: String,
     pub code: Code,
+    pub build: Option<String>,
     pub threads: usize,
     pub ranks: Option<usize>,
+    pub openmp_threads: Option<usize>,
     pub runs: usize,
     pub median_particle_steps_per_s: Real,
     pub min_particle_steps_per_s: Real,
@@ -139,10 +158,25 @@ pub struct BenchRatio {
     pub median: Real,
 }
 
+/// The fastest build of a reference code at one worker count (over its builds, ranks and
+/// OpenMP runs), and cgdem over it.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchFastest {
+    pub case: String,
+    pub code: Code,
+    pub threads: usize,
+    /// The fastest row, as the tables name it.
+    pub row: String,
+    pub median_particle_steps_per_s: Real,
+    /// cgdem on threads over that row, median of the per-repetition ratios.
+    pub cgdem_over_fastest: Option<Real>,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchOutcome {
     pub case: String,
     pub code: Code,
+    pub build: Option<String>,
     pub status: String,
     pub simulated_s: Real,
     pub heap: Option<ConicalHeap>,
@@ -166,36 +200,15 @@ pub struct BenchReport {
     pub runs: Vec<BenchRun>,
     pub medians: Vec<BenchMedian>,
     pub ratios: Vec<BenchRatio>,
+    pub fastest: Vec<BenchFastest>,
     pub outcomes: Vec<BenchOutcome>,
     pub memory: Vec<BenchMemory>,
 }
 
 pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
-    let out = &options.out;
     let ranks_bin = check_ranks(options)?;
-    let mut cases = Vec::new();
-    for path in &options.cases {
-        let case = prepare(path, options)?;
-        if let Some(grid) = options.grid {
-            let mut decomposed = case.clone();
-            decomposed.name = format!("{}-grid{grid}", case.name);
-            decomposed.grid = Some(grid);
-            if ranks_bin.is_some() {
-                let path = out.join(&decomposed.name).join("state.cgs");
-                std::fs::create_dir_all(out.join(&decomposed.name))
-                    .and_then(|_| cgdem_core::run::state_file::write(&path, &case.state))
-                    .map_err(|e| BenchError::Output {
-                        path: path.clone(),
-                        message: e.to_string(),
-                    })?;
-                decomposed.state_file = Some(path);
-            }
-            cases.push(case);
-            cases.push(decomposed);
-        } else {
-            cases.push(case);
-        }
-    }
+    let builds = builds::resolve(&options.codes, &options.builds)?;
+    let cases = prepare_cases(options, ranks_bin.is_some())?;
     let mut runs: Vec<BenchRun> = Vec::new();
     let mut memory = Vec::new();
     // Worker counts: threads (and the reference codes' ranks), and cgdem's ranks.
@@ -204,27 +217,24 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
     workers.dedup();
     for &threads in &workers {
         for repetition in 0..options.pairs {
-            // Every (case, code) in turn, the whole sequence reversed on odd repetitions
-            // (A B C, C B A), so adjacent runs make each ratio.
-            let mut order = run_order(&cases, options, threads);
+            // Every (case, code, build) in turn, the whole sequence reversed on odd
+            // repetitions (A B C, C B A), so adjacent runs make each ratio.
+            let mut order = run_order(&cases, &builds, options, threads);
             if repetition % 2 == 1 {
                 order.reverse();
             }
-            for (case, code, ranks) in order {
-                let dir = out.join(&case.name).join(match ranks {
-                    Some(n) => format!("{}-np{n}-r{repetition}", code.name()),
-                    None => format!("{}-t{threads}-r{repetition}", code.name()),
-                });
-                let (run, mem) = match (ranks, &ranks_bin) {
-                    (Some(n), Some(bin)) => {
+            for (case, runner) in order {
+                let dir = out_dir(options, case, runner, threads, repetition);
+                let (run, mem) = match (runner, &ranks_bin) {
+                    (Runner::CgdemRanks(n), Some(bin)) => {
                         (ranks_run(case, bin, n, repetition, &dir, options), None)
                     }
-                    _ => timed_run(case, code, threads, repetition, &dir, options),
+                    _ => timed_run(case, runner, threads, repetition, &dir, options),
                 };
                 eprintln!(
                     "bench {} {} threads={threads} rep={repetition}: {}",
                     case.name,
-                    label(code, run.ranks),
+                    run.label(),
                     run.particle_steps_per_s
                         .map_or(run.status.clone(), |v| format!("{v:.3e} particle-steps/s"))
                 );
@@ -237,47 +247,152 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, BenchError> {
             }
         }
     }
-    let medians = medians(&runs);
-    let mut ratios = ratios(
-        &runs,
-        &cases.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
-    );
-    ratios.extend(rank_ratios(
-        &runs,
+    let report = BenchReport {
+        provenance: provenance(&builds),
+        steps: options.steps,
+        prepare_s: options.prepare_s,
+        medians: medians(&runs),
+        ratios: all_ratios(&runs, &cases),
+        fastest: fastest(&runs),
+        outcomes: outcomes(&cases, &builds, options),
+        runs,
+        memory,
+    };
+    write_report(&report, &options.out)?;
+    Ok(report)
+}
+
+fn out_dir(
+    options: &BenchOptions,
+    case: &PreparedCase,
+    runner: Runner,
+    threads: usize,
+    repetition: usize,
+) -> PathBuf {
+    options
+        .out
+        .join(&case.name)
+        .join(run_dir(runner, threads, repetition))
+}
+
+/// Each case prepared, and after it its decomposed copy with `--grid` (with the state file
+/// its ranks start from when they run).
+fn prepare_cases(options: &BenchOptions, ranks: bool) -> Result<Vec<PreparedCase>, BenchError> {
+    let out = &options.out;
+    let mut cases = Vec::new();
+    for path in &options.cases {
+        let case = prepare(path, options)?;
+        let Some(grid) = options.grid else {
+            cases.push(case);
+            continue;
+        };
+        let mut decomposed = case.clone();
+        decomposed.name = format!("{}-grid{grid}", case.name);
+        decomposed.grid = Some(grid);
+        if ranks {
+            let path = out.join(&decomposed.name).join("state.cgs");
+            std::fs::create_dir_all(out.join(&decomposed.name))
+                .and_then(|_| cgdem_core::run::state_file::write(&path, &case.state))
+                .map_err(|e| BenchError::Output {
+                    path: path.clone(),
+                    message: e.to_string(),
+                })?;
+            decomposed.state_file = Some(path);
+        }
+        cases.push(case);
+        cases.push(decomposed);
+    }
+    Ok(cases)
+}
+
+fn all_ratios(runs: &[BenchRun], cases: &[PreparedCase]) -> Vec<BenchRatio> {
+    let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
+    let mut out = ratios(runs, &names);
+    out.extend(rank_ratios(
+        runs,
         &cases
             .iter()
             .filter(|c| c.grid.is_some())
             .map(|c| (c.name.clone(), c.base.clone()))
             .collect::<Vec<_>>(),
     ));
-    let mut outcomes = Vec::new();
-    if options.outcome {
-        let threads = options.threads.iter().copied().max().unwrap_or(1);
-        for case in &cases {
-            for &code in &options.codes {
-                outcomes.push(outcome_run(case, code, threads, options));
-            }
-        }
-    }
-    let report = BenchReport {
-        provenance: crate::validation::machine_provenance(),
-        steps: options.steps,
-        prepare_s: options.prepare_s,
-        runs,
-        medians,
-        ratios,
-        outcomes,
-        memory,
-    };
-    write_report(&report, out)?;
-    Ok(report)
+    out
 }
 
-/// How a code is named in the tables and plots: cgdem's MPI runs with their rank count.
-pub fn label(code: Code, ranks: Option<usize>) -> String {
-    match (code, ranks) {
-        (Code::Cgdem, Some(1)) => "cgdem (1 rank)".into(),
-        (Code::Cgdem, Some(n)) => format!("cgdem ({n} ranks)"),
-        _ => code.name().into(),
+/// With `options.outcome`, each case run to the scene's end by cgdem and by every build.
+fn outcomes(cases: &[PreparedCase], builds: &[Build], options: &BenchOptions) -> Vec<BenchOutcome> {
+    let mut out = Vec::new();
+    if !options.outcome {
+        return out;
+    }
+    let threads = options.threads.iter().copied().max().unwrap_or(1);
+    for case in cases {
+        if options.codes.contains(&Code::Cgdem) {
+            out.push(outcome_run(case, Runner::Cgdem, threads, options));
+        }
+        for build in builds {
+            let runner = Runner::Reference(build, builds::Launch::Ranks(threads));
+            out.push(outcome_run(case, runner, threads, options));
+        }
+    }
+    out
+}
+
+/// The machine, and each build: its banner and binary (or why it is missing).
+fn provenance(builds: &[Build]) -> BTreeMap<String, String> {
+    let mut p = crate::validation::machine_provenance();
+    for b in builds {
+        let what = match &b.found {
+            Ok(f) => format!(
+                "{}{}",
+                f.version.describe(),
+                if f.openmp { "; OPENMP" } else { "" }
+            ),
+            Err(reason) => format!("not available: {reason}"),
+        };
+        p.insert(format!("{} build {}", b.code.label(), b.label), what);
+    }
+    p
+}
+
+/// How a run is named in the tables and plots: the code, a reference build's label, and how
+/// it used its workers (cgdem's MPI ranks, a reference code's ranks or OpenMP threads).
+pub fn label(
+    code: Code,
+    build: Option<&str>,
+    ranks: Option<usize>,
+    openmp_threads: Option<usize>,
+) -> String {
+    let mut s = code.name().to_string();
+    if let Some(b) = build {
+        s = format!("{s} {b}");
+    }
+    match (code, ranks, openmp_threads) {
+        (_, _, Some(t)) => format!("{s} (1 rank x {t} OpenMP threads)"),
+        (Code::Cgdem, Some(1), _) => format!("{s} (1 rank)"),
+        (_, Some(n), _) => format!("{s} ({n} ranks)"),
+        _ => s,
+    }
+}
+
+impl BenchRun {
+    pub fn label(&self) -> String {
+        label(
+            self.code,
+            self.build.as_deref(),
+            self.ranks,
+            self.openmp_threads,
+        )
+    }
+}
+
+impl BenchMedian {
+    pub fn label(&self) -> String {
+        label(
+            self.code,
+            self.build.as_deref(),
+            self.ranks,
+            self.openmp_threads,
+        )
     }
 }

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{label, BenchError, BenchReport};
+use super::{BenchError, BenchReport};
 use crate::report::plot::write_bar_chart;
 use cgdem_core::io::CsvBuffer;
 use cgdem_core::math::Real;
@@ -20,8 +20,10 @@ pub(super) fn write_report(report: &BenchReport, out: &Path) -> Result<(), Bench
     let mut csv = CsvBuffer::new([
         "case",
         "code",
+        "build",
         "threads",
         "ranks",
+        "openmp_threads",
         "repetition",
         "status",
         "n_particles",
@@ -35,8 +37,10 @@ pub(super) fn write_report(report: &BenchReport, out: &Path) -> Result<(), Bench
         csv.row([
             r.case.to_string(),
             r.code.name().to_string(),
+            r.build.clone().unwrap_or_default(),
             r.threads.to_string(),
             r.ranks.map_or(String::new(), |n| n.to_string()),
+            r.openmp_threads.map_or(String::new(), |n| n.to_string()),
             r.repetition.to_string(),
             r.status.to_string(),
             r.n_particles.to_string(),
@@ -56,7 +60,7 @@ pub(super) fn write_report(report: &BenchReport, out: &Path) -> Result<(), Bench
         .map(|m| {
             (
                 format!("{}, {} worker(s)", m.case, m.threads),
-                label(m.code, m.ranks),
+                m.label(),
                 m.median_particle_steps_per_s / 1e6,
                 Some(0.5 * (m.max_particle_steps_per_s - m.min_particle_steps_per_s) / 1e6),
             )
@@ -92,7 +96,7 @@ pub fn format_report(report: &BenchReport) -> String {
         s += &format!(
             "{} | {} | {} | {} | {:.3e} | {:.3e} .. {:.3e} | {}\n",
             m.case,
-            label(m.code, m.ranks),
+            m.label(),
             m.threads,
             m.runs,
             m.median_particle_steps_per_s,
@@ -117,6 +121,21 @@ pub fn format_report(report: &BenchReport) -> String {
                 .join(" ")
         );
     }
+    if !report.fastest.is_empty() {
+        s += "\nfastest build per worker count | workers | median particle-steps/s | cgdem / fastest\n";
+    }
+    for f in &report.fastest {
+        s += &format!(
+            "{} {}: {} | {} | {:.3e} | {}\n",
+            f.case,
+            f.code.name(),
+            f.row,
+            f.threads,
+            f.median_particle_steps_per_s,
+            f.cgdem_over_fastest
+                .map_or("-".into(), |r| format!("{r:.2}"))
+        );
+    }
     if !report.outcomes.is_empty() {
         s += "\noutcome | code | simulated s | heap height mm | edge radius mm | flank slope deg | status\n";
         for o in &report.outcomes {
@@ -130,7 +149,7 @@ pub fn format_report(report: &BenchReport) -> String {
             s += &format!(
                 "{} | {} | {:.3} | {h} | {e} | {a} | {}\n",
                 o.case,
-                o.code.name(),
+                super::label(o.code, o.build.as_deref(), None, None),
                 o.simulated_s,
                 o.status.lines().next().unwrap_or("")
             );

@@ -1,9 +1,10 @@
-//! The bench's runs: each code on each prepared case at each worker count, in alternation,
-//! timed by its own step loop; cgdem's MPI ranks under `mpirun`; the untimed runs to the
-//! scene's end that measure the heap each code leaves.
+//! The bench's runs: each code (each build of a reference code) on each prepared case at
+//! each worker count, in alternation, timed by its own step loop; cgdem's MPI ranks under
+//! `mpirun`; the untimed runs to the scene's end that measure the heap each code leaves.
 
 use std::path::{Path, PathBuf};
 
+use super::builds::{self, Build, Launch};
 use super::measurement::mobile_centroid;
 use super::suite::PreparedCase;
 use super::{BenchError, BenchMemory, BenchOptions, BenchOutcome, BenchRun};
@@ -15,26 +16,65 @@ use cgdem_core::math::{Real, Vec3};
 use cgdem_core::run::{run, RunOptions};
 use cgdem_core::scene::{Scene, StageEnd};
 
-fn runner(threads: usize, options: &BenchOptions) -> RunnerOptions {
-    RunnerOptions {
-        stop: None,
-        np: (threads > 1).then_some(threads as u32),
-        timeout: options.timeout,
+/// Who makes one run: cgdem on threads, cgdem as MPI ranks (`--np`), or a reference build
+/// launched one way.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Runner<'b> {
+    Cgdem,
+    CgdemRanks(usize),
+    Reference(&'b Build, Launch),
+}
+
+impl Runner<'_> {
+    pub(super) fn code(&self) -> Code {
+        match self {
+            Runner::Cgdem | Runner::CgdemRanks(_) => Code::Cgdem,
+            Runner::Reference(b, _) => b.code,
+        }
+    }
+
+    fn build(&self) -> Option<String> {
+        match self {
+            Runner::Reference(b, _) => Some(b.label.clone()),
+            _ => None,
+        }
     }
 }
 
-/// One run of `code` on `scene` from the case's state in `dir`, plus cgdem's summary (with
+/// The run's directory below the case's: `cgdem-t2-r0`, `cgdem-np2-r0`,
+/// `lammps-LABEL-np2-r0`, `lammps-LABEL-omp2-r0`.
+pub(super) fn run_dir(runner: Runner, threads: usize, repetition: usize) -> String {
+    let how = match runner {
+        Runner::Cgdem => format!("cgdem-t{threads}"),
+        Runner::CgdemRanks(n) => format!("cgdem-np{n}"),
+        Runner::Reference(b, launch) => {
+            let how = match launch {
+                Launch::Ranks(1) => "t1".to_string(),
+                Launch::Ranks(n) => format!("np{n}"),
+                Launch::OpenMp(n) => format!("omp{n}"),
+            };
+            format!("{}-{}-{how}", b.code.name(), b.label)
+        }
+    };
+    format!("{how}-r{repetition}")
+}
+
+/// One run of `runner` on `scene` from the case's state in `dir`, plus cgdem's summary (with
 /// its final particles).
 fn run_code(
     case: &PreparedCase,
     scene: &Scene,
-    code: Code,
+    runner: Runner,
     threads: usize,
     dir: &Path,
     options: &BenchOptions,
 ) -> (RunResult, Option<cgdem_core::run::RunSummary>) {
     let mut result = RunResult::default();
-    match code {
+    let launch = match runner {
+        Runner::Reference(_, launch) => launch,
+        _ => Launch::Ranks(threads),
+    };
+    match runner.code() {
         Code::Cgdem => {
             let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
                 Ok(pool) => pool,
@@ -76,28 +116,53 @@ fn run_code(
             ));
             return (result, None);
         }
-        Code::Liggghts => {
-            let deck = liggghts::write_deck(scene, &case.state, case.dt);
-            finish_reference(
-                deck,
-                dir,
-                |dir| liggghts::run_deck(dir, &runner(threads, options)),
-                liggghts::LOG_FILE,
-                &mut result,
-            );
-        }
-        Code::Lammps => {
-            let deck = lammps::write_hertz_deck(scene, &case.state, case.dt);
-            finish_reference(
-                deck,
-                dir,
-                |dir| lammps::run_deck(dir, &runner(threads, options)),
-                lammps::LOG_FILE,
-                &mut result,
-            );
+        code => {
+            let Runner::Reference(build, _) = runner else {
+                return (RunResult::failed("no build to run".into()), None);
+            };
+            let (deck, log_file) = match code {
+                Code::Liggghts => (
+                    liggghts::write_deck(scene, &case.state, case.dt),
+                    liggghts::LOG_FILE,
+                ),
+                _ => (
+                    lammps::write_hertz_deck(scene, &case.state, case.dt),
+                    lammps::LOG_FILE,
+                ),
+            };
+            let run = |dir: &Path| run_build(build, launch, dir, log_file, options);
+            finish_reference(deck, dir, run, log_file, &mut result);
         }
     }
     (result, None)
+}
+
+/// Runs the deck in `dir` with `build`, launched as `launch`; a build that is not installed
+/// is a skipped run.
+fn run_build(
+    build: &Build,
+    launch: Launch,
+    dir: &Path,
+    log_file: &str,
+    options: &BenchOptions,
+) -> RunStatus {
+    let found = match &build.found {
+        Ok(found) => found,
+        Err(reason) => {
+            return RunStatus::Skipped {
+                reason: reason.clone(),
+                install_hint: decks::INSTALL_HINT.into(),
+            }
+        }
+    };
+    let argv = builds::command(found, launch, decks::DECK_FILE, log_file, runner::cores());
+    let runner = RunnerOptions {
+        stop: None,
+        // The CPU-time limit is per worker, rank or thread.
+        np: Some(launch.workers() as u32),
+        timeout: options.timeout,
+    };
+    runner::run_command(&argv, dir, log_file, &runner)
 }
 
 #[derive(Clone, Debug, Default)]
@@ -200,13 +265,13 @@ fn not_completed(status: RunStatus) -> RunResult {
 
 pub(super) fn timed_run(
     case: &PreparedCase,
-    code: Code,
+    runner: Runner,
     threads: usize,
     repetition: usize,
     dir: &Path,
     options: &BenchOptions,
 ) -> (BenchRun, Option<BenchMemory>) {
-    let (result, _) = run_code(case, &case.timed, code, threads, dir, options);
+    let (result, _) = run_code(case, &case.timed, runner, threads, dir, options);
     let per_s = match (result.particle_steps, result.loop_s) {
         (Some(ps), Some(s)) if s > 0.0 => Some(ps as Real / s),
         _ => None,
@@ -225,10 +290,17 @@ pub(super) fn timed_run(
     (
         BenchRun {
             case: case.name.clone(),
-            code,
+            code: runner.code(),
+            build: runner.build(),
             threads,
-            // The reference runner starts them under mpirun beyond one worker.
-            ranks: (code != Code::Cgdem && threads > 1).then_some(threads),
+            ranks: match runner {
+                Runner::Reference(_, launch) => launch.ranks(),
+                _ => None,
+            },
+            openmp_threads: match runner {
+                Runner::Reference(_, launch) => launch.openmp_threads(),
+                _ => None,
+            },
             repetition,
             status: result.status,
             reason: result.reason,
@@ -244,23 +316,33 @@ pub(super) fn timed_run(
 }
 
 /// The runs at `threads` workers in alternation order: each case with each code on threads
-/// (when `threads` is one of `--threads`), and after cgdem's threaded run of a decomposed
+/// (when `threads` is one of `--threads`), a reference code as each of its builds, each
+/// build as ranks and (with OPENMP) as threads; after cgdem's threaded run of a decomposed
 /// case, its run as that many MPI ranks (when `threads` is one of `--np`).
-pub(super) fn run_order<'c>(
+pub(super) fn run_order<'c, 'b>(
     cases: &'c [PreparedCase],
+    builds: &'b [Build],
     options: &BenchOptions,
     threads: usize,
-) -> Vec<(&'c PreparedCase, Code, Option<usize>)> {
+) -> Vec<(&'c PreparedCase, Runner<'b>)> {
     let threaded = options.threads.contains(&threads);
     let ranks = options.np.contains(&threads);
     let mut order = Vec::new();
     for case in cases {
         for &code in &options.codes {
-            if threaded {
-                order.push((case, code, None));
+            if code == Code::Cgdem {
+                if threaded {
+                    order.push((case, Runner::Cgdem));
+                }
+                if ranks && case.grid.is_some() {
+                    order.push((case, Runner::CgdemRanks(threads)));
+                }
+                continue;
             }
-            if ranks && code == Code::Cgdem && case.grid.is_some() {
-                order.push((case, code, Some(threads)));
+            for build in builds.iter().filter(|b| b.code == code && threaded) {
+                for launch in build.launches(threads) {
+                    order.push((case, Runner::Reference(build, launch)));
+                }
             }
         }
     }
@@ -368,8 +450,10 @@ pub(super) fn ranks_run(
     BenchRun {
         case: case.name.clone(),
         code: Code::Cgdem,
+        build: None,
         threads: np,
         ranks: Some(np),
+        openmp_threads: None,
         repetition,
         status: result.status,
         reason: result.reason,
@@ -403,24 +487,27 @@ fn read_cgdem_summary(dir: &Path) -> RunResult {
 
 pub(super) fn outcome_run(
     case: &PreparedCase,
-    code: Code,
+    runner: Runner,
     threads: usize,
     options: &BenchOptions,
 ) -> BenchOutcome {
+    let (code, build) = (runner.code(), runner.build());
     let Some(full) = &case.full else {
         return BenchOutcome {
             case: case.name.clone(),
             code,
+            build,
             status: "skipped: the timed window already reaches the scene's end".into(),
             simulated_s: 0.0,
             heap: None,
         };
     };
-    let dir = options
-        .out
-        .join(&case.name)
-        .join(format!("{}-outcome", code.name()));
-    let (result, summary) = run_code(case, full, code, threads, &dir, options);
+    let name = match &build {
+        Some(b) => format!("{}-{b}-outcome", code.name()),
+        None => format!("{}-outcome", code.name()),
+    };
+    let dir = options.out.join(&case.name).join(name);
+    let (result, summary) = run_code(case, full, runner, threads, &dir, options);
     let simulated_s = match full.stages[0].end {
         StageEnd::Duration(d) => d,
         _ => 0.0,
@@ -466,6 +553,7 @@ pub(super) fn outcome_run(
                     return BenchOutcome {
                         case: case.name.clone(),
                         code,
+                        build,
                         status: format!("failed: {e}"),
                         simulated_s,
                         heap: None,
@@ -478,6 +566,7 @@ pub(super) fn outcome_run(
     BenchOutcome {
         case: case.name.clone(),
         code,
+        build,
         status: match &result.reason {
             Some(reason) => format!("{}: {reason}", result.status),
             None => result.status.clone(),

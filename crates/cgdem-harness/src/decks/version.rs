@@ -95,22 +95,26 @@ pub fn parse_release(code: Code, banner: &str) -> Option<String> {
 /// The code's version, read once per binary (the code is started with an empty input,
 /// which makes both print their banner and stop); an error when it is not installed.
 pub fn find_version(dialect: &Dialect) -> Result<CodeVersion, String> {
+    version_of(dialect.code, &super::find_program(dialect)?)
+}
+
+/// The version of `program`, a build of `code`, read once per binary.
+pub fn version_of(code: Code, program: &Path) -> Result<CodeVersion, String> {
     static SEEN: OnceLock<Mutex<HashMap<PathBuf, CodeVersion>>> = OnceLock::new();
-    let program = super::find_program(dialect)?;
     let seen = SEEN.get_or_init(Default::default);
-    if let Some(v) = seen.lock().unwrap_or_else(|e| e.into_inner()).get(&program) {
+    if let Some(v) = seen.lock().unwrap_or_else(|e| e.into_inner()).get(program) {
         return Ok(v.clone());
     }
-    let banner = read_banner(&program)?;
+    let banner = read_banner(program)?;
     let version = CodeVersion {
-        code: dialect.code,
-        release: parse_release(dialect.code, &banner),
-        program: program.clone(),
+        code,
+        release: parse_release(code, &banner),
+        program: program.to_path_buf(),
         banner,
     };
     seen.lock()
         .unwrap_or_else(|e| e.into_inner())
-        .insert(program, version.clone());
+        .insert(program.to_path_buf(), version.clone());
     Ok(version)
 }
 
