@@ -145,7 +145,7 @@ fn run_reference(code: Code, case: &str, scene: &Scene, initial: &Particles) -> 
     // Both deck writers take the scene's material tables (reference/MAPPING.md).
     let deck: Deck = match code {
         Code::Liggghts => liggghts::write_deck(scene, initial, DT),
-        _ => lammps::write_hertz_deck(scene, initial, DT),
+        _ => lammps::write_hertz_deck_for(scene, initial, DT, lammps::WallModulus::installed()),
     }
     .expect("deck");
     assert_eq!(deck.plan.dump_every, 1);

@@ -141,7 +141,8 @@ fn run_lammps(
         .join("lammps_golden")
         .join(name);
     let _ = std::fs::remove_dir_all(&dir);
-    let deck = lammps::write_deck(&scene, initial, dt).expect("deck");
+    let deck =
+        lammps::write_deck(&scene, initial, dt, lammps::WallModulus::installed()).expect("deck");
     assert_eq!(deck.plan.dump_every, 1);
     deck.write_to(&dir).expect("write deck");
     let status = lammps::run_deck(&dir, &RunnerOptions::default());

@@ -262,7 +262,9 @@ fn live_end_wall(
         return None;
     }
     let deck = match code {
-        Code::Cgdem | Code::Lammps => lammps::write_deck(scene, particles, dt),
+        Code::Cgdem | Code::Lammps => {
+            lammps::write_deck(scene, particles, dt, lammps::WallModulus::installed())
+        }
         Code::Liggghts => liggghts::write_deck(scene, particles, dt),
     }
     .expect("deck");

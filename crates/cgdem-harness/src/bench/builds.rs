@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use super::BenchError;
+use crate::decks::lammps::WallModulus;
 use crate::decks::version::{version_of, CodeVersion};
 use crate::decks::{dialect, find_program, runner};
 use crate::suite::Code;
@@ -126,6 +127,12 @@ pub struct Build {
 }
 
 impl Build {
+    /// How this build reads a LAMMPS wall's modulus (the verified release's when unknown).
+    pub fn wall_modulus(&self) -> WallModulus {
+        let release = self.found.as_ref().ok();
+        WallModulus::of_release(release.and_then(|f| f.version.release.as_deref()))
+    }
+
     /// The runs of this build at `workers`: as many MPI ranks, and with OPENMP also one
     /// process of as many threads.
     pub fn launches(&self, workers: usize) -> Vec<Launch> {

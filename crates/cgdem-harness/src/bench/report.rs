@@ -126,9 +126,8 @@ pub fn format_report(report: &BenchReport) -> String {
     }
     for f in &report.fastest {
         s += &format!(
-            "{} {}: {} | {} | {:.3e} | {}\n",
+            "{}: {} | {} | {:.3e} | {}\n",
             f.case,
-            f.code.name(),
             f.row,
             f.threads,
             f.median_particle_steps_per_s,

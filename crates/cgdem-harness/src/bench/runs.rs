@@ -126,7 +126,7 @@ fn run_code(
                     liggghts::LOG_FILE,
                 ),
                 _ => (
-                    lammps::write_hertz_deck(scene, &case.state, case.dt),
+                    lammps::write_hertz_deck_for(scene, &case.state, case.dt, build.wall_modulus()),
                     lammps::LOG_FILE,
                 ),
             };

@@ -72,7 +72,7 @@ pub fn dialect(code: Code) -> Option<&'static Dialect> {
 }
 
 /// The deck for a scene (already coarse-grained) in a reference code, starting from
-/// `particles` and stepping `dt`.
+/// `particles` and stepping `dt`; for LAMMPS, in the words of the release the harness finds.
 pub fn write_deck(
     code: Code,
     scene: &Scene,
@@ -80,7 +80,7 @@ pub fn write_deck(
     dt: Real,
 ) -> Result<Deck, DeckError> {
     match code {
-        Code::Lammps => lammps::write_deck(scene, particles, dt),
+        Code::Lammps => lammps::write_deck(scene, particles, dt, lammps::WallModulus::installed()),
         Code::Liggghts => liggghts::write_deck(scene, particles, dt),
         Code::Cgdem => Err(DeckError::unsupported(
             scene,

@@ -92,6 +92,19 @@ pub fn parse_release(code: Code, banner: &str) -> Option<String> {
     }
 }
 
+/// A LAMMPS release's date (`29 Sep 2021`) as (year, month, day), to compare releases.
+pub fn lammps_date(release: &str) -> Option<(i32, u32, u32)> {
+    const MONTHS: [&str; 12] = [
+        "Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec",
+    ];
+    let mut words = release.split_whitespace();
+    let day: u32 = words.next()?.parse().ok()?;
+    let month = words.next()?;
+    let month = MONTHS.iter().position(|m| *m == month)? as u32 + 1;
+    let year: i32 = words.next()?.parse().ok()?;
+    (words.next().is_none() && (1..=31).contains(&day)).then_some((year, month, day))
+}
+
 /// The code's version, read once per binary (the code is started with an empty input,
 /// which makes both print their banner and stop); an error when it is not installed.
 pub fn find_version(dialect: &Dialect) -> Result<CodeVersion, String> {
@@ -121,7 +134,10 @@ pub fn version_of(code: Code, program: &Path) -> Result<CodeVersion, String> {
 /// The first line the program prints that names it, run in a scratch directory (LAMMPS
 /// would otherwise leave a log file in the working directory).
 fn read_banner(program: &Path) -> Result<String, String> {
-    let scratch = std::env::temp_dir().join(format!("cgdem-version-{}", std::process::id()));
+    // One directory per call: threads that read banners at once must not share one.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let scratch = std::env::temp_dir().join(format!("cgdem-version-{}-{call}", std::process::id()));
     std::fs::create_dir_all(&scratch)
         .map_err(|e| format!("cannot make {}: {e}", scratch.display()))?;
     let output = std::process::Command::new(program)
@@ -166,6 +182,23 @@ mod tests {
             Some("22 Jul 2025")
         );
         assert_eq!(parse_release(Code::Lammps, "LAMMPS"), None);
+    }
+
+    #[test]
+    fn lammps_releases_compare_by_date() {
+        assert_eq!(lammps_date("29 Sep 2021"), Some((2021, 9, 29)));
+        assert_eq!(lammps_date("22 Jul 2025"), Some((2025, 7, 22)));
+        assert_eq!(lammps_date("8 Feb 2023"), Some((2023, 2, 8)));
+        assert!(lammps_date("28 Mar 2023") > lammps_date("8 Feb 2023"));
+        for bad in [
+            "",
+            "Sep 2021",
+            "29 Sept 2021",
+            "32 Sep 2021",
+            "29 Sep 2021 x",
+        ] {
+            assert_eq!(lammps_date(bad), None, "{bad}");
+        }
     }
 
     #[test]

@@ -24,7 +24,7 @@ use std::fmt::Write as _;
 use super::bodies::body_lines;
 use super::coefficients::{rolling_stiffness, tangential_damping_ratio, tsuji_q_of};
 use super::tables::{table_pair_lines, wall_fixes, WallGroup};
-use super::{plane_args, removal_pads, DIALECT};
+use super::{plane_args, removal_pads, WallModulus, DIALECT};
 use crate::decks::hertz::{hertz_settings, material, wall_material, HERTZ_COLUMNS};
 use crate::decks::lines::{
     block_region, data_file, frozen_lines, g, neighbor_lines, preamble, unfix_wall, written_by,
@@ -40,8 +40,19 @@ use cgdem_core::scene::{ContactTables, HertzSettings, RollingKind, Scene};
 use cgdem_core::simulation::DELETE_EVERY;
 
 /// The deck for a Hertz `scene` starting from `particles`, stepping `dt`, one frame every
-/// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius).
+/// time-series interval (id type x y z vx vy vz omegax omegay omegaz radius), for the
+/// LAMMPS release the decks were verified against (29 Sep 2021).
 pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Result<Deck, DeckError> {
+    write_hertz_deck_for(scene, particles, dt, WallModulus::BeforeRework)
+}
+
+/// [`write_hertz_deck`] for a LAMMPS that reads the walls' modulus as `modulus` says.
+pub fn write_hertz_deck_for(
+    scene: &Scene,
+    particles: &Particles,
+    dt: Real,
+    modulus: WallModulus,
+) -> Result<Deck, DeckError> {
     let h = hertz_settings(scene, "LAMMPS", true)?;
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     // A scene with material tables: one `pair_coeff I J` per species pair and one wall fix
@@ -79,9 +90,9 @@ pub fn write_hertz_deck(scene: &Scene, particles: &Particles, dt: Real) -> Resul
     let (integrated, freeze) = frozen_lines(scene);
     d += &freeze;
     d += &integration_lines(scene, integrated, dt);
-    let wall_model = wall_model(scene, h, m)?;
+    let wall_model = wall_model(scene, h, m, modulus)?;
     let (wall_lines, wall_groups) = match &tables {
-        Some(t) => wall_fixes(scene, h, t)?,
+        Some(t) => wall_fixes(scene, h, t, modulus)?,
         None => (wall_fix_lines(scene, &wall_model)?, vec![WallGroup::all()]),
     };
     d += &wall_lines;
@@ -221,12 +232,16 @@ fn integration_lines(scene: &Scene, integrated: &str, dt: Real) -> String {
 
 /// The particle-wall model of `fix wall/gran granular` (planar walls and body regions),
 /// empty for a scene with neither.
-fn wall_model(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, DeckError> {
+fn wall_model(
+    scene: &Scene,
+    h: &HertzSettings,
+    m: Material,
+    modulus: WallModulus,
+) -> Result<String, DeckError> {
     let s0 = &scene.species[0];
-    // Particle-wall pair values, passed so that this LAMMPS computes them exactly: its
-    // fix wall/gran hertz/material takes k_n = (4/3) E/(2(1 - nu)) sqrt(R delta) (measured:
-    // contact 10% short with E itself, (1 + nu)^(-2/5)), so E is given as 2 (1 - nu) Y_eff;
-    // the Mindlin stiffness is given explicitly (8 G_eff) rather than NULL.
+    // Particle-wall pair values, passed so that LAMMPS computes them exactly: E such that
+    // its wall stiffness is (4/3) Y_eff sqrt(R delta) ([`WallModulus`]); the Mindlin
+    // stiffness explicitly (8 G_eff) rather than NULL.
     let wm = wall_material(scene, h);
     let (y_w, g_w) = (Material::y_eff(m, wm), Material::g_eff(m, wm));
     let w = &scene.wall_contact;
@@ -251,7 +266,7 @@ fn wall_model(scene: &Scene, h: &HertzSettings, m: Material) -> Result<String, D
     }
     Ok(format!(
         "hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{wall_rolling}",
-        g(2.0 * (1.0 - m.poisson_ratio) * y_w),
+        g(modulus.modulus(y_w, m.poisson_ratio)),
         g(tsuji_q_of(scene, w.restitution)?),
         g(m.poisson_ratio),
         g(8.0 * g_w),

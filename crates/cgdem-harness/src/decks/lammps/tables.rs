@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::coefficients::{rolling_args, tangential_damping_ratio, tsuji_q_of};
-use super::plane_args;
+use super::{plane_args, WallModulus};
 use crate::decks::lines::g;
 use crate::decks::DeckError;
 use cgdem_core::math::Real;
@@ -86,9 +86,10 @@ pub(super) fn wall_fixes(
     scene: &Scene,
     h: &HertzSettings,
     t: &ContactTables,
+    modulus: WallModulus,
 ) -> Result<(String, Vec<WallGroup>), DeckError> {
     let groups = wall_groups(scene);
-    Ok((table_wall_fix_lines(scene, h, t, &groups)?, groups))
+    Ok((table_wall_fix_lines(scene, h, t, &groups, modulus)?, groups))
 }
 
 fn wall_groups(scene: &Scene) -> Vec<WallGroup> {
@@ -122,6 +123,7 @@ fn table_wall_fix_lines(
     h: &HertzSettings,
     t: &ContactTables,
     groups: &[WallGroup],
+    modulus: WallModulus,
 ) -> Result<String, DeckError> {
     let mut lines = String::new();
     for w in groups.iter().filter(|w| w.group != "all") {
@@ -142,7 +144,7 @@ fn table_wall_fix_lines(
                 wall.name,
                 w.suffix,
                 w.group,
-                g(2.0 * (1.0 - nu) * y),
+                g(modulus.modulus(y, nu)),
                 g(tsuji_q_of(scene, p.restitution)?),
                 g(nu),
                 g(8.0 * g_eff),
