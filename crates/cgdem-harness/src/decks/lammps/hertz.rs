@@ -68,15 +68,7 @@ pub fn write_hertz_deck_for(
     let m = material(h);
     let dump_every = ((scene.output.timeseries_interval / dt).round() as u64).max(1);
 
-    let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
-    let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
-    let data = data_file(
-        scene,
-        particles,
-        &diameters,
-        &densities,
-        scene.species.len(),
-    );
+    let data = species_data(scene, particles);
 
     let mut files = Vec::new();
     let mut d = written_by(&DIALECT, scene);
@@ -171,6 +163,19 @@ pub fn write_hertz_deck_for(
             repose_dumps,
         },
     })
+}
+
+/// The data file: one atom type per species, with its diameter and density.
+fn species_data(scene: &Scene, particles: &Particles) -> String {
+    let diameters: Vec<Real> = scene.species.iter().map(|s| s.diameter).collect();
+    let densities: Vec<Real> = scene.species.iter().map(|s| s.density).collect();
+    data_file(
+        scene,
+        particles,
+        &diameters,
+        &densities,
+        scene.species.len(),
+    )
 }
 
 /// `pair_style granular` with the particle-particle `pair_coeff` (Hertz, Tsuji damping,
