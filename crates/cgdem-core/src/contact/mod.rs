@@ -5,6 +5,7 @@
 //! uses. The combination is chosen once, when the scene is read (see `simulation`), never
 //! per contact. Parameters are tables indexed by species pair, `si * n_species + sj`.
 
+mod cap;
 pub mod cohesion;
 pub mod damping;
 mod history;
@@ -12,6 +13,7 @@ pub mod normal;
 pub mod rolling;
 pub mod tangential;
 
+pub use cap::exceeds;
 pub use history::PairHistory;
 
 use crate::math::{Real, Vec3};

@@ -32,9 +32,9 @@
 
 use super::{HertzWall, WallContact, WallLaw};
 use crate::contact::damping::liggghts_damping_factor;
-use crate::contact::normal_force;
 use crate::contact::tangential::{Mindlin, MindlinSpring};
 use crate::contact::TangentialModel;
+use crate::contact::{exceeds, normal_force};
 use crate::math::{Real, Vec3};
 
 #[derive(Clone, Debug)]
@@ -116,9 +116,10 @@ impl<T: TangentialModel<History = Vec3> + MindlinSpring, const LIMIT_FORCE: bool
             let w_t = w - w.dot(n) * n;
             *rolling += k_t * c.radius * c.radius * dt * w_t;
             let limit = rolling_friction * c.radius * T::cap_load(normal_force);
-            let size = rolling.length();
-            if size > limit {
-                *rolling *= limit / size;
+            // `|rolling| > limit` on squares: no square root below the cap (`exceeds`).
+            let size_squared = rolling.length_squared();
+            if exceeds(size_squared, limit) {
+                *rolling *= limit / size_squared.sqrt();
             }
             torque -= *rolling;
         }

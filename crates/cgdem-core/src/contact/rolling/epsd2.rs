@@ -7,7 +7,7 @@
 //! per-pair history and is zeroed when the contact ends. As in LIGGGHTS the stored torque is
 //! not rotated with the contact.
 
-use super::super::{Contact, RollingModel};
+use super::super::{exceeds, Contact, RollingModel};
 use crate::math::{Real, Vec3};
 
 /// Per species pair: `mu_r` and `G_eff` (Pa).
@@ -39,9 +39,10 @@ impl RollingModel for Epsd2 {
         let k_r = k_t * contact.r_eff * contact.r_eff;
         let mut torque = *stored - k_r * rotation;
         let cap = self.rolling_friction[sp] * contact.r_eff * normal_force.abs();
-        let size = torque.length();
-        if size > cap {
-            torque *= cap / size;
+        // `|torque| > cap` on squares: no square root below the cap (`exceeds`).
+        let size_squared = torque.length_squared();
+        if exceeds(size_squared, cap) {
+            torque *= cap / size_squared.sqrt();
         }
         *stored = torque;
         torque

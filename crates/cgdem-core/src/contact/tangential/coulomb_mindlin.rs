@@ -23,7 +23,7 @@
 //! `mindlin`: `u_t = -(F_t + gamma_t v_t)/k_t`) leaves a spring that, at high slip speed,
 //! points the other way and flips the friction force when the slip slows.
 
-use super::super::{Contact, TangentialModel};
+use super::super::{exceeds, Contact, TangentialModel};
 use super::Mindlin;
 use crate::math::{Real, Vec3};
 
@@ -48,10 +48,11 @@ impl TangentialModel for CoulombMindlin {
         let gamma_t = m.damping_factor[sp] * (k_t * contact.m_eff).sqrt();
         let force = -k_t * u - gamma_t * contact.tangential_velocity;
         let cap = m.friction[sp] * Self::cap_load(normal_force);
-        let size = force.length();
-        if size > cap {
+        // `|force| > cap` on squares: no square root below the cap (`exceeds`).
+        let size_squared = force.length_squared();
+        if exceeds(size_squared, cap) {
             // size > cap >= 0: the direction is defined.
-            let capped = force * (cap / size);
+            let capped = force * (cap / size_squared.sqrt());
             *history = if k_t > 0.0 { -capped / k_t } else { Vec3::ZERO };
             capped
         } else {

@@ -10,7 +10,7 @@
 //! (`tangential_model_history.h`; LAMMPS instead rotates keeping the length, then adds). It is
 //! zero when a contact starts; seen from `j` it is `-u_t`.
 
-use super::super::{Contact, TangentialModel};
+use super::super::{exceeds, Contact, TangentialModel};
 use crate::math::{Real, Vec3};
 
 /// Per species pair: `G_eff` (Pa), `2 sqrt(5/6) |beta(e)|`, and `mu`.
@@ -46,9 +46,10 @@ impl TangentialModel for Mindlin {
         let (u, k_t) = self.loaded_spring(contact, *history, dt);
         let spring = -k_t * u;
         let cap = self.friction[sp] * normal_force.abs();
-        let spring_size = spring.length();
-        if spring_size > cap {
-            let capped = spring * (cap / spring_size);
+        // `|spring| > cap` on squares: no square root below the cap (`exceeds`).
+        let spring_squared = spring.length_squared();
+        if exceeds(spring_squared, cap) {
+            let capped = spring * (cap / spring_squared.sqrt());
             *history = if k_t > 0.0 { -capped / k_t } else { Vec3::ZERO };
             capped
         } else {
