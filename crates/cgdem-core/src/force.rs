@@ -6,6 +6,7 @@ use crate::bodies::{mesh_contacts, Body, BodyLoad, BodyShape, Clearance, NearTri
 use crate::contact::{Contact, PairLaw, PairResult};
 use crate::guard::overlap_fraction;
 use crate::math::{Real, Vec3};
+use crate::neighbor::PairConstants;
 use crate::particles::Particles;
 use crate::walls::{WallContact, WallLaw, WallMask, WallParticle, WallSet};
 
@@ -105,7 +106,9 @@ impl FirstParticle {
 
 /// The force of the pair `(i, j)` seen from `i` (`first`), with `j` at `position_j` (its
 /// position, or a periodic image of it); zero (and history reset) when out of range. Also
-/// returns the overlap and the smaller radius, for the guard.
+/// returns the overlap and the smaller radius, for the guard. `constants`: the pair's
+/// effective radius and mass, from the list build.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn pair_force<L: PairLaw>(
     law: &L,
@@ -113,6 +116,7 @@ pub(crate) fn pair_force<L: PairLaw>(
     first: &FirstParticle,
     j: usize,
     position_j: Vec3,
+    constants: PairConstants,
     history: &mut L::History,
     dt: Real,
 ) -> (PairResult, Real, Real) {
@@ -149,12 +153,10 @@ pub(crate) fn pair_force<L: PairLaw>(
         overlap,
         radius_i,
         radius_j,
-        r_eff: radius_i * radius_j / (radius_i + radius_j),
+        r_eff: constants.r_eff,
         inv_mass_i,
         inv_mass_j,
-        // A frozen particle (inverse mass 0) acts with infinite mass, as in LIGGGHTS and
-        // LAMMPS with `fix freeze`; two frozen particles are never listed.
-        m_eff: 1.0 / (inv_mass_i + inv_mass_j),
+        m_eff: constants.m_eff,
         relative_velocity,
         normal_speed,
         tangential_velocity: relative_velocity - normal_speed * normal,

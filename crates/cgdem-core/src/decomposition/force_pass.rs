@@ -97,11 +97,19 @@ fn pair_sums<L: PairLaw, W: WallLaw>(
     // (a macro, written once for the direct pairs and those through an image, so that each
     // loop keeps its sums in registers).
     macro_rules! pair {
-        ($a:expr, $b:expr, $position_b:expr, $history:expr) => {{
+        ($a:expr, $b:expr, $position_b:expr, $constants:expr, $history:expr) => {{
             let (a, b): (usize, usize) = ($a, $b);
             let first = FirstParticle::at(&state, a, physics.n_species);
-            let (result, overlap, smaller_radius) =
-                pair_force(physics.law, &state, &first, b, $position_b, $history, dt);
+            let (result, overlap, smaller_radius) = pair_force(
+                physics.law,
+                &state,
+                &first,
+                b,
+                $position_b,
+                $constants,
+                $history,
+                dt,
+            );
             if overlap > deepest_pair * smaller_radius {
                 deepest_pair = overlap / smaller_radius;
             }
@@ -122,9 +130,10 @@ fn pair_sums<L: PairLaw, W: WallLaw>(
     if !compacts_touching_pairs::<L::History>() {
         // A law without contact history (the seed model) is cheap per pair: a filter first
         // would cost more than it spares (the main job 11% slower, reports/PERFORMANCE.md).
-        for (&[a, b], history) in list.pairs.iter().zip(&mut list.history) {
+        let pairs = list.pairs.iter().zip(&list.constants);
+        for ((&[a, b], &constants), history) in pairs.zip(&mut list.history) {
             let b = b as usize;
-            pair!(a as usize, b, state.position[b], history);
+            pair!(a as usize, b, state.position[b], constants, history);
         }
     } else {
         let count = sort_by_reach(list, pairs_by_reach, state, physics);
@@ -133,7 +142,14 @@ fn pair_sums<L: PairLaw, W: WallLaw>(
             let k = k as usize;
             let [a, b] = list.pairs[k];
             let b = b as usize;
-            pair!(a as usize, b, state.position[b], &mut list.history[k]);
+            let constants = list.constants[k];
+            pair!(
+                a as usize,
+                b,
+                state.position[b],
+                constants,
+                &mut list.history[k]
+            );
         }
     }
     for (image, history) in list.image_pairs.iter().zip(&mut list.image_history) {
@@ -142,6 +158,7 @@ fn pair_sums<L: PairLaw, W: WallLaw>(
             image.pair[0] as usize,
             b,
             state.position[b] + image.shift,
+            image.constants,
             history
         );
     }

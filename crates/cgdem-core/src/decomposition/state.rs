@@ -76,6 +76,7 @@ macro_rules! subdomain_arrays {
         $m!($s.wall_history);
         $m!($s.receives);
         $m!($s.list.pairs);
+        $m!($s.list.constants);
         $m!($s.list.history);
         $m!($s.list.image_pairs);
         $m!($s.list.image_history);
@@ -282,6 +283,7 @@ fn check<H, WH>(
     let l = &s.list;
     if l.reference.len() != owned
         || l.history.len() != l.pairs.len()
+        || l.constants.len() != l.pairs.len()
         || l.image_history.len() != l.image_pairs.len()
         || l.each()
             .any(|([i, j], _, _)| i as usize >= n || j as usize >= n)

@@ -588,6 +588,7 @@ impl<H: PairHistory, WH: PairHistory> Decomposition<H, WH> {
             let l = &sub.list;
             m.pairs += l.len();
             m.pair_bytes += bytes(&l.pairs)
+                + bytes(&l.constants)
                 + bytes(&l.history)
                 + bytes(&l.image_pairs)
                 + bytes(&l.image_history)

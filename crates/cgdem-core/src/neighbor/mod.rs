@@ -8,5 +8,5 @@ mod pair_list;
 mod pair_search;
 
 pub use cell_grid::CellGrid;
-pub use pair_list::{HistoryRows, ImagePair, PairList};
+pub use pair_list::{HistoryRows, ImagePair, PairConstants, PairList};
 pub use pair_search::{brute_force_pairs, pairs_within, Pair};

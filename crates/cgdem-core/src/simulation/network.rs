@@ -8,7 +8,7 @@ use super::World;
 use crate::contact::PairLaw;
 use crate::force::{pair_force, FirstParticle, ParticleState};
 use crate::math::{Real, Vec3};
-use crate::neighbor::pairs_within;
+use crate::neighbor::{pairs_within, PairConstants};
 use crate::walls::WallLaw;
 
 /// One pair the law acts on now (centre distance below its cut-off).
@@ -69,6 +69,7 @@ impl<L: PairLaw, W: WallLaw> World<L, W> {
                     &first,
                     j,
                     p.position[j] + shift,
+                    PairConstants::of(p, i, j),
                     &mut history,
                     self.dt,
                 );
