@@ -44,7 +44,10 @@ impl<'a> ParticleState<'a> {
         }
     }
 
-    /// `p` split into the state a force pass reads and the arrays it writes.
+    /// `p` split into the state a force pass reads and the arrays it writes, every array cut
+    /// to the particle count (`same_length`). Inlined, so that the force pass sees where
+    /// the lengths come from.
+    #[inline(always)]
     pub(crate) fn split(p: &'a mut Particles) -> ForceView<'a> {
         let Particles {
             position,
@@ -57,8 +60,9 @@ impl<'a> ParticleState<'a> {
             angular,
             ..
         } = p;
+        let n = position.len();
         let (omega, torque) = match angular.as_mut() {
-            Some(a) => (Some(a.omega.as_slice()), a.torque.as_mut_slice()),
+            Some(a) => (Some(&a.omega[..n]), &mut a.torque[..n]),
             None => (None, &mut [][..]),
         };
         ForceView {
@@ -70,9 +74,28 @@ impl<'a> ParticleState<'a> {
                 mass,
                 inv_mass,
                 species,
-            },
-            force,
+            }
+            .same_length(),
+            force: &mut force[..n],
             torque,
+        }
+    }
+
+    /// Every array cut to `position.len()` (they all have that length): the compiler then
+    /// sees one length for all, so the pair loop's first index check of a particle (its
+    /// position) stands for the others (its velocity, spin, radius, mass, species), which it
+    /// drops. The same values, so the same bits; only checks go.
+    #[inline(always)]
+    fn same_length(self) -> Self {
+        let n = self.position.len();
+        ParticleState {
+            position: self.position,
+            velocity: &self.velocity[..n],
+            omega: self.omega.map(|w| &w[..n]),
+            radius: &self.radius[..n],
+            mass: &self.mass[..n],
+            inv_mass: &self.inv_mass[..n],
+            species: &self.species[..n],
         }
     }
 }

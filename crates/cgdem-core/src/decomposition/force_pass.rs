@@ -138,17 +138,20 @@ fn pair_sums<L: PairLaw, W: WallLaw>(
     } else {
         let count = sort_by_reach(list, pairs_by_reach, state, physics);
         forget_out_of_reach(list, &pairs_by_reach[count..]);
+        // Cut to the pairs' length: the check of `pairs[k]` stands for the other two.
+        let listed = list.pairs.len();
+        let (pairs, constants) = (&list.pairs[..], &list.constants[..listed]);
+        let history = &mut list.history[..listed];
         for &k in &pairs_by_reach[..count] {
             let k = k as usize;
-            let [a, b] = list.pairs[k];
+            let [a, b] = pairs[k];
             let b = b as usize;
-            let constants = list.constants[k];
             pair!(
                 a as usize,
                 b,
                 state.position[b],
-                constants,
-                &mut list.history[k]
+                constants[k],
+                &mut history[k]
             );
         }
     }
