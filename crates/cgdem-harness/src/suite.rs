@@ -58,6 +58,8 @@ pub struct SuiteCase {
     pub keep_going: bool,
     /// Measured as a silo discharge (`[case.discharge]`, `crate::quantity::discharge`).
     pub discharge: Option<crate::quantity::discharge::DischargeSettings>,
+    /// Measured as a rotating drum (`[case.drum]`, `crate::quantity::drum`).
+    pub drum: Option<crate::quantity::drum::DrumSettings>,
 }
 
 impl SuiteCase {
@@ -141,6 +143,7 @@ struct RawCase {
     #[serde(default)]
     keep_going: bool,
     discharge: Option<crate::quantity::discharge::RawDischarge>,
+    drum: Option<crate::quantity::drum::RawDrum>,
 }
 
 #[derive(Deserialize)]
@@ -245,6 +248,7 @@ impl Suite {
             rpms: Vec::new(),
             keep_going: false,
             discharge: None,
+            drum: None,
         };
         let case = parse_case(raw, 0, file)?;
         Ok(Suite {
@@ -382,6 +386,10 @@ fn parse_case(c: RawCase, k: usize, path: &Path) -> Result<SuiteCase, SuiteError
         discharge: c
             .discharge
             .map(|d| crate::quantity::discharge::parse_discharge(d, &format!("case[{k}]"), path))
+            .transpose()?,
+        drum: c
+            .drum
+            .map(|d| crate::quantity::drum::parse_drum(d, &format!("case[{k}]"), path))
             .transpose()?,
     })
 }

@@ -9,6 +9,7 @@
 //! - [`flow`]: a collapse's dynamics: front, height at the wall, kinetic energy, t_half.
 //! - [`mass_flow`]: a screw feeder's mass flow, beside Eq. (7).
 //! - [`discharge`]: a silo's or hopper's discharge rate, beside Beverloo's law.
+//! - [`drum`]: a rotating drum's zone counts, dynamic angle and mixing index.
 //! - [`porosity`]: a packing's porosity and pore size.
 //! - [`seeds`]: runs grouped by all but their seed, and the statistics over a group.
 //!
@@ -18,6 +19,7 @@
 //! arguments.
 
 pub mod discharge;
+pub mod drum;
 pub mod flow;
 pub mod mass_flow;
 pub mod porosity;

@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::faults::{self, Faults};
-use crate::quantity::{discharge, mass_flow};
+use crate::quantity::{discharge, drum, mass_flow};
 use crate::report::Report;
 use crate::runs::output_error;
 use crate::suite::{Suite, SuiteCase};
@@ -239,6 +239,11 @@ fn run_cases(
         .map(|(s, _, m)| (s.name.clone(), m))
         .collect();
     for (scene, case, case_runs) in scenes {
+        if case.drum.is_some() {
+            report_drum_case(report, &scene, &case, &case_runs, options)?;
+            runs.extend(case_runs);
+            continue;
+        }
         if let Some(settings) = &case.discharge {
             let measured = silos.iter().find(|(n, _)| *n == scene.name).map(|(_, m)| m);
             let measured = measured.map_or(&[][..], |m| m.as_slice());
@@ -290,6 +295,30 @@ fn run_cases(
         comparisons.extend(case_comparisons);
     }
     Ok((runs, comparisons))
+}
+
+/// A drum case (`[case.drum]`): every run measured from its frames, and its section.
+fn report_drum_case(
+    report: &mut Report,
+    scene: &Scene,
+    case: &SuiteCase,
+    case_runs: &[RunRecord],
+    options: &ValidateOptions,
+) -> Result<(), ValidateError> {
+    let Some(settings) = &case.drum else {
+        return Ok(());
+    };
+    let measured = drum::measure_runs(scene, settings, case_runs);
+    drum::write_drum_section(
+        report,
+        scene,
+        &case.origin(),
+        settings,
+        &measured,
+        &options.out,
+    )?;
+    write_code_notes(report, case_runs);
+    Ok(())
 }
 
 /// A screw case: cgdem's mass flow judged against each reference code's, speed by speed,

@@ -1,0 +1,167 @@
+//! The report of a drum case: the rules, a table of each run's steady means, the zone
+//! counts, the surface angle and Lacey's index against time for every run, and every
+//! frame's measures as CSV (`figures/<case>/drum_frames.csv`) beside the figures.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{DrumRun, DrumSettings};
+use crate::quantity::{show_figure, CaseOrigin};
+use crate::report::{Cell, Figure, Report, Series, SeriesStyle, Table};
+use crate::runs::{output_error, ValidateError};
+use cgdem_core::io::write_atomic;
+use cgdem_core::scene::Scene;
+
+fn num(v: Option<f64>, digits: usize) -> Cell {
+    Cell::num(v.map_or("-".into(), |x| format!("{x:.digits$}")))
+}
+
+fn label(r: &DrumRun) -> String {
+    format!("{} l{} s{}", r.code.name(), r.lambda, r.seed)
+}
+
+/// The section of one drum case.
+pub fn write_drum_section(
+    report: &mut Report,
+    scene: &Scene,
+    case: &CaseOrigin,
+    settings: &DrumSettings,
+    runs: &[DrumRun],
+    out: &Path,
+) -> Result<(), ValidateError> {
+    let dir = out.join("figures").join(&scene.name);
+    let section = report.section(format!("Case {}: rotating drum", scene.name));
+    section.paragraph(format!(
+        "{} Scene file: {}. Seeds: {:?}. From each frame (every code's grains at the frame's time; times from the start of stage `{}`, when the drum starts turning; earlier frames are the settle): the grains of the small (M1) and the large (M2) species whose centre lies in zone 1 (x > 0, z > 0, the upper quadrant on the side where the wall rises) and zone 2 (x < 0, z < 0), as MercuryDPM counts them; the dynamic angle of repose: the highest grain top in bins of two small-grain diameters along x, a least-squares line through the bins between 20% and 80% of the occupied span, atan of its slope, positive when the surface rises towards +x; Lacey's index of the large grains' volume fraction in cubic cells of 2.5 large-grain diameters with at least 10 grains (0 segregated, 1 random). Steady means: the frames from {} s of rotation on. reference/DRUM.md defines the three.",
+        scene.description,
+        case.file.display(),
+        case.seeds,
+        settings.stage,
+        settings.steady_from_s,
+    ));
+    let mut table = Table::new([
+        "run",
+        "frames",
+        "zone 1 M1",
+        "zone 1 M2",
+        "zone 2 M1",
+        "zone 2 M2",
+        "angle, deg",
+        "Lacey",
+        "problem",
+    ])
+    .caption(format!(
+        "Means over the steady frames (from {} s of rotation)",
+        settings.steady_from_s
+    ));
+    for r in runs {
+        let m = r.steady_means(settings.steady_from_s);
+        let count = |k: usize| num(m.map(|m| m.counts[k]), 0);
+        table.row([
+            Cell::text(label(r)),
+            Cell::num(m.map_or(0, |m| m.frames).to_string()),
+            count(0),
+            count(1),
+            count(2),
+            count(3),
+            num(m.and_then(|m| m.angle_deg), 1),
+            num(m.and_then(|m| m.lacey), 3),
+            Cell::text(r.problem.clone().unwrap_or_default()),
+        ]);
+    }
+    section.table(table);
+    let frames_csv = dir.join("drum_frames.csv");
+    std::fs::create_dir_all(&dir).map_err(|e| output_error(&dir, e))?;
+    write_atomic(&frames_csv, frames_table(runs).as_bytes())
+        .map_err(|e| output_error(&frames_csv, e))?;
+    for (stem, figure, caption) in figures(runs) {
+        show_figure(
+            section,
+            &dir,
+            stem,
+            &figure,
+            (&figure.title.clone(), caption),
+        )?;
+    }
+    section.paragraph(format!("Every frame's measures: {}.", frames_csv.display()));
+    Ok(())
+}
+
+/// Every measured frame of every run as CSV.
+fn frames_table(runs: &[DrumRun]) -> String {
+    let mut csv = String::from(
+        "code,lambda,seed,time_s,zone1_m1,zone1_m2,zone2_m1,zone2_m2,surface_angle_deg,surface_r2,lacey_index,lacey_cells\n",
+    );
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6}"));
+    for r in runs {
+        for f in &r.frames {
+            let [a, b, c, d] = f.counts.as_array();
+            let _ = writeln!(
+                csv,
+                "{},{},{},{:.6},{a},{b},{c},{d},{},{},{},{}",
+                r.code.name(),
+                r.lambda,
+                r.seed,
+                f.time_s,
+                opt(f.surface.map(|s| s.angle_deg)),
+                opt(f.surface.map(|s| s.r2)),
+                opt(f.lacey.map(|l| l.index)),
+                f.lacey.map_or(String::new(), |l| l.cells.to_string()),
+            );
+        }
+    }
+    csv
+}
+
+/// The zone counts, the surface angle and Lacey's index against time, every run.
+fn figures(runs: &[DrumRun]) -> Vec<(&'static str, Figure, &'static str)> {
+    let mut counts = Figure::new(
+        "Zone counts against time",
+        "time since the drum started, s",
+        "grains",
+    );
+    let mut angle = Figure::new(
+        "Dynamic angle of repose",
+        "time since the drum started, s",
+        "surface angle, deg",
+    );
+    let mut lacey = Figure::new(
+        "Lacey's mixing index",
+        "time since the drum started, s",
+        "Lacey index",
+    );
+    let names = ["zone 1 M1", "zone 1 M2", "zone 2 M1", "zone 2 M2"];
+    for r in runs.iter().filter(|r| !r.frames.is_empty()) {
+        for (k, name) in names.iter().enumerate() {
+            let points = r
+                .frames
+                .iter()
+                .map(|f| (f.time_s, f.counts.as_array()[k] as f64))
+                .collect();
+            let style = if k < 2 {
+                SeriesStyle::LineMarkers
+            } else {
+                SeriesStyle::Dashed
+            };
+            counts = counts
+                .with_series(Series::new(format!("{} {name}", label(r)), points).style(style));
+        }
+        let points = r
+            .frames
+            .iter()
+            .filter_map(|f| f.surface.map(|s| (f.time_s, s.angle_deg)))
+            .collect();
+        angle = angle.with_series(Series::new(label(r), points).style(SeriesStyle::LineMarkers));
+        let points = r
+            .frames
+            .iter()
+            .filter_map(|f| f.lacey.map(|l| (f.time_s, l.index)))
+            .collect();
+        lacey = lacey.with_series(Series::new(label(r), points).style(SeriesStyle::LineMarkers));
+    }
+    vec![
+        ("drum_zone_counts", counts, "Grains of each species in MercuryDPM's zones 1 and 2 (solid: zone 1, dashed: zone 2); negative times are the settle."),
+        ("drum_surface_angle", angle, "The free surface's angle by the rule above, per frame."),
+        ("drum_lacey", lacey, "Lacey's index of the large grains' volume fraction, per frame."),
+    ]
+}
