@@ -157,7 +157,7 @@ struct RawKnownDifference {
 }
 
 /// The criteria a comparison is judged by (`verdict::Criterion::name`).
-pub const CRITERIA: [&str; 7] = [
+pub const CRITERIA: [&str; 12] = [
     crate::quantity::repose::CRITERION,
     "t_half ratio",
     "front gap",
@@ -165,6 +165,11 @@ pub const CRITERIA: [&str; 7] = [
     "kinetic energy gap",
     crate::quantity::discharge::CRITERION,
     crate::quantity::mass_flow::CRITERION,
+    crate::quantity::drum::CRITERIA[0],
+    crate::quantity::drum::CRITERIA[1],
+    crate::quantity::drum::CRITERIA[2],
+    crate::quantity::drum::CRITERIA[3],
+    crate::quantity::drum::CRITERIA[4],
 ];
 
 impl Suite {

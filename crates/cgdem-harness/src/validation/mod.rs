@@ -240,7 +240,9 @@ fn run_cases(
         .collect();
     for (scene, case, case_runs) in scenes {
         if case.drum.is_some() {
-            report_drum_case(report, &scene, &case, &case_runs, options)?;
+            comparisons.extend(report_drum_case(
+                report, &scene, &case, &case_runs, options,
+            )?);
             runs.extend(case_runs);
             continue;
         }
@@ -297,28 +299,41 @@ fn run_cases(
     Ok((runs, comparisons))
 }
 
-/// A drum case (`[case.drum]`): every run measured from its frames, and its section.
+/// A drum case (`[case.drum]`): every run measured from its frames, cgdem's verdict against
+/// the reference codes (when both ran), and its section.
 fn report_drum_case(
     report: &mut Report,
     scene: &Scene,
     case: &SuiteCase,
     case_runs: &[RunRecord],
     options: &ValidateOptions,
-) -> Result<(), ValidateError> {
+) -> Result<Option<Comparison>, ValidateError> {
     let Some(settings) = &case.drum else {
-        return Ok(());
+        return Ok(None);
     };
     let measured = drum::measure_runs(scene, settings, case_runs);
+    let verdict = drum::drum_criteria(&measured, settings.steady_from_s, &case.known_differences)
+        .map(|(criteria, text)| {
+            Comparison::judged(
+                &scene.name,
+                "codes",
+                "steady rotation",
+                drum::COMPARISON,
+                text,
+                criteria,
+            )
+        });
     drum::write_drum_section(
         report,
         scene,
         &case.origin(),
         settings,
         &measured,
+        verdict.as_ref().map(|c| (c.verdict, c.detail.as_str())),
         &options.out,
     )?;
     write_code_notes(report, case_runs);
-    Ok(())
+    Ok(verdict)
 }
 
 /// A screw case: cgdem's mass flow judged against each reference code's, speed by speed,

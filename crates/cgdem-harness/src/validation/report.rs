@@ -51,9 +51,9 @@ fn criteria_table(comparisons: &[Comparison]) -> Table {
          threshold = physical tolerance + {} x noise, the noise being the combined standard \
          error of the two sides from their seeds (0 where a side has one seed; a screw's \
          mass flow: the two sides' standard errors added, each from its runs' blocks or its \
-         seeds' spread; a silo's discharge rate: inside the value); a declared \
-         known difference is judged by its band instead (amber inside, red outside). The \
-         comparison's verdict is its worst criterion's.",
+         seeds' spread; a silo's discharge rate and a drum's counts and angle: inside the \
+         value); a declared known difference is judged by its band instead (amber inside, \
+         red outside). The comparison's verdict is its worst criterion's.",
         crate::verdict::K_NOISE
     ));
     for (k, c) in comparisons.iter().enumerate() {

@@ -1,4 +1,5 @@
-//! The report of a drum case: the rules, a table of each run's steady means, the zone
+//! The report of a drum case: the rules, cgdem's verdict against the reference codes, a
+//! table of each run's steady means and swing (`figures/<case>/drum_runs.csv`), the zone
 //! counts, the surface angle and Lacey's index against time for every run, and every
 //! frame's measures as CSV (`figures/<case>/drum_frames.csv`) beside the figures.
 
@@ -9,7 +10,8 @@ use super::{DrumRun, DrumSettings};
 use crate::quantity::{show_figure, CaseOrigin};
 use crate::report::{Cell, Figure, Report, Series, SeriesStyle, Table};
 use crate::runs::{output_error, ValidateError};
-use cgdem_core::io::write_atomic;
+use crate::verdict::Verdict;
+use cgdem_core::io::{write_atomic, CsvBuffer};
 use cgdem_core::scene::Scene;
 
 fn num(v: Option<f64>, digits: usize) -> Cell {
@@ -20,25 +22,35 @@ fn label(r: &DrumRun) -> String {
     format!("{} l{} s{}", r.code.name(), r.lambda, r.seed)
 }
 
-/// The section of one drum case.
+/// The section of one drum case, with cgdem's verdict (and the means in words) when it has
+/// one.
 pub fn write_drum_section(
     report: &mut Report,
     scene: &Scene,
     case: &CaseOrigin,
     settings: &DrumSettings,
     runs: &[DrumRun],
+    verdict: Option<(Verdict, &str)>,
     out: &Path,
 ) -> Result<(), ValidateError> {
     let dir = out.join("figures").join(&scene.name);
     let section = report.section(format!("Case {}: rotating drum", scene.name));
     section.paragraph(format!(
-        "{} Scene file: {}. Seeds: {:?}. From each frame (every code's grains at the frame's time; times from the start of stage `{}`, when the drum starts turning; earlier frames are the settle): the grains of the small (M1) and the large (M2) species whose centre lies in zone 1 (x > 0, z > 0, the upper quadrant on the side where the wall rises) and zone 2 (x < 0, z < 0), as MercuryDPM counts them; the dynamic angle of repose: the highest grain top in bins of two small-grain diameters along x, a least-squares line through the bins between 20% and 80% of the occupied span, atan of its slope, positive when the surface rises towards +x; Lacey's index of the large grains' volume fraction in cubic cells of 2.5 large-grain diameters with at least 10 grains (0 segregated, 1 random). Steady means: the frames from {} s of rotation on. reference/DRUM.md defines the three.",
+        "{} Scene file: {}. Seeds: {:?}. From each frame (every code's grains at the frame's time; times from the start of stage `{}`, when the drum starts turning; earlier frames are the settle): the grains of the small (M1) and the large (M2) species whose centre lies in zone 1 (x > 0, z > 0, the upper quadrant on the side where the wall rises) and zone 2 (x < 0, z < 0), as MercuryDPM counts them; the dynamic angle of repose: the highest grain top in bins of two small-grain diameters along x, a least-squares line through the bins between 20% and 80% of the occupied span, atan of its slope, positive when the surface rises towards +x; Lacey's index of the large grains' volume fraction in cubic cells of 2.5 large-grain diameters with at least 10 grains (0 segregated, 1 random). Steady means: the frames from {} s of rotation on. The swing of the zone counts over the same frames: for trial periods from two frame intervals to the window's length, 0.5% apart, each count fitted by least squares with a constant and a sinusoid of that period; the period is the one that leaves the least of the four counts' variance unexplained (each count weighed by its own variance), the amplitude each sinusoid's (half its swing); none when the best period is the window's length (less than one swing seen). reference/DRUM.md defines the measures. cgdem's verdict: each zone count's and the angle's mean over cgdem's seeds within the reference codes' spread, every code's mean widened by two standard errors of its seeds' mean (a count's gap as a share of the reference codes' mean, the angle's in degrees).",
         scene.description,
         case.file.display(),
         case.seeds,
         settings.stage,
         settings.steady_from_s,
     ));
+    if let Some((verdict, text)) = verdict {
+        let status = match verdict {
+            Verdict::Pass => crate::report::Status::Pass,
+            Verdict::KnownDifference => crate::report::Status::Known,
+            Verdict::Fail => crate::report::Status::Fail,
+        };
+        section.banner(status, format!("Zone counts and dynamic angle: {text}."));
+    }
     let mut table = Table::new([
         "run",
         "frames",
@@ -48,6 +60,8 @@ pub fn write_drum_section(
         "zone 2 M2",
         "angle, deg",
         "Lacey",
+        "swing period, s",
+        "swing amplitudes (grains)",
         "problem",
     ])
     .caption(format!(
@@ -56,6 +70,7 @@ pub fn write_drum_section(
     ));
     for r in runs {
         let m = r.steady_means(settings.steady_from_s);
+        let swing = r.oscillation(settings.steady_from_s);
         let count = |k: usize| num(m.map(|m| m.counts[k]), 0);
         table.row([
             Cell::text(label(r)),
@@ -66,12 +81,21 @@ pub fn write_drum_section(
             count(3),
             num(m.and_then(|m| m.angle_deg), 1),
             num(m.and_then(|m| m.lacey), 3),
+            num(swing.map(|o| o.period_s), 2),
+            Cell::num(swing.map_or("-".into(), |o| {
+                (o.amplitudes.map(|a| format!("{a:.0}"))).join(" / ")
+            })),
             Cell::text(r.problem.clone().unwrap_or_default()),
         ]);
     }
     section.table(table);
-    let frames_csv = dir.join("drum_frames.csv");
     std::fs::create_dir_all(&dir).map_err(|e| output_error(&dir, e))?;
+    let runs_csv = dir.join("drum_runs.csv");
+    runs_table(runs, settings.steady_from_s)
+        .bytes()
+        .and_then(|bytes| write_atomic(&runs_csv, bytes))
+        .map_err(|e| output_error(&runs_csv, e))?;
+    let frames_csv = dir.join("drum_frames.csv");
     write_atomic(&frames_csv, frames_table(runs).as_bytes())
         .map_err(|e| output_error(&frames_csv, e))?;
     for (stem, figure, caption) in figures(runs) {
@@ -83,8 +107,60 @@ pub fn write_drum_section(
             (&figure.title.clone(), caption),
         )?;
     }
-    section.paragraph(format!("Every frame's measures: {}.", frames_csv.display()));
+    section.paragraph(format!(
+        "Each run's steady means and swing: {}. Every frame's measures: {}.",
+        runs_csv.display(),
+        frames_csv.display()
+    ));
     Ok(())
+}
+
+/// Each run's steady means and swing as CSV.
+fn runs_table(runs: &[DrumRun], steady_from_s: f64) -> CsvBuffer {
+    let mut csv = CsvBuffer::new([
+        "code",
+        "lambda",
+        "seed",
+        "steady_frames",
+        "zone1_m1",
+        "zone1_m2",
+        "zone2_m1",
+        "zone2_m2",
+        "surface_angle_deg",
+        "lacey_index",
+        "swing_period_s",
+        "swing_amplitude_zone1_m1",
+        "swing_amplitude_zone1_m2",
+        "swing_amplitude_zone2_m1",
+        "swing_amplitude_zone2_m2",
+        "swing_explained",
+    ]);
+    let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6}"));
+    for r in runs {
+        let m = r.steady_means(steady_from_s);
+        let swing = r.oscillation(steady_from_s);
+        let count = |k: usize| o(m.map(|m| m.counts[k]));
+        let amplitude = |k: usize| o(swing.map(|s| s.amplitudes[k]));
+        csv.row([
+            r.code.name().to_string(),
+            r.lambda.to_string(),
+            r.seed.to_string(),
+            m.map_or(0, |m| m.frames).to_string(),
+            count(0),
+            count(1),
+            count(2),
+            count(3),
+            o(m.and_then(|m| m.angle_deg)),
+            o(m.and_then(|m| m.lacey)),
+            o(swing.map(|s| s.period_s)),
+            amplitude(0),
+            amplitude(1),
+            amplitude(2),
+            amplitude(3),
+            o(swing.map(|s| s.explained)),
+        ]);
+    }
+    csv
 }
 
 /// Every measured frame of every run as CSV.

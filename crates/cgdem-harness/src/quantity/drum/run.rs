@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use super::measurement::{
     lacey_index, surface_angle, zone_counts, Grain, Lacey, SurfaceLine, ZoneCounts,
 };
+use super::oscillation::{oscillation, Oscillation};
 use super::DrumSettings;
 use crate::code::Code;
 use crate::runs::{Outcome, RunRecord};
@@ -80,6 +81,21 @@ impl DrumRun {
                     .collect(),
             ),
         })
+    }
+}
+
+impl DrumRun {
+    /// The swing of the zone counts over the frames at or after `steady_from_s` of the
+    /// rotation (`oscillation`); None where it is not resolved.
+    pub fn oscillation(&self, steady_from_s: f64) -> Option<Oscillation> {
+        let steady: Vec<&FrameMeasure> = (self.frames.iter())
+            .filter(|f| f.time_s >= steady_from_s - 1e-9)
+            .collect();
+        let times: Vec<f64> = steady.iter().map(|f| f.time_s).collect();
+        let counts: Vec<[f64; 4]> = (steady.iter())
+            .map(|f| f.counts.as_array().map(|c| c as f64))
+            .collect();
+        oscillation(&times, &counts)
     }
 }
 

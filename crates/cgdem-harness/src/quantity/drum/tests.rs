@@ -254,11 +254,21 @@ fn a_run_is_measured_from_its_frames_and_reported() {
         keep_going: false,
     };
     let mut report = crate::report::Report::new("drum");
-    super::write_drum_section(&mut report, &scene, &origin, &settings, &runs, &out).unwrap();
+    super::write_drum_section(&mut report, &scene, &origin, &settings, &runs, None, &out).unwrap();
     let csv = std::fs::read_to_string(out.join("figures/drum_reduced/drum_frames.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3, "{csv}");
     assert!(lines[2].starts_with("cgdem,1,1,1.500000,1,1,0,1,"), "{csv}");
+    let runs_csv = std::fs::read_to_string(out.join("figures/drum_reduced/drum_runs.csv")).unwrap();
+    // One steady frame: means, no swing.
+    assert!(
+        runs_csv
+            .lines()
+            .nth(1)
+            .unwrap()
+            .starts_with("cgdem,1,1,1,1.000000,1.000000,0.000000,1.000000,"),
+        "{runs_csv}"
+    );
     assert!(out
         .join("figures/drum_reduced/drum_zone_counts.png")
         .exists());
