@@ -31,7 +31,8 @@ pub(super) struct AdviseArgs {
     /// report (e.g. aor_hertz-fidelity).
     case: String,
     /// repose_angle (deg), profile, mass_flow, mass_flow_eq7, t_half, front_history,
-    /// pore_size, discharge_rate (relative) or porosity (absolute).
+    /// pore_size, discharge_rate (relative), porosity (absolute); for a rotating drum measured
+    /// by a suite: dynamic_angle (deg), mixing_period (relative), mixing_index (absolute).
     #[arg(long)]
     quantity: String,
     /// The largest error allowed, in the quantity's unit (e.g. 2 for 2 deg, 0.05 for 5%).

@@ -159,6 +159,6 @@ fn the_complete_example_uses_every_documented_key_and_parses() {
             suite.accuracy.len(),
             suite.stability.len()
         ),
-        (2, 1, 1)
+        (2, 2, 1)
     );
 }

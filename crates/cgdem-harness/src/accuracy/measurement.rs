@@ -95,6 +95,29 @@ pub struct AccuracyPoint {
     /// two blocks of the window, an arch over the orifice (a clog).
     #[serde(default)]
     pub flow_stopped_at_s: Option<f64>,
+    /// A drum's dynamic angle of repose, deg: its mean over the steady frames
+    /// (`crate::quantity::drum`).
+    #[serde(default)]
+    pub dynamic_angle_deg: Option<f64>,
+    /// |dynamic angle - the reference run's with the same seed|, deg.
+    #[serde(default)]
+    pub dynamic_angle_error_deg: Option<f64>,
+    /// The period of a drum's zone-count swing over the steady frames, s.
+    #[serde(default)]
+    pub mixing_period_s: Option<f64>,
+    /// |period / the reference run's with the same seed - 1|.
+    #[serde(default)]
+    pub mixing_period_error: Option<f64>,
+    /// A drum's Lacey index, mean over the steady frames (0 segregated, 1 random).
+    #[serde(default)]
+    pub mixing_index: Option<f64>,
+    /// |Lacey index - the reference run's with the same seed|.
+    #[serde(default)]
+    pub mixing_index_error: Option<f64>,
+    /// The large grains' share of the solid volume in a drum's zones 1 and 2 (steady means):
+    /// the segregation the zones see, the same measure at every lambda.
+    #[serde(default)]
+    pub large_share_zones: Option<[f64; 2]>,
 }
 
 impl AccuracyPoint {
@@ -110,6 +133,9 @@ impl AccuracyPoint {
             pore_size_error: None,
             front_error: None,
             discharge_rate_error: None,
+            dynamic_angle_error_deg: None,
+            mixing_period_error: None,
+            mixing_index_error: None,
             ..self.clone()
         }
     }
@@ -155,10 +181,13 @@ pub enum Measure {
     Porosity,
     PoreSize,
     DischargeRate,
+    DynamicAngle,
+    MixingPeriod,
+    MixingIndex,
 }
 
 impl Measure {
-    pub const ALL: [Measure; 9] = [
+    pub const ALL: [Measure; 12] = [
         Measure::Angle,
         Measure::Profile,
         Measure::MassFlow,
@@ -168,6 +197,9 @@ impl Measure {
         Measure::Porosity,
         Measure::PoreSize,
         Measure::DischargeRate,
+        Measure::DynamicAngle,
+        Measure::MixingPeriod,
+        Measure::MixingIndex,
     ];
 
     /// The run's error under this measure.
@@ -182,6 +214,9 @@ impl Measure {
             Measure::Porosity => p.porosity_error,
             Measure::PoreSize => p.pore_size_error,
             Measure::DischargeRate => p.discharge_rate_error,
+            Measure::DynamicAngle => p.dynamic_angle_error_deg,
+            Measure::MixingPeriod => p.mixing_period_error,
+            Measure::MixingIndex => p.mixing_index_error,
         }
     }
 
@@ -197,6 +232,9 @@ impl Measure {
             Measure::Porosity => "porosity",
             Measure::PoreSize => "pore_size",
             Measure::DischargeRate => "discharge_rate",
+            Measure::DynamicAngle => "dynamic_angle",
+            Measure::MixingPeriod => "mixing_period",
+            Measure::MixingIndex => "mixing_index",
         }
     }
 
@@ -215,6 +253,9 @@ impl Measure {
             Measure::Porosity => "porosity vs reference",
             Measure::PoreSize => "pore size (in diameters) vs reference",
             Measure::DischargeRate => "discharge rate vs reference",
+            Measure::DynamicAngle => "dynamic angle vs reference",
+            Measure::MixingPeriod => "mixing period vs reference",
+            Measure::MixingIndex => "mixing index vs reference",
         }
     }
 
@@ -229,6 +270,9 @@ impl Measure {
             Measure::Porosity => "porosity_error",
             Measure::PoreSize => "pore_size_error",
             Measure::DischargeRate => "discharge_rate_error",
+            Measure::DynamicAngle => "dynamic_angle_error",
+            Measure::MixingPeriod => "mixing_period_error",
+            Measure::MixingIndex => "mixing_index_error",
         }
     }
 
@@ -243,6 +287,9 @@ impl Measure {
             Measure::Porosity => "|porosity - reference| [-]",
             Measure::PoreSize => "|pore diameter / d over the reference's - 1| [-]",
             Measure::DischargeRate => "|W / W_reference - 1| (discharge rate) [-]",
+            Measure::DynamicAngle => "|dynamic angle - reference| [deg]",
+            Measure::MixingPeriod => "|T / T_reference - 1| (zone-count swing) [-]",
+            Measure::MixingIndex => "|Lacey index - reference| [-]",
         }
     }
 
@@ -256,14 +303,17 @@ impl Measure {
             Measure::Porosity => t.porosity,
             Measure::PoreSize => t.pore_size,
             Measure::DischargeRate => t.discharge_rate,
+            Measure::DynamicAngle => t.dynamic_angle_deg,
+            Measure::MixingPeriod => t.mixing_period,
+            Measure::MixingIndex => t.mixing_index,
         }
     }
 
     /// A value in the measure's unit, for tables and answers.
     pub fn format(self, v: f64) -> String {
         match self {
-            Measure::Angle => format!("{v:.2} deg"),
-            Measure::Porosity => format!("{v:.4}"),
+            Measure::Angle | Measure::DynamicAngle => format!("{v:.2} deg"),
+            Measure::Porosity | Measure::MixingIndex => format!("{v:.4}"),
             _ => format!("{:.1}%", 100.0 * v),
         }
     }
@@ -336,6 +386,9 @@ pub(crate) fn measure(points: &mut [AccuracyPoint]) {
         p.porosity_error = difference(Measure::Porosity, p, r);
         p.pore_size_error = difference(Measure::PoreSize, p, r);
         p.discharge_rate_error = difference(Measure::DischargeRate, p, r);
+        p.dynamic_angle_error_deg = difference(Measure::DynamicAngle, p, r);
+        p.mixing_period_error = difference(Measure::MixingPeriod, p, r);
+        p.mixing_index_error = difference(Measure::MixingIndex, p, r);
     }
 }
 
@@ -363,6 +416,9 @@ fn difference(m: Measure, p: &AccuracyPoint, r: &AccuracyPoint) -> Option<f64> {
         Measure::DischargeRate => {
             finite((p.discharge_rate_kg_s? / r.discharge_rate_kg_s? - 1.0).abs())
         }
+        Measure::DynamicAngle => finite((p.dynamic_angle_deg? - r.dynamic_angle_deg?).abs()),
+        Measure::MixingPeriod => finite((p.mixing_period_s? / r.mixing_period_s? - 1.0).abs()),
+        Measure::MixingIndex => finite((p.mixing_index? - r.mixing_index?).abs()),
     }
 }
 

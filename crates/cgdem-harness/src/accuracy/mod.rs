@@ -18,11 +18,15 @@
 //! with every seed and code), `measurement` (errors, means over seeds, the cheapest setting)
 //! and `report` (the subsection, its figures, `points.csv` and the coarse-graining matrix);
 //! `discharge` puts a silo's discharge rate into the points and the report (a sweep with a
-//! `discharge` table). What each run measures, and how, is `crate::quantity`'s.
+//! `discharge` table), `drum` a rotating drum's angle, mixing period and segregation (a sweep
+//! with a `drum` table). What each run measures, and how, is `crate::quantity`'s.
 
 mod discharge;
 #[cfg(test)]
 mod discharge_tests;
+mod drum;
+#[cfg(test)]
+mod drum_tests;
 mod measurement;
 mod report;
 mod runs;

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use super::discharge::write_discharge_table;
+use super::drum::write_drum_table;
 use super::measurement::candidates;
 use super::{
     cheapest_setting, measure_named, pareto_front, settings, AccuracyPoint, AccuracySweep,
@@ -51,6 +52,9 @@ pub(crate) fn write_sweep_section(
     }
     if let Some(discharge) = &sweep.discharge {
         write_discharge_table(sub, discharge, points, dir)?;
+    }
+    if sweep.drum.is_some() {
+        write_drum_table(sub, points, dir)?;
     }
     sub.table(table);
     Ok(cheapest)
@@ -127,7 +131,7 @@ fn points_table(points: &[AccuracyPoint], measures: &[Measure]) -> Table {
             _ => match (p.discharge_rate_kg_s, p.flow_stopped_at_s) {
                 (Some(w), None) => format!("discharge {w:.4} kg/s"),
                 (Some(w), Some(t)) => format!("discharge {w:.4} kg/s, stopped at {t:.2} s"),
-                _ => "-".into(),
+                _ => drum_result(p),
             },
         };
         table.row(
@@ -189,6 +193,14 @@ fn points_csv(points: &[AccuracyPoint]) -> CsvBuffer {
         "bulk_density_kg_m3",
         "particle_diameter_m",
         "flow_stopped_at_s",
+        "dynamic_angle_deg",
+        "dynamic_angle_error_deg",
+        "mixing_period_s",
+        "mixing_period_error",
+        "mixing_index",
+        "mixing_index_error",
+        "large_share_zone1",
+        "large_share_zone2",
     ]);
     let o = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.6e}"));
     for p in points {
@@ -227,9 +239,26 @@ fn points_csv(points: &[AccuracyPoint]) -> CsvBuffer {
             o(p.bulk_density_kg_m3),
             o(p.particle_diameter_m),
             o(p.flow_stopped_at_s),
+            o(p.dynamic_angle_deg),
+            o(p.dynamic_angle_error_deg),
+            o(p.mixing_period_s),
+            o(p.mixing_period_error),
+            o(p.mixing_index),
+            o(p.mixing_index_error),
+            o(p.large_share_zones.map(|z| z[0])),
+            o(p.large_share_zones.map(|z| z[1])),
         ]);
     }
     csv
+}
+
+/// A drum run's result in words, or "-".
+fn drum_result(p: &AccuracyPoint) -> String {
+    match (p.dynamic_angle_deg, p.mixing_period_s) {
+        (Some(a), Some(t)) => format!("drum {a:.2} deg, swing {t:.2} s"),
+        (Some(a), None) => format!("drum {a:.2} deg, swing not resolved"),
+        _ => "-".into(),
+    }
 }
 
 /// One figure per error measure and cost, with each code's cheapest setting per measure.

@@ -5,9 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use super::discharge::measure_discharge;
+use super::drum::measure_drum;
 use super::{AccuracyPoint, AccuracySweep, Knob, KnobSeries};
 use crate::code::Code;
 use crate::quantity::discharge::DischargeSettings;
+use crate::quantity::drum::DrumSettings;
 use crate::quantity::flow::{flow_stage, measured_t_half};
 use crate::quantity::mass_flow::conveying_value;
 use crate::quantity::porosity::{pore_diameter_in_diameters, porosity};
@@ -193,7 +195,7 @@ pub(crate) fn run_sweep(
             &run.scene,
             (run.code, run.lambda, run.rule, run.seed),
             &run.dir,
-            sweep.discharge.as_ref(),
+            (sweep.discharge.as_ref(), sweep.drum.as_ref()),
             options,
         );
         let p = AccuracyPoint {
@@ -224,12 +226,12 @@ pub(crate) fn run_sweep(
 }
 
 /// Runs one point (or reuses it) and reads what it measured; with `discharge`, the run is
-/// measured as a silo's discharge.
+/// measured as a silo's discharge, with `drum` as a rotating drum.
 fn run_point(
     scene: &Scene,
     (code, lambda, rule, seed): (Code, u32, CoarseGrainRule, u64),
     dir: &Path,
-    discharge: Option<&DischargeSettings>,
+    (discharge, drum): (Option<&DischargeSettings>, Option<&DrumSettings>),
     options: &ValidateOptions,
 ) -> AccuracyPoint {
     let mut record = run_one(scene, code, lambda, rule, seed, dir, options);
@@ -245,6 +247,7 @@ fn run_point(
     // without a heap or a flow to measure.
     if record.status == Outcome::Ok
         && discharge.is_none()
+        && drum.is_none()
         && record.repose_angle_deg.is_none()
         && conveying_value(&summary, "mass_flow_kg_s").is_none()
         && porosity(&summary).is_none()
@@ -299,11 +302,24 @@ fn run_point(
         bulk_density_kg_m3: None,
         particle_diameter_m: None,
         flow_stopped_at_s: None,
+        dynamic_angle_deg: None,
+        dynamic_angle_error_deg: None,
+        mixing_period_s: None,
+        mixing_period_error: None,
+        mixing_index: None,
+        mixing_index_error: None,
+        large_share_zones: None,
     };
     if let Some(d) = discharge.filter(|_| ok) {
         if let Err(problem) = measure_discharge(scene, d, &measured, &mut point) {
             point.status = Outcome::Failed;
             point.reason = Some(format!("measured no discharge: {problem}"));
+        }
+    }
+    if let Some(d) = drum.filter(|_| ok) {
+        if let Err(problem) = measure_drum(scene, d, &measured, &mut point) {
+            point.status = Outcome::Failed;
+            point.reason = Some(format!("measured no drum: {problem}"));
         }
     }
     point

@@ -85,6 +85,12 @@ pub struct Targets {
     pub pore_size: f64,
     /// Relative discharge-rate error (a silo's, against the reference run).
     pub discharge_rate: f64,
+    /// A drum's dynamic angle of repose, deg.
+    pub dynamic_angle_deg: f64,
+    /// Relative error of the period of a drum's zone-count swing.
+    pub mixing_period: f64,
+    /// Absolute difference of a drum's Lacey index.
+    pub mixing_index: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -104,6 +110,10 @@ pub struct AccuracySweep {
     /// How each run is measured as a discharge (`discharge`, as a suite case's): the silo's
     /// rate, as mass, against the reference's.
     pub discharge: Option<crate::quantity::discharge::DischargeSettings>,
+    /// How each run is measured as a rotating drum (`drum`, as a suite case's): its dynamic
+    /// angle, the period of its zone counts' swing and its Lacey index, against the
+    /// reference's.
+    pub drum: Option<crate::quantity::drum::DrumSettings>,
 }
 
 #[derive(Deserialize)]
@@ -126,6 +136,10 @@ pub(crate) struct RawSweep {
     pore_size_target: Option<f64>,
     discharge_rate_target: Option<f64>,
     discharge: Option<crate::quantity::discharge::RawDischarge>,
+    dynamic_angle_target_deg: Option<f64>,
+    mixing_period_target: Option<f64>,
+    mixing_index_target: Option<f64>,
+    drum: Option<crate::quantity::drum::RawDrum>,
 }
 
 #[derive(Deserialize)]
@@ -170,6 +184,13 @@ fn parse_targets(raw: &RawSweep, k: usize, path: &Path) -> Result<Targets, Suite
         porosity: target("porosity_target", raw.porosity_target, 0.02)?,
         pore_size: target("pore_size_target", raw.pore_size_target, 0.1)?,
         discharge_rate: target("discharge_rate_target", raw.discharge_rate_target, 0.05)?,
+        dynamic_angle_deg: target(
+            "dynamic_angle_target_deg",
+            raw.dynamic_angle_target_deg,
+            2.0,
+        )?,
+        mixing_period: target("mixing_period_target", raw.mixing_period_target, 0.1)?,
+        mixing_index: target("mixing_index_target", raw.mixing_index_target, 0.05)?,
     })
 }
 
@@ -278,6 +299,9 @@ impl AccuracySweep {
                 crate::quantity::discharge::parse_discharge(d, &format!("accuracy[{k}]"), path)
             })
             .transpose()?;
+        let drum = (raw.drum.take())
+            .map(|d| crate::quantity::drum::parse_drum(d, &format!("accuracy[{k}]"), path))
+            .transpose()?;
         Ok(AccuracySweep {
             file: crate::suite_entry::beside_suite(path, &raw.file),
             overrides,
@@ -288,6 +312,7 @@ impl AccuracySweep {
             series,
             targets,
             discharge,
+            drum,
         })
     }
 

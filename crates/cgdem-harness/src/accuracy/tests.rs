@@ -84,6 +84,13 @@ pub(crate) fn run(
         bulk_density_kg_m3: None,
         particle_diameter_m: None,
         flow_stopped_at_s: None,
+        dynamic_angle_deg: None,
+        dynamic_angle_error_deg: None,
+        mixing_period_s: None,
+        mixing_period_error: None,
+        mixing_index: None,
+        mixing_index_error: None,
+        large_share_zones: None,
     }
 }
 
@@ -144,6 +151,9 @@ fn errors_pair_runs_by_seed_and_settings_average_over_seeds() {
         porosity: 0.02,
         pore_size: 0.1,
         discharge_rate: 0.05,
+        dynamic_angle_deg: 2.0,
+        mixing_period: 0.1,
+        mixing_index: 0.05,
     };
     let c = cheapest_setting("c", Code::Cgdem, Measure::Angle, &targets, &points);
     assert_eq!(c.setting, None);

@@ -346,6 +346,8 @@ fn sweep(
             .collect(),
         targets,
         discharge: discharge_settings(scene, opening),
+        // A drum is measured as its suite says (`[case.drum]`): a scene alone cannot.
+        drum: None,
     }
 }
 
@@ -359,6 +361,9 @@ const DEFAULT_TARGETS: Targets = Targets {
     porosity: 0.02,
     pore_size: 0.1,
     discharge_rate: 0.05,
+    dynamic_angle_deg: 2.0,
+    mixing_period: 0.1,
+    mixing_index: 0.05,
 };
 
 fn set_target(t: &mut Targets, m: Measure, target: f64) {
@@ -371,6 +376,9 @@ fn set_target(t: &mut Targets, m: Measure, target: f64) {
         Measure::Porosity => &mut t.porosity,
         Measure::PoreSize => &mut t.pore_size,
         Measure::DischargeRate => &mut t.discharge_rate,
+        Measure::DynamicAngle => &mut t.dynamic_angle_deg,
+        Measure::MixingPeriod => &mut t.mixing_period,
+        Measure::MixingIndex => &mut t.mixing_index,
     };
     *slot = target;
 }

@@ -3,9 +3,11 @@
 //! repose by a stated rule and Lacey's mixing index (`measurement`); the period and
 //! amplitude of the zone counts' swing (`oscillation`); each frame of a run read and
 //! measured, and the means over its steady part (`run`); cgdem's verdict against the
-//! reference codes (`verdict`); the case's section with its figures and CSV (`report`). How
-//! a run is measured (`settings`) comes from a suite's `[case.drum]` table.
+//! reference codes (`verdict`); the case's section with its figures and CSV (`report`); the
+//! measures per coarse-graining level of an accuracy sweep (`levels`). How a run is measured
+//! (`settings`) comes from a suite's `[case.drum]` table or an `[[accuracy]]` entry's `drum`.
 
+mod levels;
 mod measurement;
 mod oscillation;
 mod report;
@@ -15,6 +17,7 @@ mod settings;
 mod tests;
 mod verdict;
 
+pub use levels::{write_levels_table, LevelMeans};
 pub use measurement::{
     lacey_index, surface_angle, zone_counts, Grain, Lacey, SurfaceLine, ZoneCounts,
 };
