@@ -116,8 +116,9 @@ pub fn repose_angle(
     })
 }
 
-/// Slope and R^2 of the least-squares line through `points` (at least 3).
-fn least_squares(points: &[(Real, Real)]) -> Option<(Real, Real)> {
+/// Slope and R^2 of the least-squares line through `points` (at least 3, not all at one x);
+/// a line through points all at one height fits them exactly: R^2 = 1.
+pub fn least_squares(points: &[(Real, Real)]) -> Option<(Real, Real)> {
     if points.len() < 3 {
         return None;
     }

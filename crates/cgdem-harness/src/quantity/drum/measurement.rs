@@ -77,36 +77,12 @@ pub fn surface_angle(grains: &[Grain], bin_width: f64) -> Option<SurfaceLine> {
         .filter(|(&b, _)| (from..=to).contains(&(b as f64 + 0.5)))
         .map(|(&b, &h)| ((b as f64 + 0.5) * bin_width, h))
         .collect();
-    let (slope, r2) = line_fit(&points)?;
+    let (slope, r2) = cgdem_core::analysis::heap::least_squares(&points)?;
     Some(SurfaceLine {
         angle_deg: slope.atan().to_degrees(),
         r2,
         bins: points.len(),
     })
-}
-
-/// Least-squares slope and R^2 of at least three points with distinct x.
-fn line_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
-    if points.len() < 3 {
-        return None;
-    }
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let syy: f64 = points.iter().map(|p| (p.1 - my).powi(2)).sum();
-    if sxx <= 0.0 {
-        return None;
-    }
-    let slope = sxy / sxx;
-    let residual = syy - slope * sxy;
-    let r2 = if syy > 0.0 {
-        1.0 - residual / syy
-    } else {
-        f64::NAN
-    };
-    Some((slope, r2))
 }
 
 /// Lacey's mixing index and the cells it used.
