@@ -21,9 +21,9 @@
 
 use std::fmt::Write as _;
 
-use super::bodies::body_lines;
+use super::bodies::{body_lines, BodyLines};
 use super::coefficients::{rolling_stiffness, tangential_damping_ratio, tsuji_q_of};
-use super::tables::{table_pair_lines, wall_fixes, WallGroup};
+use super::tables::{table_pair_lines, table_wall_model, wall_fixes, WallGroup};
 use super::{plane_args, removal_pads, WallModulus, DIALECT};
 use crate::decks::hertz::{hertz_settings, material, wall_material, HERTZ_COLUMNS};
 use crate::decks::lines::{
@@ -58,8 +58,8 @@ pub fn write_hertz_deck_for(
     // A scene with material tables: one `pair_coeff I J` per species pair and one wall fix
     // per wall and mobile species (`super::tables`); without, the one material of `[contact]`.
     let tables = if scene.gives_material_tables() {
-        if !scene.bodies.is_empty() {
-            return Err(unsupported("LAMMPS decks with bodies take the one material and coefficients of [contact] and [wall_contact]: this scene has materials per species or pair (LIGGGHTS decks take them)".into()));
+        if scene.bodies.iter().any(|b| b.particles.is_some()) {
+            return Err(unsupported("LAMMPS decks with bodies built of particles take the one material and coefficients of [contact] and [wall_contact]: this scene has materials per species or pair (LIGGGHTS decks take them)".into()));
         }
         Some(ContactTables::of_hertz(scene, h))
     } else {
@@ -88,16 +88,15 @@ pub fn write_hertz_deck_for(
         None => (wall_fix_lines(scene, &wall_model)?, vec![WallGroup::all()]),
     };
     d += &wall_lines;
-    let bodies = body_lines(scene, integrated, &wall_model)?;
+    let walls = RegionWalls {
+        tables: tables.as_ref().map(|t| (h, t, modulus)),
+        groups: &wall_groups,
+        integrated,
+        wall_model: &wall_model,
+    };
+    let bodies = body_lines(scene, dt, &|region, k| walls.fixes(scene, region, k))?;
     d += &bodies.setup;
-    // Later setups (`run 0` after a body starts turning or a top-up) re-apply LAMMPS's Tsuji
-    // polynomial to its wall fixes' coefficient; the body region's fix is defined anew
-    // before each, planar walls cannot be.
-    let later_setups = scene.bodies.iter().any(|b| b.start_stage.is_some())
-        || scene.insertions.iter().any(|i| i.refill.is_some());
-    if later_setups && !scene.walls.is_empty() {
-        return Err(unsupported("planar walls with a top-up or a body that starts later: LAMMPS would re-apply its Tsuji polynomial to the walls' damping at each setup (reference/HERTZ_COLLAPSE.md)".into()));
-    }
+    let later_setups = later_setups(scene, &bodies)?;
     for (start, motion) in &bodies.motions {
         if start.is_none() {
             d += motion;
@@ -126,7 +125,8 @@ pub fn write_hertz_deck_for(
             lines += &bodies.refix_walls;
             lines += "run             0 post no\n";
         }
-        lines
+        let turns = bodies.turns.iter().filter(|(start, _)| start == stage);
+        turns.map(|(_, l)| l.as_str()).collect::<String>() + &lines
     };
     let periodic = |stage: &str| top_ups.periodic(stage, &bodies.refix_walls);
     let repose_dumps = stage_lines(
@@ -163,6 +163,56 @@ pub fn write_hertz_deck_for(
             repose_dumps,
         },
     })
+}
+
+/// Whether the deck sets up again after its first run: later setups (`run 0` after a
+/// particle body starts turning or a top-up) re-apply LAMMPS's Tsuji polynomial to its wall
+/// fixes' coefficient; the body region's fix is defined anew before each, planar walls
+/// cannot be (refused). A turning region needs none.
+fn later_setups(scene: &Scene, bodies: &BodyLines) -> Result<bool, DeckError> {
+    let later = bodies.motions.iter().any(|(start, _)| start.is_some())
+        || scene.insertions.iter().any(|i| i.refill.is_some());
+    if later && !scene.walls.is_empty() {
+        return Err(DeckError::unsupported(scene, "planar walls with a top-up or a body that starts later: LAMMPS would re-apply its Tsuji polynomial to the walls' damping at each setup (reference/HERTZ_COLLAPSE.md)".into()));
+    }
+    Ok(later)
+}
+
+/// What a region body's wall fixes are made of: the deck's one wall model on the mobile
+/// atoms (`integrated`), or with material tables one fix per wall group.
+struct RegionWalls<'a> {
+    tables: Option<(&'a HertzSettings, &'a ContactTables, WallModulus)>,
+    groups: &'a [WallGroup],
+    integrated: &'a str,
+    wall_model: &'a str,
+}
+
+impl RegionWalls<'_> {
+    /// The `fix wall/gran/region` lines of `region`, with material tables each species
+    /// against the body's wall material `k`.
+    fn fixes(&self, scene: &Scene, region: &str, k: usize) -> Result<String, DeckError> {
+        let mut lines = String::new();
+        for w in self.groups {
+            let (group, model) = match (self.tables, w.species) {
+                (Some((h, t, modulus)), Some(a)) => (
+                    w.group.as_str(),
+                    table_wall_model(scene, h, t, a, k, modulus)?,
+                ),
+                _ => ("all", self.wall_model.to_string()),
+            };
+            let group = if group == "all" {
+                self.integrated
+            } else {
+                group
+            };
+            let _ = writeln!(
+                lines,
+                "fix             w_{region}{} {group} wall/gran/region granular {model} region {region}",
+                w.suffix
+            );
+        }
+        Ok(lines)
+    }
 }
 
 /// The data file: one atom type per species, with its diameter and density.

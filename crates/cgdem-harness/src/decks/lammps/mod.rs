@@ -5,6 +5,7 @@
 
 mod bodies;
 pub mod coefficients;
+mod cylinder;
 pub mod hertz;
 pub mod tables;
 pub mod wca;

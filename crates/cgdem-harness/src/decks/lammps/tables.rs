@@ -113,6 +113,31 @@ fn wall_groups(scene: &Scene) -> Vec<WallGroup> {
     }
 }
 
+/// The `granular` arguments of species `a` against wall material `k` (see
+/// [`table_wall_fix_lines`]).
+pub(super) fn table_wall_model(
+    scene: &Scene,
+    h: &HertzSettings,
+    t: &ContactTables,
+    a: usize,
+    k: usize,
+    modulus: WallModulus,
+) -> Result<String, DeckError> {
+    let (s, nu) = (&scene.species[a], t.species[a].poisson_ratio);
+    let (y, g_eff) = (t.wall_y_eff(a, k), t.wall_g_eff(a, k));
+    let p = t.wall_pair(a, k);
+    Ok(format!(
+        "hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{}",
+        g(modulus.modulus(y, nu)),
+        g(tsuji_q_of(scene, p.restitution)?),
+        g(nu),
+        g(8.0 * g_eff),
+        g(tangential_damping_ratio(y, g_eff)),
+        g(p.friction),
+        rolling_args(h, p, y, g_eff, s.radius(), s.mass())
+    ))
+}
+
 /// The wall fixes of a scene with material tables: for each planar wall and each of
 /// `groups`, the model of that species against the wall's material. The wall fix of this
 /// LAMMPS takes `k_n = (4/3) E/(2 (1 - nu)) sqrt(R delta)`, so `E = 2 (1 - nu) Y*` with the
@@ -134,23 +159,13 @@ fn table_wall_fix_lines(
         let plane = plane_args(scene, wall)?;
         for w in groups {
             let a = w.species.expect("a table wall group names its species");
-            let k = wall.material;
-            let (s, nu) = (&scene.species[a], t.species[a].poisson_ratio);
-            let (y, g_eff) = (t.wall_y_eff(a, k), t.wall_g_eff(a, k));
-            let p = t.wall_pair(a, k);
             let _ = writeln!(
                 lines,
-                "fix             w_{}{} {} wall/gran granular hertz/material {} {} {} damping tsuji tangential mindlin {} {} {}{} {plane}",
+                "fix             w_{}{} {} wall/gran granular {} {plane}",
                 wall.name,
                 w.suffix,
                 w.group,
-                g(modulus.modulus(y, nu)),
-                g(tsuji_q_of(scene, p.restitution)?),
-                g(nu),
-                g(8.0 * g_eff),
-                g(tangential_damping_ratio(y, g_eff)),
-                g(p.friction),
-                rolling_args(h, p, y, g_eff, s.radius(), s.mass())
+                table_wall_model(scene, h, t, a, wall.material, modulus)?
             );
         }
     }
