@@ -276,7 +276,7 @@ fn cylinder_lines(
         g(c.hi)
     );
     out.notes.push(format!(
-        "LAMMPS: the body `{}` is a cylinder region about {} of radius {} m from {} to {} m, closed at both ends: a true circle where the mesh is a {}-gon. The radius is the {}-gon's corners' (the circle the mesh was drawn on, the drum's stated radius); its faces lie up to {:.2e} m closer to the axis (apothem {} m). The smooth circle drags the grains by friction alone, where the polygon's corners also push them; and LAMMPS's region contact takes the wall's curvature (R* = 2 r R/(2 R - r) for a grain of radius r), where the flat faces give R* = r",
+        "LAMMPS: the body `{}` is a cylinder region about {} of radius {:.6} m from {:.6} to {:.6} m, closed at both ends: a true circle where the mesh is a {}-gon. The radius is the {}-gon's corners' (the circle its vertices were placed on, so the nominal radius of a drum drawn as an N-gon on it, as the drum's STL and MercuryDPM's triangles are); its faces lie up to {:.2e} m closer to the axis (apothem {:.6} m). The smooth circle drags the grains by friction alone, where the polygon's corners also push them; and LAMMPS's region contact takes the wall's curvature (R* = 2 r R/(2 R - r) for a grain of radius r), where the flat faces give R* = r",
         b.name,
         c.dim_name(),
         c.radius,

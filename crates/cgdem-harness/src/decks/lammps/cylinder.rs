@@ -41,7 +41,7 @@ const TOLERANCE: Real = 1e-5;
 /// across it in one of two planes that bound the lateral faces (the end caps), and the
 /// surface must be closed.
 pub(crate) fn closed_cylinder(mesh: &TriMesh, point: Vec3, axis: Vec3) -> Result<Cylinder, String> {
-    if !(axis.length() > 0.0) {
+    if !axis.is_finite() || axis.length() == 0.0 {
         return Err("it has no axis".into());
     }
     let a = axis / axis.length();
@@ -64,7 +64,7 @@ pub(crate) fn closed_cylinder(mesh: &TriMesh, point: Vec3, axis: Vec3) -> Result
         .iter()
         .map(|&v| off(v).max(along(v).abs()))
         .fold(0.0, Real::max);
-    if !(size > 0.0) || mesh.triangles.is_empty() {
+    if !size.is_finite() || size == 0.0 || mesh.triangles.is_empty() {
         return Err("its mesh is empty".into());
     }
     let tol = TOLERANCE * size;
@@ -181,7 +181,7 @@ fn faces(
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let [p, q, r] = tri.map(|i| mesh.vertices[i as usize]);
         let n = (q - p).cross(r - p);
-        if !(n.length() > 0.0) {
+        if n.length() == 0.0 {
             continue;
         }
         let n = n / n.length();
