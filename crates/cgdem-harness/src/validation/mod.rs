@@ -312,8 +312,8 @@ fn report_drum_case(
         return Ok(None);
     };
     let measured = drum::measure_runs(scene, settings, case_runs);
-    let verdict = drum::drum_criteria(&measured, settings.steady_from_s, &case.known_differences)
-        .map(|(criteria, text)| {
+    let verdict = drum::drum_criteria(&measured, settings, &case.known_differences).map(
+        |(criteria, text)| {
             Comparison::judged(
                 &scene.name,
                 "codes",
@@ -322,7 +322,8 @@ fn report_drum_case(
                 text,
                 criteria,
             )
-        });
+        },
+    );
     drum::write_drum_section(
         report,
         scene,

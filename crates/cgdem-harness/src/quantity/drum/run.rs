@@ -47,13 +47,31 @@ pub struct SteadyMeans {
 }
 
 impl DrumRun {
+    /// The frames from `steady_from_s` of rotation on, to the nearest frame: a frame within
+    /// half a frame interval before it counts. cgdem writes a frame one time step after
+    /// each multiple of the frame period, the reference codes' dumps at the multiple itself;
+    /// both must give the same frames.
+    fn steady_frames(&self, steady_from_s: f64) -> Vec<&FrameMeasure> {
+        let rotating: Vec<f64> = (self.frames.iter())
+            .map(|f| f.time_s)
+            .filter(|&t| t >= 0.0)
+            .collect();
+        let interval = (rotating.windows(2))
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min);
+        let slack = if interval.is_finite() {
+            0.5 * interval
+        } else {
+            1e-9
+        };
+        (self.frames.iter())
+            .filter(|f| f.time_s >= steady_from_s - slack)
+            .collect()
+    }
+
     /// Means over the frames at or after `steady_from_s` of the rotation; None without any.
     pub fn steady_means(&self, steady_from_s: f64) -> Option<SteadyMeans> {
-        let steady: Vec<&FrameMeasure> = self
-            .frames
-            .iter()
-            .filter(|f| f.time_s >= steady_from_s - 1e-9)
-            .collect();
+        let steady = self.steady_frames(steady_from_s);
         if steady.is_empty() {
             return None;
         }
@@ -88,9 +106,7 @@ impl DrumRun {
     /// The swing of the zone counts over the frames at or after `steady_from_s` of the
     /// rotation (`oscillation`); None where it is not resolved.
     pub fn oscillation(&self, steady_from_s: f64) -> Option<Oscillation> {
-        let steady: Vec<&FrameMeasure> = (self.frames.iter())
-            .filter(|f| f.time_s >= steady_from_s - 1e-9)
-            .collect();
+        let steady = self.steady_frames(steady_from_s);
         let times: Vec<f64> = steady.iter().map(|f| f.time_s).collect();
         let counts: Vec<[f64; 4]> = (steady.iter())
             .map(|f| f.counts.as_array().map(|c| c as f64))

@@ -159,7 +159,25 @@ fn settings_are_checked() {
         "case[0]",
         path,
     );
-    assert_eq!(ok.unwrap().steady_from_s, 1.0);
+    let ok = ok.unwrap();
+    assert_eq!(ok.steady_from_s, 1.0);
+    assert_eq!(
+        (ok.count_tolerance, ok.angle_tolerance_deg),
+        (
+            super::settings::DEFAULT_COUNT_TOLERANCE,
+            super::settings::DEFAULT_ANGLE_TOLERANCE_DEG
+        )
+    );
+    let negative = parse_drum(
+        toml::from_str("stage = \"rotate\"\nsteady_from = 1.0\ncount_tolerance = -0.1").unwrap(),
+        "case[0]",
+        path,
+    );
+    let message = negative.unwrap_err().to_string();
+    assert!(
+        message.contains("case[0].drum.count_tolerance"),
+        "{message}"
+    );
     let bad = parse_drum(
         toml::from_str("stage = \"rotate\"\nsteady_from = -1.0").unwrap(),
         "case[0]",
@@ -222,6 +240,8 @@ fn a_run_is_measured_from_its_frames_and_reported() {
     let settings = super::DrumSettings {
         stage: "rotate".into(),
         steady_from_s: 1.0,
+        count_tolerance: 0.03,
+        angle_tolerance_deg: 1.0,
     };
     let record = crate::runs::RunRecord::ok(
         "drum_reduced".into(),

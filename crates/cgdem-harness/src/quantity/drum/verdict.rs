@@ -1,12 +1,12 @@
 //! cgdem's verdict on a drum case, one of the suite's comparisons: each zone count and the
 //! dynamic angle, cgdem's steady mean over its seeds within the reference codes' spread,
 //! each code's mean widened by two standard errors of the mean over its seeds (the silo's
-//! rule, `quantity::discharge::verdict`). A count's gap is a share of the reference codes'
-//! mean count; the angle's is in degrees.
+//! rule, `quantity::discharge::verdict`), give or take a stated tolerance. A count's gap is
+//! a share of the reference codes' mean count; the angle's is in degrees.
 
 use std::fmt::Write as _;
 
-use super::{DrumRun, SteadyMeans};
+use super::{DrumRun, DrumSettings, SteadyMeans};
 use crate::code::Code;
 use crate::quantity::seeds::mean_se;
 use crate::verdict::{Criterion, KnownDifference};
@@ -63,9 +63,10 @@ fn code_means(code: Code, runs: &[DrumRun], steady_from_s: f64) -> Option<CodeMe
 /// difference of [`COMPARISON`] and its name holds its gap in the band, red otherwise.
 pub fn drum_criteria(
     runs: &[DrumRun],
-    steady_from_s: f64,
+    settings: &DrumSettings,
     known: &[KnownDifference],
 ) -> Option<(Vec<Criterion>, String)> {
+    let steady_from_s = settings.steady_from_s;
     let cgdem = code_means(Code::Cgdem, runs, steady_from_s)?;
     let refs: Vec<CodeMeans> = [Code::Liggghts, Code::Lammps]
         .iter()
@@ -93,12 +94,17 @@ pub fn drum_criteria(
             .max(0.0);
         let angle = k == 4;
         let reference_mean = sides.iter().map(|s| s.1).sum::<f64>() / sides.len() as f64;
-        let (gap, unit) = if angle {
-            (outside, "deg outside the reference codes' spread")
+        let (gap, unit, tolerance) = if angle {
+            (
+                outside,
+                "deg outside the reference codes' spread",
+                settings.angle_tolerance_deg,
+            )
         } else {
             (
                 outside / reference_mean.max(1.0),
                 "of the reference count, outside their spread",
+                settings.count_tolerance,
             )
         };
         let digits = if angle { 2 } else { 0 };
@@ -125,7 +131,7 @@ pub fn drum_criteria(
         let known = known.iter().find(|d| d.applies_to(COMPARISON, name));
         // The noise is already in the gap (each mean widened by two standard errors); a side
         // with one seed has none, which the criterion's description says.
-        let criterion = Criterion::judge(name, unit, gap, 0.0, seeds, 0.0, known);
+        let criterion = Criterion::judge(name, unit, gap, 0.0, seeds, tolerance, known);
         criteria.push(if seeds.iter().all(|&n| n > 1) {
             criterion.with_noise_rule(
                 "in the gap, each code's mean over its seeds widened by 2 standard errors",
@@ -170,6 +176,15 @@ mod tests {
         }
     }
 
+    fn settings(count_tolerance: f64) -> DrumSettings {
+        DrumSettings {
+            stage: "rotate".into(),
+            steady_from_s: 1.0,
+            count_tolerance,
+            angle_tolerance_deg: 0.5,
+        }
+    }
+
     /// Three seeds per code, the counts and angles a few percent apart between seeds.
     fn runs(cgdem_zone2_m1: usize, cgdem_angle: f64) -> Vec<DrumRun> {
         let mut out = Vec::new();
@@ -202,7 +217,7 @@ mod tests {
 
     #[test]
     fn codes_within_each_others_seed_spread_pass() {
-        let (criteria, text) = drum_criteria(&runs(2810, 36.4), 1.0, &[]).unwrap();
+        let (criteria, text) = drum_criteria(&runs(2810, 36.4), &settings(0.0), &[]).unwrap();
         assert_eq!(criteria.len(), 5);
         assert!(
             criteria.iter().all(|c| c.verdict == Verdict::Pass),
@@ -217,7 +232,7 @@ mod tests {
         // cgdem's zone 2 M1 at 2540 +- 23.1 over its seeds (2 SE 46.2); LIGGGHTS's 2840
         // +- 23.1: the bands [2493.8, 2586.2] and [2793.8, 2886.2] are 207.6 apart, 7.3% of
         // 2840.
-        let (criteria, _) = drum_criteria(&runs(2500, 36.4), 1.0, &[]).unwrap();
+        let (criteria, _) = drum_criteria(&runs(2500, 36.4), &settings(0.0), &[]).unwrap();
         let c = &criteria[2];
         assert_eq!(
             (c.name.as_str(), c.verdict),
@@ -229,6 +244,10 @@ mod tests {
             "{c:?}"
         );
         assert_eq!(crate::verdict::decide(&criteria).1, "zone 2 M1 count");
+        // A tolerance of 8% of the count holds it; the angle's 0.5 deg has no gap to hold.
+        let (criteria, _) = drum_criteria(&runs(2500, 36.4), &settings(0.08), &[]).unwrap();
+        assert_eq!(criteria[2].verdict, Verdict::Pass, "{:?}", criteria[2]);
+        assert_eq!(criteria[4].tolerance, 0.5);
     }
 
     #[test]
@@ -240,7 +259,7 @@ mod tests {
             evidence: "none".into(),
             band: [1.0, 5.0],
         };
-        let (criteria, _) = drum_criteria(&runs(2810, 33.0), 1.0, &[known]).unwrap();
+        let (criteria, _) = drum_criteria(&runs(2810, 33.0), &settings(0.0), &[known]).unwrap();
         let angle = &criteria[4];
         assert_eq!(angle.verdict, Verdict::KnownDifference, "{angle:?}");
         assert!(angle.value > 1.0 && angle.value < 5.0, "{angle:?}");
@@ -251,6 +270,6 @@ mod tests {
         let only: Vec<DrumRun> = (runs(2810, 36.4).into_iter())
             .filter(|r| r.code == Code::Cgdem)
             .collect();
-        assert!(drum_criteria(&only, 1.0, &[]).is_none());
+        assert!(drum_criteria(&only, &settings(0.0), &[]).is_none());
     }
 }
