@@ -1,7 +1,8 @@
 //! The report of a drum case: the rules, cgdem's verdict against the reference codes, a
 //! table of each run's steady means and swing (`figures/<case>/drum_runs.csv`), the zone
-//! counts, the surface angle and Lacey's index against time for every run, and every
-//! frame's measures as CSV (`figures/<case>/drum_frames.csv`) beside the figures.
+//! counts, the surface angle and Lacey's index against time (each code's mean over its
+//! seeds), and every frame's measures as CSV (`figures/<case>/drum_frames.csv`) beside the
+//! figures.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -189,55 +190,84 @@ fn frames_table(runs: &[DrumRun]) -> String {
     csv
 }
 
-/// The zone counts, the surface angle and Lacey's index against time, every run.
-fn figures(runs: &[DrumRun]) -> Vec<(&'static str, Figure, &'static str)> {
-    let mut counts = Figure::new(
-        "Zone counts against time",
-        "time since the drum started, s",
-        "grains",
-    );
-    let mut angle = Figure::new(
-        "Dynamic angle of repose",
-        "time since the drum started, s",
-        "surface angle, deg",
-    );
-    let mut lacey = Figure::new(
-        "Lacey's mixing index",
-        "time since the drum started, s",
-        "Lacey index",
-    );
-    let names = ["zone 1 M1", "zone 1 M2", "zone 2 M1", "zone 2 M2"];
-    for r in runs.iter().filter(|r| !r.frames.is_empty()) {
-        for (k, name) in names.iter().enumerate() {
-            let points = r
-                .frames
-                .iter()
-                .map(|f| (f.time_s, f.counts.as_array()[k] as f64))
-                .collect();
-            let style = if k < 2 {
-                SeriesStyle::LineMarkers
-            } else {
-                SeriesStyle::Dashed
-            };
-            counts = counts
-                .with_series(Series::new(format!("{} {name}", label(r)), points).style(style));
+/// The runs of one code and level (their seeds): for each frame time, rounded to the
+/// nearest frame interval (the seeds' rotations start up to a few steps apart), the mean and
+/// standard deviation over the seeds of `value`.
+fn seeds_mean(
+    runs: &[&DrumRun],
+    value: impl Fn(&super::FrameMeasure) -> Option<f64>,
+) -> (Vec<(f64, f64)>, Vec<f64>) {
+    let interval = (runs.iter())
+        .flat_map(|r| r.frames.windows(2).map(|w| w[1].time_s - w[0].time_s))
+        .fold(f64::INFINITY, f64::min);
+    let interval = if interval.is_finite() && interval > 0.0 {
+        interval
+    } else {
+        1.0
+    };
+    let mut at: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
+    for f in runs.iter().flat_map(|r| &r.frames) {
+        if let Some(v) = value(f) {
+            at.entry((f.time_s / interval).round() as i64)
+                .or_default()
+                .push(v);
         }
-        let points = r
-            .frames
-            .iter()
-            .filter_map(|f| f.surface.map(|s| (f.time_s, s.angle_deg)))
+    }
+    at.into_iter()
+        .map(|(k, v)| {
+            let (mean, sd) = crate::quantity::seeds::mean_spread(&v).unwrap_or((f64::NAN, 0.0));
+            ((k as f64 * interval, mean), sd)
+        })
+        .unzip()
+}
+
+/// The zone counts (zone 1 and zone 2 apart), the surface angle and Lacey's index against
+/// time: each code's mean over its seeds, with their standard deviation as error bars (each
+/// run's frames are in `drum_frames.csv`).
+fn figures(runs: &[DrumRun]) -> Vec<(&'static str, Figure, &'static str)> {
+    let axis = "time since the drum started, s";
+    let mut zone1 = Figure::new("Zone 1 counts against time", axis, "grains in zone 1");
+    let mut zone2 = Figure::new("Zone 2 counts against time", axis, "grains in zone 2");
+    let mut angle = Figure::new("Dynamic angle of repose", axis, "surface angle, deg");
+    let mut lacey = Figure::new("Lacey's mixing index", axis, "Lacey index");
+    let mut groups: Vec<(crate::code::Code, u32)> = (runs.iter())
+        .filter(|r| !r.frames.is_empty())
+        .map(|r| (r.code, r.lambda))
+        .collect();
+    groups.sort();
+    groups.dedup();
+    for (code, lambda) in groups {
+        let members: Vec<&DrumRun> = (runs.iter())
+            .filter(|r| r.code == code && r.lambda == lambda && !r.frames.is_empty())
             .collect();
-        angle = angle.with_series(Series::new(label(r), points).style(SeriesStyle::LineMarkers));
-        let points = r
-            .frames
-            .iter()
-            .filter_map(|f| f.lacey.map(|l| (f.time_s, l.index)))
-            .collect();
-        lacey = lacey.with_series(Series::new(label(r), points).style(SeriesStyle::LineMarkers));
+        let name = format!("{} l{lambda} ({} seeds)", code.name(), members.len());
+        let series = |label: String, (points, sd): (Vec<(f64, f64)>, Vec<f64>)| {
+            Series::new(label, points)
+                .y_err(sd)
+                .style(SeriesStyle::LineMarkers)
+        };
+        for (k, species) in ["M1", "M2"].iter().enumerate() {
+            let count = |zone: usize| {
+                seeds_mean(&members, move |f| {
+                    Some(f.counts.as_array()[2 * zone + k] as f64)
+                })
+            };
+            zone1 = zone1.with_series(series(format!("{name} {species}"), count(0)));
+            zone2 = zone2.with_series(series(format!("{name} {species}"), count(1)));
+        }
+        angle = angle.with_series(series(
+            name.clone(),
+            seeds_mean(&members, |f| f.surface.map(|s| s.angle_deg)),
+        ));
+        lacey = lacey.with_series(series(
+            name,
+            seeds_mean(&members, |f| f.lacey.map(|l| l.index)),
+        ));
     }
     vec![
-        ("drum_zone_counts", counts, "Grains of each species in MercuryDPM's zones 1 and 2 (solid: zone 1, dashed: zone 2); negative times are the settle."),
-        ("drum_surface_angle", angle, "The free surface's angle by the rule above, per frame."),
-        ("drum_lacey", lacey, "Lacey's index of the large grains' volume fraction, per frame."),
+        ("drum_zone1_counts", zone1, "Grains of each species in MercuryDPM's zone 1 (x > 0, z > 0): each code's mean over its seeds at each frame, error bars one standard deviation over the seeds; negative times are the settle."),
+        ("drum_zone2_counts", zone2, "Grains of each species in MercuryDPM's zone 2 (x < 0, z < 0), as zone 1's figure."),
+        ("drum_surface_angle", angle, "The free surface's angle by the rule above, each code's mean over its seeds per frame."),
+        ("drum_lacey", lacey, "Lacey's index of the large grains' volume fraction, each code's mean over its seeds per frame."),
     ]
 }

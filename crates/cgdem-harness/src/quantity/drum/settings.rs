@@ -23,9 +23,11 @@ pub struct DrumSettings {
     pub angle_tolerance_deg: f64,
 }
 
-/// The default tolerances: the reduced drum's three codes (cgdem, LIGGGHTS and LAMMPS, three
-/// seeds each) differ by up to about 2% on a zone count and 0.2 degrees on the angle where
-/// their seeds' means are a few tenths of a percent apart (reference/DRUM.md, "Three codes").
+/// The default tolerances. On the reduced drum (three seeds per code) the seeds' means of a
+/// zone count are a few tenths of a percent apart, while the two reference codes differ from
+/// each other by up to 5% (LAMMPS's smooth cylinder against LIGGGHTS's mesh: zone 2 M1, 1431
+/// against 1363) and by 0.2 degrees on the angle; with one reference code the seeds' noise
+/// alone would turn such a difference red (reports/drum/NOTE.md).
 pub const DEFAULT_COUNT_TOLERANCE: f64 = 0.03;
 pub const DEFAULT_ANGLE_TOLERANCE_DEG: f64 = 1.0;
 

@@ -290,10 +290,10 @@ fn a_run_is_measured_from_its_frames_and_reported() {
         "{runs_csv}"
     );
     assert!(out
-        .join("figures/drum_reduced/drum_zone_counts.png")
+        .join("figures/drum_reduced/drum_zone1_counts.png")
         .exists());
     assert!(out
-        .join("figures/drum_reduced/drum_zone_counts.csv")
+        .join("figures/drum_reduced/drum_zone2_counts.csv")
         .exists());
 
     // A reference code's run is read from its trajectory dump, which this one lacks.
