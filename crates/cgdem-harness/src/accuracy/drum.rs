@@ -9,7 +9,9 @@ use std::path::Path;
 use super::measurement::settings;
 use super::AccuracyPoint;
 use crate::code::Code;
-use crate::quantity::drum::{measure_runs, write_levels_table, DrumSettings, LevelMeans};
+use crate::quantity::drum::{
+    measure_runs, species_diameters, write_levels_table, DrumSettings, LevelMeans,
+};
 use crate::report::Section;
 use crate::runs::{RunRecord, ValidateError};
 use cgdem_core::scene::Scene;
@@ -39,11 +41,7 @@ pub(crate) fn measure_drum(
 /// The large grains' share of the solid volume in zones 1 and 2 from the mean counts (a
 /// parcel's volume is lambda^3 grains' for both species, so the share needs no lambda).
 fn large_share_zones(scene: &Scene, counts: &[f64; 4]) -> Option<[f64; 2]> {
-    let d: Vec<f64> = scene.species.iter().map(|s| s.diameter).collect();
-    let (small, large) = (
-        d.iter().copied().fold(f64::INFINITY, f64::min),
-        d.iter().copied().fold(0.0, f64::max),
-    );
+    let (small, large) = species_diameters(scene);
     let share = |m1: f64, m2: f64| {
         let (v1, v2) = (m1 * small.powi(3), m2 * large.powi(3));
         (v1 + v2 > 0.0).then(|| v2 / (v1 + v2))

@@ -26,7 +26,7 @@ use crate::decks::DeckError;
 use cgdem_core::geometry::screw_feeder::{hopper_inner_rect, ScrewFeederSpec};
 use cgdem_core::geometry::silo::SiloSpec;
 use cgdem_core::math::Real;
-use cgdem_core::scene::{BodySettings, MeshSource, Scene, SiloPart};
+use cgdem_core::scene::{BodyParticles, BodySettings, MeshSource, Scene, SiloPart};
 
 /// The deck lines of the scene's bodies.
 pub(crate) struct BodyLines {
@@ -77,8 +77,8 @@ pub(crate) fn body_lines(
     };
     let mut regions = Vec::new();
     for (k, b) in scene.bodies.iter().enumerate() {
-        if b.particles.is_some() {
-            particle_body(scene, k, &mut out)?;
+        if let Some(bp) = &b.particles {
+            particle_body(scene, k, bp, &mut out)?;
         } else {
             regions.push(region_body(scene, k)?);
         }
@@ -139,10 +139,14 @@ fn refix(fixes: &str) -> String {
 }
 
 /// A body built of particles: its group and, when it turns, its `fix move` from its stage.
-fn particle_body(scene: &Scene, k: usize, out: &mut BodyLines) -> Result<(), DeckError> {
+fn particle_body(
+    scene: &Scene,
+    k: usize,
+    bp: &BodyParticles,
+    out: &mut BodyLines,
+) -> Result<(), DeckError> {
     let unsupported = |reason: String| DeckError::unsupported(scene, reason);
     let b = &scene.bodies[k];
-    let bp = b.particles.as_ref().expect("a particle body");
     // The body's atoms are its species' atoms: no other body or insertion may use it.
     let shared = scene
         .bodies

@@ -23,6 +23,7 @@ pub use measurement::{
 };
 pub use oscillation::{oscillation, Oscillation};
 pub use report::write_drum_section;
+pub(crate) use run::species_diameters;
 pub use run::{measure_runs, DrumRun, FrameMeasure, SteadyMeans};
 pub use settings::DrumSettings;
 pub(crate) use settings::{parse_drum, RawDrum};

@@ -173,6 +173,15 @@ fn large_type(scene: &Scene) -> Result<u64, String> {
     }
 }
 
+/// The scene's smallest and largest species diameters (the drum's M1 and M2), m.
+pub(crate) fn species_diameters(scene: &Scene) -> (f64, f64) {
+    let d = scene.species.iter().map(|s| s.diameter);
+    (
+        d.clone().fold(f64::INFINITY, f64::min),
+        d.fold(0.0, f64::max),
+    )
+}
+
 /// Every frame of one finished run measured: the surface in bins of two small-grain
 /// diameters, Lacey's index in cells of 2.5 large-grain diameters with at least 10 grains
 /// (4 mm and 10 mm in the benchmark; at lambda > 1 the parcels').
@@ -197,13 +206,8 @@ pub(crate) fn measure_one(
         .start_s;
     let large = large_type(scene)?;
     let lambda = f64::from(r.lambda);
-    let small_d = lambda
-        * scene
-            .species
-            .iter()
-            .map(|s| s.diameter)
-            .fold(f64::INFINITY, f64::min);
-    let large_d = lambda * scene.species.iter().map(|s| s.diameter).fold(0.0, f64::max);
+    let (small_d, large_d) = species_diameters(scene);
+    let (small_d, large_d) = (lambda * small_d, lambda * large_d);
     let measure = |time: f64, grains: Vec<Grain>| FrameMeasure {
         time_s: time - start,
         counts: zone_counts(&grains),
